@@ -1,0 +1,109 @@
+//! `meta.toml`: what a calibrator must know about the robot and the world besides the samples.
+
+use serde::{Deserialize, Serialize};
+
+/// The format tag every `meta.toml` carries.
+pub const FORMAT: &str = "hilsim-recording/1";
+
+/// The contents of `meta.toml`.
+///
+/// Unknown keys are ignored when reading, so that other tools may add their own.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// The robot's geometry.
+    pub robot: RobotMeta,
+    /// The lidar's mount pose; absent when the robot has no lidar.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lidar: Option<LidarMount>,
+    /// The sonar's mount and beam; absent when the robot has no sonar.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sonar: Option<SonarMount>,
+    /// What is known of the environment.
+    #[serde(default, skip_serializing_if = "WorldMeta::is_empty")]
+    pub world: WorldMeta,
+    /// Where the recording came from (hilsim's own addition; optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<SourceMeta>,
+}
+
+impl Default for Meta {
+    fn default() -> Self {
+        Self {
+            format: FORMAT.to_string(),
+            robot: RobotMeta { wheel_base_m: 0.23 },
+            lidar: None,
+            sonar: None,
+            world: WorldMeta::default(),
+            source: None,
+        }
+    }
+}
+
+/// `[robot]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotMeta {
+    /// Distance between the wheels, metres.
+    pub wheel_base_m: f64,
+}
+
+/// `[lidar]`: the mount pose in the robot frame (x forward, y left).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LidarMount {
+    /// Forward offset, metres.
+    #[serde(default)]
+    pub x_m: f64,
+    /// Leftward offset, metres.
+    #[serde(default)]
+    pub y_m: f64,
+    /// Yaw of the lidar's 0° axis relative to the robot's forward axis, degrees.
+    #[serde(default)]
+    pub yaw_deg: f64,
+}
+
+/// `[sonar]`: the mount and the beam.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SonarMount {
+    /// Forward offset, metres (hilsim addition; default 0).
+    #[serde(default)]
+    pub x_m: f64,
+    /// Leftward offset, metres (hilsim addition; default 0).
+    #[serde(default)]
+    pub y_m: f64,
+    /// Yaw of the beam axis relative to the robot's forward axis, degrees.
+    #[serde(default)]
+    pub yaw_deg: f64,
+    /// Half of the beam cone, degrees.
+    pub half_angle_deg: f64,
+}
+
+/// `[world]`: what is known of the environment; every key optional.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct WorldMeta {
+    /// The cylinders' radius, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub landmark_radius_m: Option<f64>,
+    /// Lidar-to-frontal-target distance at t = 0, when known (EM needs it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_start_distance_m: Option<f64>,
+}
+
+impl WorldMeta {
+    fn is_empty(&self) -> bool {
+        self.landmark_radius_m.is_none() && self.target_start_distance_m.is_none()
+    }
+}
+
+/// `[source]`: which scenario and seed produced a simulated recording.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SourceMeta {
+    /// What wrote the recording, e.g. `hilsim 0.1.0`.
+    pub generator: String,
+    /// The scenario's name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scenario: Option<String>,
+    /// The seed of the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}

@@ -1,0 +1,335 @@
+//! Reading a recording directory, strictly: a malformed file is an error naming the file and line.
+
+use std::fs;
+use std::path::Path;
+
+use crate::csv::Table;
+use crate::{
+    CommandSample, Error, LidarSample, Meta, OdometrySample, Recording, SonarSample, TruthSample,
+    FORMAT,
+};
+
+impl Recording {
+    /// Reads a recording directory.
+    ///
+    /// `meta.toml` and `commands.csv` are required; the sensor tables and `truth.csv` may be
+    /// absent. Columns are found by name, so extra columns are ignored; times must be finite,
+    /// non-negative and never go backwards.
+    ///
+    /// # Errors
+    /// A missing required file, or the first malformed line, naming the file and line.
+    pub fn read_dir(dir: &Path) -> Result<Self, Error> {
+        if !dir.is_dir() {
+            return Err(Error::format(dir, None, "not a recording directory"));
+        }
+        let meta = read_meta(&dir.join("meta.toml"))?;
+        let commands_path = dir.join("commands.csv");
+        let commands = read_commands(&commands_path, &read_text(&commands_path)?)?;
+        Ok(Self {
+            meta,
+            commands,
+            odometry: optional(dir, "odometry.csv", read_odometry)?,
+            lidar: optional(dir, "lidar.csv", read_lidar)?,
+            sonar: optional(dir, "sonar.csv", read_sonar)?,
+            truth: optional(dir, "truth.csv", read_truth)?,
+        })
+    }
+}
+
+fn read_text(path: &Path) -> Result<String, Error> {
+    let bytes = fs::read(path).map_err(|err| Error::io(path, err))?;
+    String::from_utf8(bytes).map_err(|err| {
+        let line = 1 + err.as_bytes()[..err.utf8_error().valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        Error::format(path, Some(line), "not UTF-8 text")
+    })
+}
+
+fn optional<T>(
+    dir: &Path,
+    name: &str,
+    read: fn(&Path, &str) -> Result<Vec<T>, Error>,
+) -> Result<Option<Vec<T>>, Error> {
+    let path = dir.join(name);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = read_text(&path)?;
+    read(&path, &text).map(Some)
+}
+
+fn read_meta(path: &Path) -> Result<Meta, Error> {
+    let text = read_text(path)?;
+    let meta: Meta = toml::from_str(&text).map_err(|err| {
+        let line = err
+            .span()
+            .map(|span| 1 + text[..span.start.min(text.len())].matches('\n').count());
+        Error::format(path, line, err.message().trim().to_string())
+    })?;
+    if meta.format != FORMAT {
+        return Err(Error::format(
+            path,
+            None,
+            format!("format is `{}`, expected `{FORMAT}`", meta.format),
+        ));
+    }
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !positive(meta.robot.wheel_base_m) {
+        return Err(Error::format(path, None, "robot.wheel_base_m must be positive"));
+    }
+    if let Some(sonar) = &meta.sonar {
+        if !(sonar.half_angle_deg.is_finite() && (0.0..90.0).contains(&sonar.half_angle_deg)) {
+            return Err(Error::format(
+                path,
+                None,
+                "sonar.half_angle_deg must be in [0, 90)",
+            ));
+        }
+    }
+    for (key, value) in [
+        ("world.landmark_radius_m", meta.world.landmark_radius_m),
+        ("world.target_start_distance_m", meta.world.target_start_distance_m),
+    ] {
+        if value.is_some_and(|v| !positive(v)) {
+            return Err(Error::format(path, None, format!("{key} must be positive")));
+        }
+    }
+    Ok(meta)
+}
+
+fn read_commands(path: &Path, text: &str) -> Result<Vec<CommandSample>, Error> {
+    let table = Table::parse(path, text)?;
+    let (t, l, r) = (
+        table.column("t_s")?,
+        table.column("left_mps")?,
+        table.column("right_mps")?,
+    );
+    let mut prev = None;
+    table
+        .rows()
+        .map(|row| {
+            let t_s = row.f64(t)?;
+            row.check_time(t_s, &mut prev)?;
+            Ok(CommandSample {
+                t_s,
+                left_mps: row.f64(l)?,
+                right_mps: row.f64(r)?,
+            })
+        })
+        .collect()
+}
+
+fn read_odometry(path: &Path, text: &str) -> Result<Vec<OdometrySample>, Error> {
+    let table = Table::parse(path, text)?;
+    let (t, l, r) = (
+        table.column("t_s")?,
+        table.column("left_m")?,
+        table.column("right_m")?,
+    );
+    let mut prev = None;
+    table
+        .rows()
+        .map(|row| {
+            let t_s = row.f64(t)?;
+            row.check_time(t_s, &mut prev)?;
+            Ok(OdometrySample {
+                t_s,
+                left_m: row.f64(l)?,
+                right_m: row.f64(r)?,
+            })
+        })
+        .collect()
+}
+
+fn read_lidar(path: &Path, text: &str) -> Result<Vec<LidarSample>, Error> {
+    let table = Table::parse(path, text)?;
+    let t = table.column("t_s")?;
+    let rev = table.column("rev")?;
+    let angle = table.column("angle_deg")?;
+    let range = table.column("range_m")?;
+    let strength = table.column("strength")?;
+    let invalid = table.column("invalid")?;
+    let warning = table.column("warning")?;
+    let truth = table.optional_column("true_range_m");
+    let mut prev = None;
+    table
+        .rows()
+        .map(|row| {
+            let t_s = row.f64(t)?;
+            row.check_time(t_s, &mut prev)?;
+            let angle_deg: u16 = row.uint(angle)?;
+            if angle_deg >= 360 {
+                return Err(Error::format(
+                    path,
+                    Some(row.line),
+                    format!("column `angle_deg`: expected 0..359, found {angle_deg}"),
+                ));
+            }
+            let range_m = row.f64(range)?;
+            if range_m < 0.0 {
+                return Err(Error::format(
+                    path,
+                    Some(row.line),
+                    format!("column `range_m`: must not be negative, found {range_m}"),
+                ));
+            }
+            Ok(LidarSample {
+                t_s,
+                rev: row.uint(rev)?,
+                angle_deg,
+                range_m,
+                strength: row.uint(strength)?,
+                invalid: row.flag(invalid)?,
+                warning: row.flag(warning)?,
+                true_range_m: truth.map(|c| row.f64(c)).transpose()?,
+            })
+        })
+        .collect()
+}
+
+fn read_sonar(path: &Path, text: &str) -> Result<Vec<SonarSample>, Error> {
+    let table = Table::parse(path, text)?;
+    let (t, range) = (table.column("t_s")?, table.column("range_m")?);
+    let truth = table.optional_column("true_range_m");
+    let mut prev = None;
+    table
+        .rows()
+        .map(|row| {
+            let t_s = row.f64(t)?;
+            row.check_time(t_s, &mut prev)?;
+            Ok(SonarSample {
+                t_s,
+                range_m: row.f64(range)?,
+                true_range_m: truth.map(|c| row.f64(c)).transpose()?,
+            })
+        })
+        .collect()
+}
+
+fn read_truth(path: &Path, text: &str) -> Result<Vec<TruthSample>, Error> {
+    let table = Table::parse(path, text)?;
+    let (t, x, y, yaw) = (
+        table.column("t_s")?,
+        table.column("x_m")?,
+        table.column("y_m")?,
+        table.column("yaw_rad")?,
+    );
+    let mut prev = None;
+    table
+        .rows()
+        .map(|row| {
+            let t_s = row.f64(t)?;
+            row.check_time(t_s, &mut prev)?;
+            Ok(TruthSample {
+                t_s,
+                x_m: row.f64(x)?,
+                y_m: row.f64(y)?,
+                yaw_rad: row.f64(yaw)?,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, name: &str, text: &str) {
+        fs::write(dir.join(name), text).unwrap();
+    }
+
+    fn minimal(dir: &Path) {
+        write(dir, "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n");
+        write(dir, "commands.csv", "t_s,left_mps,right_mps\n0,0.1,0.1\n");
+    }
+
+    fn err(dir: &Path) -> String {
+        Recording::read_dir(dir).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn minimal_recording_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        let rec = Recording::read_dir(dir.path()).unwrap();
+        assert_eq!(rec.commands.len(), 1);
+        assert!(rec.lidar.is_none());
+    }
+
+    #[test]
+    fn malformed_rows_name_file_and_line() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        write(dir.path(), "sonar.csv", "t_s,range_m\n0.0,1.0\n0.1,abc\n");
+        let msg = err(dir.path());
+        assert!(msg.ends_with("sonar.csv:3: column `range_m`: expected a finite number, found `abc`"), "{msg}");
+        write(dir.path(), "sonar.csv", "t_s,range_m\n0.2,1.0\n0.1,1.0\n");
+        assert!(err(dir.path()).contains("sonar.csv:3: time goes backwards"));
+        write(dir.path(), "sonar.csv", "t_s,range_m\n0.0,NaN\n");
+        assert!(err(dir.path()).contains("sonar.csv:2:"));
+        write(dir.path(), "sonar.csv", "t_s,range\n0.0,1\n");
+        assert!(err(dir.path()).contains("sonar.csv:1: missing column `range_m`"));
+        write(dir.path(), "sonar.csv", "t_s,range_m\n0.0\n");
+        assert!(err(dir.path()).contains("sonar.csv:2: expected 2 fields"));
+        write(dir.path(), "sonar.csv", "");
+        assert!(err(dir.path()).contains("sonar.csv:1: empty file"));
+    }
+
+    #[test]
+    fn lidar_flags_and_angles_are_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        let header = "t_s,rev,angle_deg,range_m,strength,invalid,warning\n";
+        write(dir.path(), "lidar.csv", &format!("{header}0,0,360,1.0,100,0,0\n"));
+        assert!(err(dir.path()).contains("lidar.csv:2: column `angle_deg`"));
+        write(dir.path(), "lidar.csv", &format!("{header}0,0,1,1.0,100,2,0\n"));
+        assert!(err(dir.path()).contains("lidar.csv:2: column `invalid`: expected 0 or 1"));
+        write(dir.path(), "lidar.csv", &format!("{header}0,0,1,1.0,70000,0,0\n"));
+        assert!(err(dir.path()).contains("column `strength`"));
+    }
+
+    #[test]
+    fn meta_is_validated() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        write(dir.path(), "meta.toml", "format = \"other/2\"\n[robot]\nwheel_base_m = 0.23\n");
+        assert!(err(dir.path()).contains("meta.toml: format is `other/2`"));
+        write(dir.path(), "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = -1\n");
+        assert!(err(dir.path()).contains("wheel_base_m must be positive"));
+        write(dir.path(), "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\n");
+        assert!(err(dir.path()).contains("meta.toml:"));
+        fs::remove_file(dir.path().join("meta.toml")).unwrap();
+        assert!(err(dir.path()).contains("meta.toml: "));
+    }
+
+    #[test]
+    fn write_then_read_is_identity_and_replaces_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("rec");
+        let mut rec = Recording::new(Meta::default());
+        rec.commands.push(CommandSample { t_s: 0.0, left_mps: 0.1, right_mps: 0.1 });
+        rec.lidar = Some(vec![LidarSample {
+            t_s: 0.1 + 0.2,
+            rev: 0,
+            angle_deg: 359,
+            range_m: 1.234,
+            strength: 3000,
+            invalid: false,
+            warning: true,
+            true_range_m: Some(1.2299999999),
+        }]);
+        rec.sonar = Some(vec![]);
+        rec.write_dir(&out).unwrap();
+        assert_eq!(Recording::read_dir(&out).unwrap(), rec);
+        // A second write without the lidar must not leave the old lidar.csv behind.
+        rec.lidar = None;
+        rec.write_dir(&out).unwrap();
+        assert!(!out.join("lidar.csv").exists());
+        assert_eq!(Recording::read_dir(&out).unwrap(), rec);
+        // No temporary siblings remain.
+        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("rec")]);
+    }
+}

@@ -1,0 +1,293 @@
+//! The simulation: a fixed-step physics clock, the differential drive, ground truth at every step
+//! and the log of collisions. Nothing here reads the wall clock: a run is a pure function of the
+//! scenario (and the seed, for the sensors that draw noise).
+
+use hilsim_recording::{CommandSample, TruthSample};
+use rapier2d::prelude::*;
+
+use crate::drive::{DriveProgram, WheelCommand};
+use crate::pose::{wrap_angle, Pose};
+use crate::scenario::Scenario;
+use crate::world::{Obstacle, World};
+
+/// The robot touched an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    /// When the contact started, seconds.
+    pub t_s: f64,
+    /// What the robot touched.
+    pub obstacle: Obstacle,
+    /// The robot's pose then.
+    pub pose: Pose,
+}
+
+/// What happened during one physics step, for the sensors to sample from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepState {
+    /// Index of the step, from 0.
+    pub index: u64,
+    /// Time at the start of the step, seconds.
+    pub t0: f64,
+    /// Time at the end of the step, seconds.
+    pub t1: f64,
+    /// The robot's pose at `t0`.
+    pub pose0: Pose,
+    /// The robot's pose at `t1`.
+    pub pose1: Pose,
+    /// The command in force during the step.
+    pub command: WheelCommand,
+    /// True cumulative wheel travel (left, right) at `t0`, metres.
+    pub wheels0: [f64; 2],
+    /// True cumulative wheel travel (left, right) at `t1`, metres.
+    pub wheels1: [f64; 2],
+}
+
+impl StepState {
+    /// The robot's pose at time `t` within the step (clamped to it).
+    #[must_use]
+    pub fn pose_at(&self, t: f64) -> Pose {
+        self.pose0.lerp(&self.pose1, self.fraction(t))
+    }
+
+    /// True cumulative wheel travel at time `t` within the step.
+    #[must_use]
+    pub fn wheels_at(&self, t: f64) -> [f64; 2] {
+        let u = self.fraction(t);
+        [
+            self.wheels0[0] + (self.wheels1[0] - self.wheels0[0]) * u,
+            self.wheels0[1] + (self.wheels1[1] - self.wheels0[1]) * u,
+        ]
+    }
+
+    fn fraction(&self, t: f64) -> f64 {
+        ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0)
+    }
+}
+
+/// Where the wheel commands come from.
+enum Driver {
+    /// The scenario's drive program.
+    Program(DriveProgram),
+    /// Set from outside (firmware in the loop) with [`Simulation::set_command`].
+    External(WheelCommand),
+}
+
+/// A running simulation of one scenario.
+pub struct Simulation {
+    world: World,
+    driver: Driver,
+    step_s: f64,
+    wheel_base_m: f64,
+    steps_done: u64,
+    end_step: Option<u64>,
+    pose: Pose,
+    wheels: [f64; 2],
+    commands: Vec<CommandSample>,
+    truth: Vec<TruthSample>,
+    collisions: Vec<Collision>,
+    touching: Vec<ColliderHandle>,
+}
+
+impl Simulation {
+    /// A simulation that runs the scenario's drive program until `duration_s` or the program's
+    /// end.
+    #[must_use]
+    pub fn new(scenario: &Scenario) -> Self {
+        let mut sim = Self::build(scenario, Driver::Program(DriveProgram::new(scenario)));
+        sim.end_step = Some(scenario.run_steps());
+        sim
+    }
+
+    /// A simulation whose wheels are commanded from outside ([`Simulation::set_command`]), with
+    /// no end of its own.
+    #[must_use]
+    pub fn externally_driven(scenario: &Scenario) -> Self {
+        Self::build(scenario, Driver::External(WheelCommand::default()))
+    }
+
+    fn build(scenario: &Scenario, driver: Driver) -> Self {
+        let world = World::new(scenario);
+        let pose = world.robot_pose();
+        Self {
+            world,
+            driver,
+            step_s: scenario.step_s(),
+            wheel_base_m: scenario.robot.wheel_base_m,
+            steps_done: 0,
+            end_step: None,
+            pose,
+            wheels: [0.0; 2],
+            commands: Vec::new(),
+            truth: vec![truth(0.0, pose)],
+            collisions: Vec::new(),
+            touching: Vec::new(),
+        }
+    }
+
+    /// Sets the wheel command of an externally driven simulation; ignored when the drive
+    /// program drives.
+    pub fn set_command(&mut self, command: WheelCommand) {
+        if let Driver::External(current) = &mut self.driver {
+            *current = command;
+        }
+    }
+
+    /// The simulated time now, seconds.
+    #[must_use]
+    pub fn time_s(&self) -> f64 {
+        self.steps_done as f64 * self.step_s
+    }
+
+    /// The physics step, seconds.
+    #[must_use]
+    pub fn step_s(&self) -> f64 {
+        self.step_s
+    }
+
+    /// Whether the run has reached its end.
+    #[must_use]
+    pub fn finished(&self) -> bool {
+        self.end_step.is_some_and(|end| self.steps_done >= end)
+    }
+
+    /// The world, for sensors to cast rays in.
+    #[must_use]
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The robot's pose now.
+    #[must_use]
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// Advances one physics step; `None` once the run has ended.
+    pub fn step(&mut self) -> Option<StepState> {
+        if self.finished() {
+            return None;
+        }
+        let index = self.steps_done;
+        let command = match &self.driver {
+            Driver::Program(program) => program.command_at(index),
+            Driver::External(command) => *command,
+        };
+        let t0 = self.time_s();
+        if self.commands.last().is_none_or(|c| {
+            c.left_mps != command.left_mps || c.right_mps != command.right_mps
+        }) {
+            self.commands.push(CommandSample {
+                t_s: t0,
+                left_mps: command.left_mps,
+                right_mps: command.right_mps,
+            });
+        }
+        self.apply(command);
+        self.world.physics.step();
+        self.steps_done += 1;
+        let t1 = self.time_s();
+        let pose0 = self.pose;
+        let pose1 = self.world.robot_pose();
+        let wheels0 = self.wheels;
+        self.wheels = self.wheel_travel(pose0, pose1);
+        self.pose = pose1;
+        self.truth.push(truth(t1, pose1));
+        self.log_contacts(t1);
+        Some(StepState {
+            index,
+            t0,
+            t1,
+            pose0,
+            pose1,
+            command,
+            wheels0,
+            wheels1: self.wheels,
+        })
+    }
+
+    /// Differential drive: wheel speeds → body twist, held by setting the body's velocity each
+    /// step; the physics then resolves contacts (a wall stops the robot).
+    fn apply(&mut self, command: WheelCommand) {
+        let v = (command.left_mps + command.right_mps) / 2.0;
+        let omega = (command.right_mps - command.left_mps) / self.wheel_base_m;
+        let (sin, cos) = self.pose.yaw.sin_cos();
+        let body = &mut self.world.physics.bodies[self.world.robot];
+        body.set_linvel(Vector::new((v * cos) as f32, (v * sin) as f32), true);
+        body.set_angvel(omega as f32, true);
+    }
+
+    /// The wheels' true cumulative travel after moving from `p0` to `p1`: the body's forward
+    /// displacement and turn, split onto the wheels. A robot pushed against a wall stalls its
+    /// wheels: they report what the body did, not what was commanded.
+    fn wheel_travel(&self, p0: Pose, p1: Pose) -> [f64; 2] {
+        let mid_yaw = p0.yaw + wrap_angle(p1.yaw - p0.yaw) / 2.0;
+        let forward = (p1.x - p0.x) * mid_yaw.cos() + (p1.y - p0.y) * mid_yaw.sin();
+        let turn = wrap_angle(p1.yaw - p0.yaw) * self.wheel_base_m / 2.0;
+        [self.wheels[0] + forward - turn, self.wheels[1] + forward + turn]
+    }
+
+    fn log_contacts(&mut self, t: f64) {
+        let robot = self.world.robot_collider();
+        let now: Vec<ColliderHandle> = self
+            .world
+            .physics
+            .contact_pairs_with(robot)
+            .filter(|pair| pair.has_any_active_contact())
+            .map(|pair| {
+                if pair.collider1 == robot {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                }
+            })
+            .collect();
+        for handle in &now {
+            if !self.touching.contains(handle) {
+                if let Some(obstacle) = self.world.obstacle(*handle) {
+                    self.collisions.push(Collision {
+                        t_s: t,
+                        obstacle,
+                        pose: self.pose,
+                    });
+                }
+            }
+        }
+        self.touching = now;
+    }
+
+    /// Commands as issued so far, one row per change.
+    #[must_use]
+    pub fn commands(&self) -> &[CommandSample] {
+        &self.commands
+    }
+
+    /// The true pose at every step so far, from t = 0.
+    #[must_use]
+    pub fn truth(&self) -> &[TruthSample] {
+        &self.truth
+    }
+
+    /// Contacts the robot started with obstacles.
+    #[must_use]
+    pub fn collisions(&self) -> &[Collision] {
+        &self.collisions
+    }
+
+    /// Hands over the logs, leaving the simulation's empty.
+    pub fn take_logs(&mut self) -> (Vec<CommandSample>, Vec<TruthSample>, Vec<Collision>) {
+        (
+            std::mem::take(&mut self.commands),
+            std::mem::take(&mut self.truth),
+            std::mem::take(&mut self.collisions),
+        )
+    }
+}
+
+fn truth(t_s: f64, pose: Pose) -> TruthSample {
+    TruthSample {
+        t_s,
+        x_m: pose.x,
+        y_m: pose.y,
+        yaw_rad: pose.yaw,
+    }
+}

@@ -1,0 +1,145 @@
+//! The static world and the robot's body in a rapier2d physics world, seen from above: no
+//! gravity, obstacles fixed, the robot a dynamic disc driven by wheel speeds.
+//!
+//! rapier works in `f32` glam types; everything public here is `f64` in SI units.
+
+use rapier2d::prelude::*;
+
+use crate::pose::Pose;
+use crate::scenario::Scenario;
+
+/// What a collider is, so a sensor can ask what it hit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Obstacle {
+    /// `world.walls[i]`.
+    Wall(usize),
+    /// `world.cylinders[i]`.
+    Cylinder(usize),
+    /// `world.boards[i]`.
+    Board(usize),
+}
+
+/// A ray's first hit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayHit {
+    /// Distance along the ray, metres.
+    pub distance: f64,
+    /// What was hit.
+    pub obstacle: Obstacle,
+    /// Surface normal at the hit, world frame, unit length.
+    pub normal: [f64; 2],
+    /// The surface material's reflectivity, (0, 1].
+    pub reflectivity: f64,
+}
+
+/// The physics world: obstacles plus the robot's body.
+pub struct World {
+    pub(crate) physics: PhysicsWorld,
+    pub(crate) robot: RigidBodyHandle,
+    robot_collider: ColliderHandle,
+    /// Per obstacle collider (indexed by `user_data`): what it is and its reflectivity.
+    obstacles: Vec<(Obstacle, f64)>,
+}
+
+impl World {
+    /// Builds the world of a validated scenario with the robot at its start pose.
+    #[must_use]
+    pub fn new(scenario: &Scenario) -> Self {
+        let mut physics = PhysicsWorld::default();
+        physics.gravity = Vector::ZERO;
+        physics.integration_parameters.dt = scenario.step_s() as f32;
+        let mut obstacles = Vec::new();
+        let fixed = physics.insert_body(RigidBodyBuilder::fixed());
+        let mut add = |physics: &mut PhysicsWorld, builder: ColliderBuilder, what, material: Option<&String>| {
+            let collider = builder
+                .user_data(obstacles.len() as u128)
+                .friction(0.0)
+                .build();
+            obstacles.push((what, scenario.reflectivity(material.map(String::as_str))));
+            physics.insert_collider(collider, Some(fixed));
+        };
+        let w = &scenario.world;
+        for (i, wall) in w.walls.iter().enumerate() {
+            let builder = ColliderBuilder::segment(vec2(wall.from), vec2(wall.to));
+            add(&mut physics, builder, Obstacle::Wall(i), wall.material.as_ref());
+        }
+        for (i, c) in w.cylinders.iter().enumerate() {
+            let builder = ColliderBuilder::ball(c.radius as f32).translation(vec2(c.center));
+            add(&mut physics, builder, Obstacle::Cylinder(i), c.material.as_ref());
+        }
+        for (i, b) in w.boards.iter().enumerate() {
+            let builder = ColliderBuilder::cuboid((b.length / 2.0) as f32, (b.thickness / 2.0) as f32)
+                .translation(vec2(b.center))
+                .rotation(b.yaw_deg.to_radians() as f32);
+            add(&mut physics, builder, Obstacle::Board(i), b.material.as_ref());
+        }
+        let start = scenario.robot.start;
+        let (robot, robot_collider) = physics.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(start.x as f32, start.y as f32))
+                .rotation(start.yaw_deg.to_radians() as f32)
+                .can_sleep(false)
+                // Fast, thin walls: sweep the robot so it cannot tunnel through a segment.
+                .ccd_enabled(true),
+            ColliderBuilder::ball(scenario.robot.radius_m as f32)
+                .friction(0.0)
+                .active_events(ActiveEvents::COLLISION_EVENTS),
+        );
+        Self {
+            physics,
+            robot,
+            robot_collider,
+            obstacles,
+        }
+    }
+
+    /// The robot's pose now.
+    #[must_use]
+    pub fn robot_pose(&self) -> Pose {
+        let body = &self.physics.bodies[self.robot];
+        let t = body.translation();
+        Pose::new(f64::from(t.x), f64::from(t.y), f64::from(body.rotation().angle()))
+    }
+
+    /// Casts a ray from `origin` along `heading_rad` (world frame) up to `max_m`, ignoring the
+    /// robot's own body. Static obstacles do not move, so the answer does not depend on when
+    /// within a physics step it is asked.
+    #[must_use]
+    pub fn cast_ray(&self, origin: [f64; 2], heading_rad: f64, max_m: f64) -> Option<RayHit> {
+        let (sin, cos) = heading_rad.sin_cos();
+        let ray = Ray::new(vec2(origin), Vector::new(cos as f32, sin as f32));
+        let filter = QueryFilter::default().exclude_rigid_body(self.robot);
+        let (handle, hit) = self
+            .physics
+            .cast_ray_and_get_normal(&ray, max_m as f32, true, filter)?;
+        let (obstacle, reflectivity) = self.obstacle_of(handle)?;
+        Some(RayHit {
+            distance: f64::from(hit.time_of_impact),
+            obstacle,
+            normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
+            reflectivity,
+        })
+    }
+
+    fn obstacle_of(&self, handle: ColliderHandle) -> Option<(Obstacle, f64)> {
+        let index = self.physics.colliders.get(handle)?.user_data as usize;
+        self.obstacles.get(index).copied()
+    }
+
+    /// What a collider handle refers to, if it is an obstacle.
+    pub(crate) fn obstacle(&self, handle: ColliderHandle) -> Option<Obstacle> {
+        if handle == self.robot_collider {
+            return None;
+        }
+        self.obstacle_of(handle).map(|(o, _)| o)
+    }
+
+    /// The robot's collider.
+    pub(crate) fn robot_collider(&self) -> ColliderHandle {
+        self.robot_collider
+    }
+}
+
+fn vec2(p: [f64; 2]) -> Vector {
+    Vector::new(p[0] as f32, p[1] as f32)
+}

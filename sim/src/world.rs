@@ -85,6 +85,8 @@ impl World {
                 .friction(0.0)
                 .active_events(ActiveEvents::COLLISION_EVENTS),
         );
+        // Fill the broad phase now so that rays can be cast before the first step.
+        physics.detect_collisions(&(), &());
         Self {
             physics,
             robot,

@@ -1,0 +1,19 @@
+//! Sensor emulators for hilsim, driven by the simulated world: the papers' range model, the Neato
+//! XV-11 triangulation lidar, the sonar and the wheel-slip odometer, their in-process delivery
+//! ([`Emulation`]), and the Neato XV-11 serial packet codec.
+#![warn(missing_docs)]
+
+mod emulation;
+pub mod lidar;
+mod mount;
+pub mod neato_packet;
+mod odometer;
+mod range_model;
+mod sonar;
+
+pub use emulation::{Emulation, Run, StepSamples};
+pub use lidar::{Lidar, LidarReading};
+pub use mount::Mount;
+pub use odometer::Odometer;
+pub use range_model::{ModelError, RangeModel, RangeModelBuilder};
+pub use sonar::Sonar;

@@ -1,0 +1,25 @@
+//! One module per subcommand; each validates its arguments before opening anything.
+
+pub mod record;
+pub mod run;
+pub mod scenario_test;
+
+use std::path::Path;
+
+use anyhow::Result;
+use hilsim_sim::Scenario;
+
+/// The built-in default scenario: the straight-board run of the EM paper (Sec. VI).
+const BUILTIN_SCENARIO: &str = include_str!("../../scenarios/straight-board.toml");
+
+/// Loads a scenario file, or the built-in one, and applies a `--seed` override.
+pub fn load_scenario(path: Option<&Path>, seed: Option<u64>) -> Result<Scenario> {
+    let mut scenario = match path {
+        Some(path) => Scenario::load(path)?,
+        None => Scenario::from_toml(BUILTIN_SCENARIO, Path::new("<built-in straight-board>"))?,
+    };
+    if let Some(seed) = seed {
+        scenario.seed = seed;
+    }
+    Ok(scenario)
+}

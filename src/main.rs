@@ -1,0 +1,39 @@
+//! `hilsim`: the command line. Glue only: parse, validate, call the libraries, print.
+//!
+//! Exit codes: 0 success; 1 a check or assertion failed; 2 bad input or usage (every error is
+//! one line on stderr naming the file, and the line where there is one).
+
+mod cli;
+mod commands;
+mod metrics;
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use cli::{Cli, Command, ScenarioCommand};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    let result = match &cli.command {
+        Command::Run(args) => commands::run::run(args, &mut out),
+        Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
+        Command::Decode(_) => Err(anyhow::anyhow!("decode is not available in this build yet")),
+        Command::Scenario(ScenarioCommand::Test(args)) => {
+            commands::scenario_test::test(args, &mut out)
+        }
+    };
+    let _ = out.flush();
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            // One line: the chain of context joined by ": ".
+            let line = format!("{err:#}").replace('\n', " ");
+            eprintln!("hilsim: {line}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,133 @@
+//! The metrics a run produces (the catalogue is `hilsim_sim::scenario::metrics::METRICS`) and the
+//! check of a scenario's `[[expect]]` assertions against them.
+
+use std::collections::BTreeMap;
+
+use hilsim_lidar_emulator::Run;
+use hilsim_sim::scenario::Expect;
+
+/// Metric name → value. Only metrics that could be computed are present.
+pub type Metrics = BTreeMap<String, f64>;
+
+/// The metrics of a finished run.
+pub fn of_run(run: &Run) -> Metrics {
+    let rec = &run.recording;
+    let mut m = Metrics::new();
+    let mut put = |name: &str, value: f64| {
+        if value.is_finite() {
+            m.insert(name.to_string(), value);
+        }
+    };
+    if let Some(truth) = &rec.truth {
+        if let (Some(first), Some(last)) = (truth.first(), truth.last()) {
+            put("sim.duration_s", last.t_s - first.t_s);
+            put("sim.final_x_m", last.x_m);
+            put("sim.final_y_m", last.y_m);
+            put("sim.final_yaw_deg", last.yaw_rad.to_degrees());
+        }
+        let path: f64 = truth
+            .windows(2)
+            .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
+            .sum();
+        put("sim.distance_m", path);
+    }
+    put("sim.collisions", run.collisions.len() as f64);
+    if let Some(lidar) = &rec.lidar {
+        put("lidar.readings", lidar.len() as f64);
+        let revs = lidar.last().map_or(0, |r| r.rev + u64::from(r.angle_deg == 359));
+        put("lidar.revolutions", revs as f64);
+        let valid: Vec<_> = lidar.iter().filter(|r| !r.invalid).collect();
+        if !lidar.is_empty() {
+            put("lidar.valid_fraction", valid.len() as f64 / lidar.len() as f64);
+        }
+        put(
+            "lidar.rmse_m",
+            rms(valid.iter().filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
+        );
+    }
+    if let Some(sonar) = &rec.sonar {
+        put("sonar.readings", sonar.len() as f64);
+        put(
+            "sonar.rmse_m",
+            rms(sonar.iter().filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
+        );
+    }
+    if let Some(odometry) = &rec.odometry {
+        put("odometer.readings", odometry.len() as f64);
+        if let (Some(last), Some(truth)) = (odometry.last(), &rec.truth) {
+            // True wheel travel is not in the recording; the mean of the wheels' reported travel
+            // over the true path length is the scale for straight runs (turns cancel out).
+            let reported = (last.left_m.abs() + last.right_m.abs()) / 2.0;
+            let true_path: f64 = truth
+                .windows(2)
+                .take_while(|w| w[0].t_s < last.t_s)
+                .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
+                .sum();
+            if true_path > 0.01 {
+                put("odometer.scale", reported / true_path);
+            }
+        }
+    }
+    m
+}
+
+fn rms(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        (sum / n as f64).sqrt()
+    }
+}
+
+/// The outcome of one assertion.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Outcome {
+    pub metric: String,
+    pub value: Option<f64>,
+    pub at_least: Option<f64>,
+    pub at_most: Option<f64>,
+    pub passed: bool,
+}
+
+impl Outcome {
+    /// One line for people: `PASS lidar.readings = 72000 (≥ 1000)`.
+    pub fn describe(&self) -> String {
+        let bounds: Vec<String> = [
+            self.at_least.map(|v| format!("≥ {v}")),
+            self.at_most.map(|v| format!("≤ {v}")),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let value = self
+            .value
+            .map_or_else(|| "not computed".to_string(), |v| format!("{v:.6}"));
+        format!(
+            "{} {} = {value} (expected {})",
+            if self.passed { "PASS" } else { "FAIL" },
+            self.metric,
+            bounds.join(" and ")
+        )
+    }
+}
+
+/// Checks every assertion; a metric that was not computed fails its assertion.
+pub fn check(expects: &[Expect], metrics: &Metrics) -> Vec<Outcome> {
+    expects
+        .iter()
+        .map(|e| {
+            let value = metrics.get(&e.metric).copied();
+            let passed = value.is_some_and(|v| {
+                e.at_least.is_none_or(|lo| v >= lo) && e.at_most.is_none_or(|hi| v <= hi)
+            });
+            Outcome {
+                metric: e.metric.clone(),
+                value,
+                at_least: e.at_least,
+                at_most: e.at_most,
+                passed,
+            }
+        })
+        .collect()
+}

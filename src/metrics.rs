@@ -34,22 +34,31 @@ pub fn of_run(run: &Run) -> Metrics {
     put("sim.collisions", run.collisions.len() as f64);
     if let Some(lidar) = &rec.lidar {
         put("lidar.readings", lidar.len() as f64);
-        let revs = lidar.last().map_or(0, |r| r.rev + u64::from(r.angle_deg == 359));
+        let revs = lidar
+            .last()
+            .map_or(0, |r| r.rev + u64::from(r.angle_deg == 359));
         put("lidar.revolutions", revs as f64);
         let valid: Vec<_> = lidar.iter().filter(|r| !r.invalid).collect();
         if !lidar.is_empty() {
-            put("lidar.valid_fraction", valid.len() as f64 / lidar.len() as f64);
+            put(
+                "lidar.valid_fraction",
+                valid.len() as f64 / lidar.len() as f64,
+            );
         }
         put(
             "lidar.rmse_m",
-            rms(valid.iter().filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
+            rms(valid
+                .iter()
+                .filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
         );
     }
     if let Some(sonar) = &rec.sonar {
         put("sonar.readings", sonar.len() as f64);
         put(
             "sonar.rmse_m",
-            rms(sonar.iter().filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
+            rms(sonar
+                .iter()
+                .filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
         );
     }
     if let Some(odometry) = &rec.odometry {

@@ -178,9 +178,8 @@ impl Lidar {
     fn read(&mut self, world: &World, robot: &hilsim_sim::Pose, t: f64) -> LidarReading {
         let sensor = self.mount.in_world(robot);
         let angle_noise: f64 = StandardNormal.sample(&mut self.rng);
-        let beam = sensor.yaw
-            + f64::from(self.index).to_radians()
-            + self.angle_noise_rad * angle_noise;
+        let beam =
+            sensor.yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
         // Cast past the maximum so that a far target is seen as "beyond range", not "nothing".
         let cast_limit = (self.max_mm / 1000.0 * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0);
         let mut reading = LidarReading {
@@ -202,7 +201,8 @@ impl Lidar {
         // Diffuse return: proportional to reflectivity and to the cosine of the incidence.
         let cos_incidence = (hit.normal[0] * beam.cos() + hit.normal[1] * beam.sin()).abs();
         let speckle: f64 = StandardNormal.sample(&mut self.rng);
-        let strength = STRENGTH_AT_1M * (hit.reflectivity / REFERENCE_REFLECTIVITY)
+        let strength = STRENGTH_AT_1M
+            * (hit.reflectivity / REFERENCE_REFLECTIVITY)
             * cos_incidence
             * d.max(0.05).powf(-STRENGTH_FALLOFF)
             * (1.0 + STRENGTH_SPREAD * speckle).max(0.0);

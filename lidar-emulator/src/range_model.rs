@@ -132,7 +132,11 @@ impl RangeModelBuilder {
         }
         for (which, coeffs) in [("bias", &self.bias), ("noise", &self.noise)] {
             if let Some((index, &value)) = coeffs.iter().enumerate().find(|(_, c)| !c.is_finite()) {
-                return Err(ModelError::NotFinite { which, index, value });
+                return Err(ModelError::NotFinite {
+                    which,
+                    index,
+                    value,
+                });
             }
         }
         if let Some((index, &value)) = self.noise.iter().enumerate().find(|(_, c)| **c < 0.0) {
@@ -159,10 +163,17 @@ mod tests {
         assert_eq!(RangeModel::builder().build(), Err(ModelError::EmptyBias));
         assert!(matches!(
             RangeModel::builder().bias([0.0, f64::NAN]).build(),
-            Err(ModelError::NotFinite { which: "bias", index: 1, .. })
+            Err(ModelError::NotFinite {
+                which: "bias",
+                index: 1,
+                ..
+            })
         ));
         assert!(matches!(
-            RangeModel::builder().bias([0.0, 1.0]).noise([0.01, -0.001]).build(),
+            RangeModel::builder()
+                .bias([0.0, 1.0])
+                .noise([0.01, -0.001])
+                .build(),
             Err(ModelError::NegativeNoise { index: 1, .. })
         ));
     }

@@ -60,7 +60,9 @@ impl Sonar {
         let sensor = self.mount.in_world(robot);
         self.ray_offsets
             .iter()
-            .filter_map(|off| world.cast_ray([sensor.x, sensor.y], sensor.yaw + off, self.max_range_m))
+            .filter_map(|off| {
+                world.cast_ray([sensor.x, sensor.y], sensor.yaw + off, self.max_range_m)
+            })
             .map(|hit| hit.distance)
             .min_by(f64::total_cmp)
     }

@@ -21,7 +21,11 @@ impl<'a> Table<'a> {
             .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
             .filter(|(_, l)| !l.trim().is_empty());
         let Some((_, header)) = lines.next() else {
-            return Err(Error::format(path, Some(1), "empty file: expected a header row"));
+            return Err(Error::format(
+                path,
+                Some(1),
+                "empty file: expected a header row",
+            ));
         };
         let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
         let mut rows = Vec::new();
@@ -131,9 +135,7 @@ impl Row<'_, '_> {
     pub(crate) fn check_time(&self, t: f64, previous: &mut Option<f64>) -> Result<(), Error> {
         if let Some(prev) = *previous {
             if t < prev {
-                return Err(self.error(format!(
-                    "time goes backwards: t_s = {t} after {prev}"
-                )));
+                return Err(self.error(format!("time goes backwards: t_s = {t} after {prev}")));
             }
         }
         if t < 0.0 {

@@ -77,7 +77,11 @@ fn read_meta(path: &Path) -> Result<Meta, Error> {
     }
     let positive = |v: f64| v.is_finite() && v > 0.0;
     if !positive(meta.robot.wheel_base_m) {
-        return Err(Error::format(path, None, "robot.wheel_base_m must be positive"));
+        return Err(Error::format(
+            path,
+            None,
+            "robot.wheel_base_m must be positive",
+        ));
     }
     if let Some(sonar) = &meta.sonar {
         if !(sonar.half_angle_deg.is_finite() && (0.0..90.0).contains(&sonar.half_angle_deg)) {
@@ -90,7 +94,10 @@ fn read_meta(path: &Path) -> Result<Meta, Error> {
     }
     for (key, value) in [
         ("world.landmark_radius_m", meta.world.landmark_radius_m),
-        ("world.target_start_distance_m", meta.world.target_start_distance_m),
+        (
+            "world.target_start_distance_m",
+            meta.world.target_start_distance_m,
+        ),
     ] {
         if value.is_some_and(|v| !positive(v)) {
             return Err(Error::format(path, None, format!("{key} must be positive")));
@@ -241,7 +248,11 @@ mod tests {
     }
 
     fn minimal(dir: &Path) {
-        write(dir, "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n");
+        write(
+            dir,
+            "meta.toml",
+            "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n",
+        );
         write(dir, "commands.csv", "t_s,left_mps,right_mps\n0,0.1,0.1\n");
     }
 
@@ -264,7 +275,10 @@ mod tests {
         minimal(dir.path());
         write(dir.path(), "sonar.csv", "t_s,range_m\n0.0,1.0\n0.1,abc\n");
         let msg = err(dir.path());
-        assert!(msg.ends_with("sonar.csv:3: column `range_m`: expected a finite number, found `abc`"), "{msg}");
+        assert!(
+            msg.ends_with("sonar.csv:3: column `range_m`: expected a finite number, found `abc`"),
+            "{msg}"
+        );
         write(dir.path(), "sonar.csv", "t_s,range_m\n0.2,1.0\n0.1,1.0\n");
         assert!(err(dir.path()).contains("sonar.csv:3: time goes backwards"));
         write(dir.path(), "sonar.csv", "t_s,range_m\n0.0,NaN\n");
@@ -282,11 +296,23 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         minimal(dir.path());
         let header = "t_s,rev,angle_deg,range_m,strength,invalid,warning\n";
-        write(dir.path(), "lidar.csv", &format!("{header}0,0,360,1.0,100,0,0\n"));
+        write(
+            dir.path(),
+            "lidar.csv",
+            &format!("{header}0,0,360,1.0,100,0,0\n"),
+        );
         assert!(err(dir.path()).contains("lidar.csv:2: column `angle_deg`"));
-        write(dir.path(), "lidar.csv", &format!("{header}0,0,1,1.0,100,2,0\n"));
+        write(
+            dir.path(),
+            "lidar.csv",
+            &format!("{header}0,0,1,1.0,100,2,0\n"),
+        );
         assert!(err(dir.path()).contains("lidar.csv:2: column `invalid`: expected 0 or 1"));
-        write(dir.path(), "lidar.csv", &format!("{header}0,0,1,1.0,70000,0,0\n"));
+        write(
+            dir.path(),
+            "lidar.csv",
+            &format!("{header}0,0,1,1.0,70000,0,0\n"),
+        );
         assert!(err(dir.path()).contains("column `strength`"));
     }
 
@@ -294,11 +320,23 @@ mod tests {
     fn meta_is_validated() {
         let dir = tempfile::tempdir().unwrap();
         minimal(dir.path());
-        write(dir.path(), "meta.toml", "format = \"other/2\"\n[robot]\nwheel_base_m = 0.23\n");
+        write(
+            dir.path(),
+            "meta.toml",
+            "format = \"other/2\"\n[robot]\nwheel_base_m = 0.23\n",
+        );
         assert!(err(dir.path()).contains("meta.toml: format is `other/2`"));
-        write(dir.path(), "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = -1\n");
+        write(
+            dir.path(),
+            "meta.toml",
+            "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = -1\n",
+        );
         assert!(err(dir.path()).contains("wheel_base_m must be positive"));
-        write(dir.path(), "meta.toml", "format = \"hilsim-recording/1\"\n[robot]\n");
+        write(
+            dir.path(),
+            "meta.toml",
+            "format = \"hilsim-recording/1\"\n[robot]\n",
+        );
         assert!(err(dir.path()).contains("meta.toml:"));
         fs::remove_file(dir.path().join("meta.toml")).unwrap();
         assert!(err(dir.path()).contains("meta.toml: "));
@@ -309,7 +347,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("rec");
         let mut rec = Recording::new(Meta::default());
-        rec.commands.push(CommandSample { t_s: 0.0, left_mps: 0.1, right_mps: 0.1 });
+        rec.commands.push(CommandSample {
+            t_s: 0.0,
+            left_mps: 0.1,
+            right_mps: 0.1,
+        });
         rec.lidar = Some(vec![LidarSample {
             t_s: 0.1 + 0.2,
             rev: 0,
@@ -329,7 +371,10 @@ mod tests {
         assert!(!out.join("lidar.csv").exists());
         assert_eq!(Recording::read_dir(&out).unwrap(), rec);
         // No temporary siblings remain.
-        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        let names: Vec<_> = fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("rec")]);
     }
 }

@@ -56,15 +56,25 @@ impl DriveProgram {
             let command = match (step.speed_mps, step.distance_m, step.turn_deg) {
                 (Some(v), Some(d), _) => {
                     let v = v.signum() * d / held_s;
-                    WheelCommand { left_mps: v, right_mps: v }
+                    WheelCommand {
+                        left_mps: v,
+                        right_mps: v,
+                    }
                 }
                 (_, _, Some(deg)) => {
                     let omega = deg.to_radians() / held_s;
-                    WheelCommand { left_mps: -omega * half_base, right_mps: omega * half_base }
+                    WheelCommand {
+                        left_mps: -omega * half_base,
+                        right_mps: omega * half_base,
+                    }
                 }
                 _ => WheelCommand::default(),
             };
-            segments.push(Segment { start_step, steps, command });
+            segments.push(Segment {
+                start_step,
+                steps,
+                command,
+            });
             start_step += steps;
         }
         Self { segments }
@@ -85,7 +95,9 @@ impl DriveProgram {
     /// The command in force during physics step `step`; zero after the program ends.
     #[must_use]
     pub fn command_at(&self, step: u64) -> WheelCommand {
-        let i = self.segments.partition_point(|s| s.start_step + s.steps <= step);
+        let i = self
+            .segments
+            .partition_point(|s| s.start_step + s.steps <= step);
         self.segments
             .get(i)
             .filter(|s| s.start_step <= step)

@@ -173,9 +173,11 @@ impl Simulation {
             Driver::External(command) => *command,
         };
         let t0 = self.time_s();
-        if self.commands.last().is_none_or(|c| {
-            c.left_mps != command.left_mps || c.right_mps != command.right_mps
-        }) {
+        if self
+            .commands
+            .last()
+            .is_none_or(|c| c.left_mps != command.left_mps || c.right_mps != command.right_mps)
+        {
             self.commands.push(CommandSample {
                 t_s: t0,
                 left_mps: command.left_mps,
@@ -223,7 +225,10 @@ impl Simulation {
         let mid_yaw = p0.yaw + wrap_angle(p1.yaw - p0.yaw) / 2.0;
         let forward = (p1.x - p0.x) * mid_yaw.cos() + (p1.y - p0.y) * mid_yaw.sin();
         let turn = wrap_angle(p1.yaw - p0.yaw) * self.wheel_base_m / 2.0;
-        [self.wheels[0] + forward - turn, self.wheels[1] + forward + turn]
+        [
+            self.wheels[0] + forward - turn,
+            self.wheels[1] + forward + turn,
+        ]
     }
 
     fn log_contacts(&mut self, t: f64) {

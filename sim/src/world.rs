@@ -45,12 +45,18 @@ impl World {
     /// Builds the world of a validated scenario with the robot at its start pose.
     #[must_use]
     pub fn new(scenario: &Scenario) -> Self {
-        let mut physics = PhysicsWorld::default();
-        physics.gravity = Vector::ZERO;
+        // Seen from above: no gravity.
+        let mut physics = PhysicsWorld {
+            gravity: Vector::ZERO,
+            ..PhysicsWorld::default()
+        };
         physics.integration_parameters.dt = scenario.step_s() as f32;
         let mut obstacles = Vec::new();
         let fixed = physics.insert_body(RigidBodyBuilder::fixed());
-        let mut add = |physics: &mut PhysicsWorld, builder: ColliderBuilder, what, material: Option<&String>| {
+        let mut add = |physics: &mut PhysicsWorld,
+                       builder: ColliderBuilder,
+                       what,
+                       material: Option<&String>| {
             let collider = builder
                 .user_data(obstacles.len() as u128)
                 .friction(0.0)
@@ -61,17 +67,33 @@ impl World {
         let w = &scenario.world;
         for (i, wall) in w.walls.iter().enumerate() {
             let builder = ColliderBuilder::segment(vec2(wall.from), vec2(wall.to));
-            add(&mut physics, builder, Obstacle::Wall(i), wall.material.as_ref());
+            add(
+                &mut physics,
+                builder,
+                Obstacle::Wall(i),
+                wall.material.as_ref(),
+            );
         }
         for (i, c) in w.cylinders.iter().enumerate() {
             let builder = ColliderBuilder::ball(c.radius as f32).translation(vec2(c.center));
-            add(&mut physics, builder, Obstacle::Cylinder(i), c.material.as_ref());
+            add(
+                &mut physics,
+                builder,
+                Obstacle::Cylinder(i),
+                c.material.as_ref(),
+            );
         }
         for (i, b) in w.boards.iter().enumerate() {
-            let builder = ColliderBuilder::cuboid((b.length / 2.0) as f32, (b.thickness / 2.0) as f32)
-                .translation(vec2(b.center))
-                .rotation(b.yaw_deg.to_radians() as f32);
-            add(&mut physics, builder, Obstacle::Board(i), b.material.as_ref());
+            let builder =
+                ColliderBuilder::cuboid((b.length / 2.0) as f32, (b.thickness / 2.0) as f32)
+                    .translation(vec2(b.center))
+                    .rotation(b.yaw_deg.to_radians() as f32);
+            add(
+                &mut physics,
+                builder,
+                Obstacle::Board(i),
+                b.material.as_ref(),
+            );
         }
         let start = scenario.robot.start;
         let (robot, robot_collider) = physics.insert(
@@ -100,7 +122,11 @@ impl World {
     pub fn robot_pose(&self) -> Pose {
         let body = &self.physics.bodies[self.robot];
         let t = body.translation();
-        Pose::new(f64::from(t.x), f64::from(t.y), f64::from(body.rotation().angle()))
+        Pose::new(
+            f64::from(t.x),
+            f64::from(t.y),
+            f64::from(body.rotation().angle()),
+        )
     }
 
     /// Casts a ray from `origin` along `heading_rad` (world frame) up to `max_m`, ignoring the
@@ -111,9 +137,9 @@ impl World {
         let (sin, cos) = heading_rad.sin_cos();
         let ray = Ray::new(vec2(origin), Vector::new(cos as f32, sin as f32));
         let filter = QueryFilter::default().exclude_rigid_body(self.robot);
-        let (handle, hit) = self
-            .physics
-            .cast_ray_and_get_normal(&ray, max_m as f32, true, filter)?;
+        let (handle, hit) =
+            self.physics
+                .cast_ray_and_get_normal(&ray, max_m as f32, true, filter)?;
         let (obstacle, reflectivity) = self.obstacle_of(handle)?;
         Some(RayHit {
             distance: f64::from(hit.time_of_impact),

@@ -60,7 +60,10 @@ fn a_wall_stops_the_robot_and_the_contact_is_logged() {
 
 #[test]
 fn duration_longer_than_the_program_stands_still_after_it() {
-    let s = scenario_with("duration_s = 3.0", "[[drive]]\nspeed_mps = 0.5\ndistance_m = 0.5\n");
+    let s = scenario_with(
+        "duration_s = 3.0",
+        "[[drive]]\nspeed_mps = 0.5\ndistance_m = 0.5\n",
+    );
     let sim = run(&s);
     assert_eq!(sim.truth().last().unwrap().t_s, 3.0);
     assert!((sim.pose().x - 0.5).abs() < 1e-3);
@@ -80,12 +83,18 @@ fn the_same_scenario_gives_the_same_trajectory_bit_for_bit() {
 
 #[test]
 fn rays_hit_obstacles_but_never_the_robot() {
-    let s = scenario_with("duration_s = 0.1", "[world]\ncylinders = [{ center = [2.0, 0.0], radius = 0.12 }]\n");
+    let s = scenario_with(
+        "duration_s = 0.1",
+        "[world]\ncylinders = [{ center = [2.0, 0.0], radius = 0.12 }]\n",
+    );
     let sim = Simulation::new(&s);
     let hit = sim.world().cast_ray([0.0, 0.0], 0.0, 10.0).unwrap();
     // f32 geometry: ~1e-6 relative at 2 m.
     assert!((hit.distance - 1.88).abs() < 1e-4, "{hit:?}");
     assert_eq!(hit.obstacle, Obstacle::Cylinder(0));
     // From inside the robot's own disc, looking away from the cylinder: nothing.
-    assert!(sim.world().cast_ray([0.0, 0.0], std::f64::consts::PI, 10.0).is_none());
+    assert!(sim
+        .world()
+        .cast_ray([0.0, 0.0], std::f64::consts::PI, 10.0)
+        .is_none());
 }

@@ -47,10 +47,10 @@ pub fn execute(scenario: Scenario, origin: &str) -> Result<Report> {
 }
 
 pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let origin = args
-        .scenario
-        .as_ref()
-        .map_or_else(|| "<built-in straight-board>".to_string(), |p| p.display().to_string());
+    let origin = args.scenario.as_ref().map_or_else(
+        || "<built-in straight-board>".to_string(),
+        |p| p.display().to_string(),
+    );
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
     if args.via == Via::Serial {
         bail!("--via serial is not available in this build yet: use --via memory");
@@ -88,7 +88,11 @@ pub fn summarise(report: &Report, out: &mut dyn Write) -> Result<()> {
         report.run.collisions.len()
     )?;
     for c in &report.run.collisions {
-        writeln!(out, "  collision at t = {:.2} s with {:?}", c.t_s, c.obstacle)?;
+        writeln!(
+            out,
+            "  collision at t = {:.2} s with {:?}",
+            c.t_s, c.obstacle
+        )?;
     }
     if rec.lidar.is_some() {
         writeln!(

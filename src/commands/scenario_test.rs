@@ -57,9 +57,7 @@ pub fn test(args: &ScenarioTestArgs, out: &mut dyn Write) -> Result<ExitCode> {
 }
 
 /// Runs the scenarios on all cores; results come back in the input order.
-fn run_all(
-    scenarios: Vec<(PathBuf, Scenario)>,
-) -> Result<Vec<(PathBuf, super::run::Report)>> {
+fn run_all(scenarios: Vec<(PathBuf, Scenario)>) -> Result<Vec<(PathBuf, super::run::Report)>> {
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut slots: Vec<Option<Result<super::run::Report>>> =
         (0..scenarios.len()).map(|_| None).collect();
@@ -83,15 +81,16 @@ fn run_all(
         .into_iter()
         .zip(slots)
         .map(|((path, _), report)| {
-            let report = report
-                .with_context(|| format!("{}: the run did not finish", path.display()))??;
+            let report =
+                report.with_context(|| format!("{}: the run did not finish", path.display()))??;
             Ok((path, report))
         })
         .collect()
 }
 
 fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<()> {
-    let meta = std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let meta =
+        std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
     if meta.is_file() {
         files.push(path.to_path_buf());
         return Ok(());

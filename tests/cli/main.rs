@@ -1,1 +1,8 @@
+//! End-to-end tests of the `hilsim` binary: each runs the built binary in a fresh temporary
+//! directory with the user's environment removed.
 
+mod bad_input;
+mod common;
+mod record;
+mod run;
+mod scenario_test;

@@ -74,5 +74,8 @@ pub(crate) fn line_of(source: &str, path: &[Key]) -> Option<usize> {
 /// The 1-based line holding byte `offset`.
 pub(crate) fn line_at(source: &str, offset: usize) -> usize {
     let end = offset.min(source.len());
-    1 + source.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count()
+    1 + source.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
 }

@@ -4,19 +4,37 @@
 /// Every metric name with what it measures. Keep `scenarios/README.md` in step.
 pub const METRICS: &[(&str, &str)] = &[
     ("sim.duration_s", "simulated time, seconds"),
-    ("sim.collisions", "number of contacts the robot started with obstacles"),
-    ("sim.distance_m", "path length the robot travelled, metres (truth)"),
+    (
+        "sim.collisions",
+        "number of contacts the robot started with obstacles",
+    ),
+    (
+        "sim.distance_m",
+        "path length the robot travelled, metres (truth)",
+    ),
     ("sim.final_x_m", "true x at the end, metres"),
     ("sim.final_y_m", "true y at the end, metres"),
     ("sim.final_yaw_deg", "true heading at the end, degrees"),
     ("lidar.revolutions", "complete lidar revolutions recorded"),
     ("lidar.readings", "lidar readings recorded"),
-    ("lidar.valid_fraction", "fraction of lidar readings without the invalid flag"),
-    ("lidar.rmse_m", "RMS of reported minus true range over valid readings, metres"),
+    (
+        "lidar.valid_fraction",
+        "fraction of lidar readings without the invalid flag",
+    ),
+    (
+        "lidar.rmse_m",
+        "RMS of reported minus true range over valid readings, metres",
+    ),
     ("sonar.readings", "sonar pings recorded"),
-    ("sonar.rmse_m", "RMS of reported minus true sonar range, metres"),
+    (
+        "sonar.rmse_m",
+        "RMS of reported minus true sonar range, metres",
+    ),
     ("odometer.readings", "odometer readings recorded"),
-    ("odometer.scale", "encoder-reported over true wheel travel (1 + slip when noise is small)"),
+    (
+        "odometer.scale",
+        "encoder-reported over true wheel travel (1 + slip when noise is small)",
+    ),
 ];
 
 /// Whether `name` is in the catalogue.

@@ -129,6 +129,5 @@ impl Scenario {
     }
 }
 
-
 #[cfg(test)]
 mod tests;

@@ -43,21 +43,31 @@ fn semantic_errors_name_the_line_of_the_key() {
         "{MINIMAL}[world]\ncylinders = [\n  {{ center = [1.0, 1.0], radius = 0.1 }},\n  {{ center = [3.0, 1.0], radius = -0.1 }},\n]\n"
     );
     let msg = err(&text);
-    assert!(msg.starts_with("s.toml:9: world.cylinders[1].radius: expected a positive"), "{msg}");
+    assert!(
+        msg.starts_with("s.toml:9: world.cylinders[1].radius: expected a positive"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn drive_step_with_two_kinds_is_rejected_at_its_table() {
-    let text = format!("{MINIMAL}[[drive]]\nstop_s = 1.0\n[[drive]]\nstop_s = 1.0\nturn_deg = 90.0\n");
+    let text =
+        format!("{MINIMAL}[[drive]]\nstop_s = 1.0\n[[drive]]\nstop_s = 1.0\nturn_deg = 90.0\n");
     let msg = err(&text);
-    assert!(msg.starts_with("s.toml:8: drive[1]: found stop_s and turn_deg"), "{msg}");
+    assert!(
+        msg.starts_with("s.toml:8: drive[1]: found stop_s and turn_deg"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn robot_inside_a_wall_is_rejected() {
     let text = format!("{MINIMAL}[world]\nwalls = [{{ from = [0.1, -1.0], to = [0.1, 1.0] }}]\n");
     let msg = err(&text);
-    assert!(msg.contains("robot.start: the robot (radius 0.165 m) starts inside wall 0"), "{msg}");
+    assert!(
+        msg.contains("robot.start: the robot (radius 0.165 m) starts inside wall 0"),
+        "{msg}"
+    );
     assert!(msg.starts_with("s.toml:4: "), "{msg}");
 }
 
@@ -71,5 +81,8 @@ fn empty_program_needs_a_duration() {
 fn unknown_metric_is_rejected() {
     let text = format!("{MINIMAL}[[expect]]\nmetric = \"lidar.magic\"\nat_least = 1.0\n");
     let msg = err(&text);
-    assert!(msg.starts_with("s.toml:7: expect[0].metric: unknown metric `lidar.magic`"), "{msg}");
+    assert!(
+        msg.starts_with("s.toml:7: expect[0].metric: unknown metric `lidar.magic`"),
+        "{msg}"
+    );
 }

@@ -20,11 +20,25 @@ fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
     })
 }
 
+/// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
+fn toml_number(v: f64) -> String {
+    if v.is_nan() {
+        "nan".to_string()
+    } else if v.is_infinite() {
+        if v > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        v.to_string()
+    }
+}
+
 fn finite(path: Vec<Key>, v: f64) -> Check {
     if v.is_finite() {
         Ok(())
     } else {
-        fail(path, format!("expected a finite number, found {v}"))
+        fail(
+            path,
+            format!("expected a finite number, found {}", toml_number(v)),
+        )
     }
 }
 
@@ -32,7 +46,10 @@ fn positive(path: Vec<Key>, v: f64) -> Check {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        fail(path, format!("expected a positive number, found {v}"))
+        fail(
+            path,
+            format!("expected a positive number, found {}", toml_number(v)),
+        )
     }
 }
 
@@ -40,7 +57,10 @@ fn non_negative(path: Vec<Key>, v: f64) -> Check {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        fail(path, format!("expected a number ≥ 0, found {v}"))
+        fail(
+            path,
+            format!("expected a number ≥ 0, found {}", toml_number(v)),
+        )
     }
 }
 
@@ -48,7 +68,14 @@ fn point(path: Vec<Key>, p: [f64; 2]) -> Check {
     if p.iter().all(|c| c.is_finite()) {
         Ok(())
     } else {
-        fail(path, format!("expected finite coordinates, found {p:?}"))
+        fail(
+            path,
+            format!(
+                "expected finite coordinates, found [{}, {}]",
+                toml_number(p[0]),
+                toml_number(p[1])
+            ),
+        )
     }
 }
 
@@ -68,7 +95,11 @@ fn polynomial(path: Vec<Key>, coeffs: &[f64], non_negative_terms: bool) -> Check
             } else {
                 "finite coefficients"
             };
-            return fail(path, format!("expected {what}, found {coeffs:?}"));
+            let shown: Vec<String> = coeffs.iter().map(|&c| toml_number(c)).collect();
+            return fail(
+                path,
+                format!("expected {what}, found [{}]", shown.join(", ")),
+            );
         }
     }
     Ok(())
@@ -140,14 +171,25 @@ fn world(s: &Scenario) -> Check {
         point(key_path!["world", "walls", i, "from"], wall.from)?;
         point(key_path!["world", "walls", i, "to"], wall.to)?;
         if (wall.from[0] - wall.to[0]).hypot(wall.from[1] - wall.to[1]) < 1e-3 {
-            return fail(key_path!["world", "walls", i], "a wall must be at least 1 mm long");
+            return fail(
+                key_path!["world", "walls", i],
+                "a wall must be at least 1 mm long",
+            );
         }
-        material(s, key_path!["world", "walls", i, "material"], wall.material.as_ref())?;
+        material(
+            s,
+            key_path!["world", "walls", i, "material"],
+            wall.material.as_ref(),
+        )?;
     }
     for (i, c) in w.cylinders.iter().enumerate() {
         point(key_path!["world", "cylinders", i, "center"], c.center)?;
         positive(key_path!["world", "cylinders", i, "radius"], c.radius)?;
-        material(s, key_path!["world", "cylinders", i, "material"], c.material.as_ref())?;
+        material(
+            s,
+            key_path!["world", "cylinders", i, "material"],
+            c.material.as_ref(),
+        )?;
         for (j, other) in w.cylinders.iter().enumerate().take(i) {
             let gap = (c.center[0] - other.center[0]).hypot(c.center[1] - other.center[1]);
             if gap < c.radius + other.radius {
@@ -163,7 +205,11 @@ fn world(s: &Scenario) -> Check {
         positive(key_path!["world", "boards", i, "length"], b.length)?;
         positive(key_path!["world", "boards", i, "thickness"], b.thickness)?;
         finite(key_path!["world", "boards", i, "yaw_deg"], b.yaw_deg)?;
-        material(s, key_path!["world", "boards", i, "material"], b.material.as_ref())?;
+        material(
+            s,
+            key_path!["world", "boards", i, "material"],
+            b.material.as_ref(),
+        )?;
     }
     Ok(())
 }
@@ -218,7 +264,10 @@ fn drive_step(i: usize, step: &DriveStep) -> Check {
         (None, None, None, Some(a)) => {
             finite(key_path!["drive", i, "turn_deg"], a)?;
             if a == 0.0 {
-                return fail(key_path!["drive", i, "turn_deg"], "expected a non-zero angle");
+                return fail(
+                    key_path!["drive", i, "turn_deg"],
+                    "expected a non-zero angle",
+                );
             }
             Ok(())
         }
@@ -246,7 +295,10 @@ fn sensors(s: &Scenario) -> Check {
         non_negative(p("angle_noise_deg"), l.angle_noise_deg)?;
         // The packet's rpm field is rpm × 64 in 16 bits: at most 1023 rpm.
         if !(l.rpm.is_finite() && l.rpm > 0.0 && l.rpm <= 1000.0) {
-            return fail(p("rpm"), format!("expected 0 < rpm ≤ 1000, found {}", l.rpm));
+            return fail(
+                p("rpm"),
+                format!("expected 0 < rpm ≤ 1000, found {}", l.rpm),
+            );
         }
         non_negative(p("rpm_wobble"), l.rpm_wobble)?;
         if l.rpm_wobble >= l.rpm {
@@ -270,7 +322,10 @@ fn sensors(s: &Scenario) -> Check {
         if !(u.half_angle_deg.is_finite() && (0.0..90.0).contains(&u.half_angle_deg)) {
             return fail(
                 p("half_angle_deg"),
-                format!("expected 0 ≤ half_angle_deg < 90, found {}", u.half_angle_deg),
+                format!(
+                    "expected 0 ≤ half_angle_deg < 90, found {}",
+                    u.half_angle_deg
+                ),
             );
         }
         positive(p("rate_hz"), u.rate_hz)?;
@@ -280,7 +335,10 @@ fn sensors(s: &Scenario) -> Check {
     if let Some(o) = &s.sensors.odometer {
         let p = |k: &'static str| key_path!["sensors", "odometer", k];
         if !(o.slip.is_finite() && o.slip > -1.0 && o.slip < 1.0) {
-            return fail(p("slip"), format!("expected -1 < slip < 1, found {}", o.slip));
+            return fail(
+                p("slip"),
+                format!("expected -1 < slip < 1, found {}", o.slip),
+            );
         }
         non_negative(p("noise_m"), o.noise_m)?;
         positive(p("tick_m"), o.tick_m)?;

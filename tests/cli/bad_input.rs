@@ -1,0 +1,130 @@
+//! The bad-input corpus (`tests/data/bad-scenarios/`): every malformed scenario fails before any
+//! work with exit code 2 and one line naming the file, the line and what was expected.
+
+use super::common::*;
+
+/// (file, line, a fragment of what was expected).
+const CORPUS: &[(&str, usize, &str)] = &[
+    ("missing-robot.toml", 1, "missing field `robot`"),
+    (
+        "wrong-type.toml",
+        6,
+        "invalid type: string \"wide\", expected f64",
+    ),
+    ("unknown-key.toml", 6, "unknown field `wheel_bse_m`"),
+    (
+        "negative-radius.toml",
+        9,
+        "world.cylinders[0].radius: expected a positive number",
+    ),
+    (
+        "nan-coefficient.toml",
+        9,
+        "sensors.lidar.bias: expected finite coefficients",
+    ),
+    (
+        "empty-drive-without-duration.toml",
+        1,
+        "the drive program is empty and `duration_s` is not set",
+    ),
+    ("robot-inside-wall.toml", 5, "starts inside wall 0"),
+    (
+        "robot-inside-cylinder.toml",
+        5,
+        "starts inside or touching cylinder 0",
+    ),
+    (
+        "overlapping-cylinders.toml",
+        11,
+        "cylinder 1 overlaps cylinder 0",
+    ),
+    ("empty.toml", 1, "missing field `name`"),
+    (
+        "binary-garbage.toml",
+        1,
+        "not a text file: expected UTF-8 TOML",
+    ),
+    (
+        "drive-step-two-kinds.toml",
+        8,
+        "drive[0]: found stop_s and turn_deg",
+    ),
+    (
+        "speed-without-distance.toml",
+        9,
+        "`speed_mps` needs `distance_m`",
+    ),
+    (
+        "negative-noise.toml",
+        9,
+        "sensors.lidar.noise: expected finite coefficients ≥ 0",
+    ),
+    ("toml-syntax.toml", 8, "unclosed table"),
+    ("unknown-metric.toml", 9, "unknown metric `lidar.magic`"),
+    (
+        "sonar-half-angle.toml",
+        9,
+        "expected 0 ≤ half_angle_deg < 90",
+    ),
+    (
+        "name-not-a-string.toml",
+        1,
+        "invalid type: integer `42`, expected a string",
+    ),
+];
+
+#[test]
+fn every_malformed_scenario_names_file_line_and_expectation() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (file, line, fragment) in CORPUS {
+        let path = repo_file(&format!("tests/data/bad-scenarios/{file}"));
+        let path = path.to_str().unwrap();
+        for args in [
+            vec!["run", path],
+            vec!["record", path, "--out", "rec"],
+            vec!["scenario", "test", path],
+        ] {
+            let out = hilsim(tmp.path(), &args);
+            let err = assert_bad_input(&out);
+            let located = format!("{path}:{line}: ");
+            assert!(
+                err.contains(&located),
+                "{args:?}: expected `{located}` in: {err}"
+            );
+            assert!(
+                err.contains(fragment),
+                "{args:?}: expected `{fragment}` in: {err}"
+            );
+        }
+        assert!(
+            !tmp.path().join("rec").exists(),
+            "{file}: no output for bad input"
+        );
+    }
+}
+
+#[test]
+fn the_corpus_is_complete() {
+    let dir = repo_file("tests/data/bad-scenarios");
+    let files = std::fs::read_dir(dir).unwrap().count();
+    assert_eq!(files, CORPUS.len(), "every corpus file has an expectation");
+}
+
+#[test]
+fn a_missing_scenario_file_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = hilsim(tmp.path(), &["run", "no-such.toml"]);
+    let err = assert_bad_input(&out);
+    assert!(err.contains("no-such.toml: cannot read"), "{err}");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = hilsim(tmp.path(), &["run", "--seed", "minus-one"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = hilsim(tmp.path(), &["record", "x.toml"]);
+    assert_eq!(out.status.code(), Some(2), "--out is required");
+    let out = hilsim(tmp.path(), &["frobnicate"]);
+    assert_eq!(out.status.code(), Some(2));
+}

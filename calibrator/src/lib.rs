@@ -1,8 +1,19 @@
 //! Calibration of distance sensors from recordings (`hilsim_recording::Recording`): the
-//! ground-truth-less EM calibrator with its Kalman/RTS smoother (Alhashimi et al., IEEE Sensors
-//! J. 2017), the landmark calibrator (Alhashimi et al., Sensors 2021), the ground-truth baseline
-//! and sim-to-real mismatch discovery.
+//! ground-truth-less EM calibrator with its Kalman/RTS smoother (Alhashimi, Varagnolo,
+//! Gustafsson, IEEE Sensors J. 2017), the landmark calibrator (Alhashimi, Magnusson, Knorn,
+//! Varagnolo, Sensors 2021) and the ground-truth baseline.
 //!
-//! The methods arrive with their issues (#5, #6, #7); until then this crate holds no code. It
-//! reads recordings only and must never depend on the physics (`hilsim-sim`, rapier).
+//! It reads recordings only and never depends on the physics (`hilsim-sim`, rapier): a
+//! calibrator that could only read simulations would be useless on a real robot's data.
 #![warn(missing_docs)]
+
+pub mod calibration;
+pub mod em;
+pub mod error;
+pub mod groundtruth;
+pub mod kalman_smoother;
+pub mod landmarks;
+pub mod target_samples;
+
+pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};
+pub use error::CalibrationError;

@@ -1,0 +1,112 @@
+//! The result every calibration method returns, serialised exactly as `hilsim calibrate --json`
+//! prints it (interfaces.md).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// A calibration method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Ground-truth-less EM with a Kalman/RTS smoother (Alhashimi et al., IEEE Sensors J. 2017).
+    Em,
+    /// Landmarks in unknown positions (Alhashimi et al., Sensors 2021).
+    Landmarks,
+    /// Maximum-likelihood fit against the true pose (Alhashimi et al., ICINCO 2016).
+    Groundtruth,
+}
+
+impl Method {
+    /// The method's name as on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Em => "em",
+            Method::Landmarks => "landmarks",
+            Method::Groundtruth => "groundtruth",
+        }
+    }
+}
+
+/// Which sensor a model belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Sensor {
+    /// The lidar.
+    Lidar,
+    /// The sonar.
+    Sonar,
+    /// The wheel odometer.
+    Odometer,
+}
+
+/// The fitted model of one sensor, eq. (2) of both papers:
+/// `reading = Σ alpha_i d^i + (Σ beta_i d^i) e`, lowest order first, metres.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SensorModel {
+    /// Bias coefficients alpha_0..
+    pub alpha: Vec<f64>,
+    /// Noise coefficients beta_0..
+    pub beta: Vec<f64>,
+}
+
+/// Distance-estimate quality against the truth, when the recording has truth.
+///
+/// `mse_*` is the mean squared error of the distance estimates (raw: the sensor's readings as
+/// distances; calibrated: the method's estimates), metres²; `nmse_*` normalises by the mean
+/// squared true distance, as the EM paper's Fig. 3 does.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Metrics {
+    /// MSE of the raw readings.
+    pub mse_raw: f64,
+    /// MSE of the calibrated estimates.
+    pub mse_calibrated: f64,
+    /// Normalised MSE of the raw readings.
+    pub nmse_raw: f64,
+    /// Normalised MSE of the calibrated estimates.
+    pub nmse_calibrated: f64,
+}
+
+impl Metrics {
+    /// The landmark paper's MSE ratio (31): raw over calibrated. Larger is better.
+    #[must_use]
+    pub fn mse_ratio(&self) -> f64 {
+        self.mse_raw / self.mse_calibrated
+    }
+}
+
+/// What a calibration found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Calibration {
+    /// The method used.
+    pub method: Method,
+    /// One model per calibrated sensor; sensors absent from the recording are absent here.
+    pub sensors: BTreeMap<Sensor, SensorModel>,
+    /// Iterations the method ran (1 for closed-form methods).
+    pub iterations: usize,
+    /// Whether it met its convergence criterion.
+    pub converged: bool,
+    /// Quality against the truth; present only when the recording has truth.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub metrics: Option<Metrics>,
+    /// The selected polynomial order (landmarks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
+    /// Estimated landmark centres, metres, in the frame of the robot's pose at the start of the
+    /// recording (x forward, y left) (landmarks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub landmarks: Option<Vec<[f64; 2]>>,
+    /// Further method-specific facts for people (e.g. AIC and cross-validation choices); not
+    /// part of the JSON interface.
+    #[serde(skip)]
+    pub notes: Vec<String>,
+}
+
+impl Calibration {
+    /// The JSON object of `hilsim calibrate --json`.
+    #[must_use]
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+}

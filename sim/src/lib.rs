@@ -23,6 +23,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod actuation;
 pub mod drive;
 pub mod pose;
 pub mod rng;

@@ -5,6 +5,7 @@
 use hilsim_recording::{CommandSample, TruthSample};
 use rapier2d::prelude::*;
 
+use crate::actuation::ActuationError;
 use crate::drive::{DriveProgram, WheelCommand};
 use crate::pose::{wrap_angle, Pose};
 use crate::scenario::Scenario;
@@ -86,11 +87,12 @@ pub struct Simulation {
     truth: Vec<TruthSample>,
     collisions: Vec<Collision>,
     touching: Vec<ColliderHandle>,
+    actuation: ActuationError,
 }
 
 impl Simulation {
     /// A simulation that runs the scenario's drive program until `duration_s` or the program's
-    /// end.
+    /// end. The actuation error (if the scenario has one) draws from `scenario.seed`.
     #[must_use]
     pub fn new(scenario: &Scenario) -> Self {
         let mut sim = Self::build(scenario, Driver::Program(DriveProgram::new(scenario)));
@@ -121,6 +123,7 @@ impl Simulation {
             truth: vec![truth(0.0, pose)],
             collisions: Vec::new(),
             touching: Vec::new(),
+            actuation: ActuationError::new(&scenario.robot.actuation, scenario.seed),
         }
     }
 
@@ -210,8 +213,10 @@ impl Simulation {
     /// Differential drive: wheel speeds → body twist, held by setting the body's velocity each
     /// step; the physics then resolves contacts (a wall stops the robot).
     fn apply(&mut self, command: WheelCommand) {
-        let v = (command.left_mps + command.right_mps) / 2.0;
-        let omega = (command.right_mps - command.left_mps) / self.wheel_base_m;
+        // The wheels achieve the command scaled by the actuation error (1 when it is off).
+        let factor = self.actuation.next_factor(self.step_s);
+        let v = factor * (command.left_mps + command.right_mps) / 2.0;
+        let omega = factor * (command.right_mps - command.left_mps) / self.wheel_base_m;
         let (sin, cos) = self.pose.yaw.sin_cos();
         let body = &mut self.world.physics.bodies[self.world.robot];
         body.set_linvel(Vector::new((v * cos) as f32, (v * sin) as f32), true);

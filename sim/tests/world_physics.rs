@@ -98,3 +98,30 @@ fn rays_hit_obstacles_but_never_the_robot() {
         .cast_ray([0.0, 0.0], std::f64::consts::PI, 10.0)
         .is_none());
 }
+
+#[test]
+fn actuation_error_makes_the_robot_miss_the_commanded_distance_but_not_the_commands() {
+    let drive = "[[drive]]\nspeed_mps = 0.2\ndistance_m = 2.0\n";
+    let exact = run(&scenario(drive));
+    let with_error = |seed: u64| {
+        let mut s = scenario(&format!(
+            "{drive}[robot.actuation]\nscale_sd = 0.03\nwander_sd = 0.01\nwander_tau_s = 5.0\n"
+        ));
+        s.seed = seed;
+        run(&s)
+    };
+    let a = with_error(1);
+    let b = with_error(2);
+    // The commands are what was issued, whatever the wheels did.
+    assert_eq!(a.commands(), exact.commands());
+    // A 3 % scale error moves the end by ~6 cm; two seeds differ, one seed repeats exactly.
+    let (xa, xb) = (a.pose().x, b.pose().x);
+    assert!(
+        (xa - 2.0).abs() > 1e-3 && (xb - 2.0).abs() > 1e-3,
+        "{xa} {xb}"
+    );
+    assert_ne!(xa, xb);
+    assert_eq!(with_error(1).truth(), a.truth());
+    // Bounded by 10 standard deviations of the combined error: |error| < 10·√(0.03²+0.01²)·2 m.
+    assert!((xa - 2.0).abs() < 10.0 * (0.03f64.powi(2) + 0.01f64.powi(2)).sqrt() * 2.0);
+}

@@ -173,6 +173,42 @@ pub struct Robot {
     /// Speed of turns in place, degrees per second; default 45.
     #[serde(default = "default_turn_rate")]
     pub turn_rate_deg_s: f64,
+    /// How far the wheels' actual speed departs from the command; default: not at all.
+    #[serde(default)]
+    pub actuation: Actuation,
+}
+
+/// `[robot.actuation]`: the wheels do not do exactly what they are told. The actual speed of both
+/// wheels is `command × (1 + scale_error + wander(t))`: a fixed error drawn once per run and an
+/// Ornstein–Uhlenbeck process that wanders slowly (motor temperature, battery voltage, floor).
+/// The commands in the recording stay as issued, so a calibrator that trusts them errs.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Actuation {
+    /// Standard deviation of the fixed speed-scale error, drawn once per run from the seed
+    /// (e.g. 0.02 for ±2 %).
+    #[serde(default)]
+    pub scale_sd: f64,
+    /// Stationary standard deviation of the wandering speed-scale error.
+    #[serde(default)]
+    pub wander_sd: f64,
+    /// Correlation time of the wander, seconds; default 10.
+    #[serde(default = "default_wander_tau")]
+    pub wander_tau_s: f64,
+}
+
+fn default_wander_tau() -> f64 {
+    10.0
+}
+
+impl Default for Actuation {
+    fn default() -> Self {
+        Self {
+            scale_sd: 0.0,
+            wander_sd: 0.0,
+            wander_tau_s: default_wander_tau(),
+        }
+    }
 }
 
 fn default_robot_radius() -> f64 {

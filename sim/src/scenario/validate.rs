@@ -221,7 +221,23 @@ fn robot(s: &Scenario) -> Check {
     finite(key_path!["robot", "start", "yaw_deg"], r.start.yaw_deg)?;
     positive(key_path!["robot", "wheel_base_m"], r.wheel_base_m)?;
     positive(key_path!["robot", "radius_m"], r.radius_m)?;
-    positive(key_path!["robot", "turn_rate_deg_s"], r.turn_rate_deg_s)
+    positive(key_path!["robot", "turn_rate_deg_s"], r.turn_rate_deg_s)?;
+    let a = r.actuation;
+    non_negative(key_path!["robot", "actuation", "scale_sd"], a.scale_sd)?;
+    non_negative(key_path!["robot", "actuation", "wander_sd"], a.wander_sd)?;
+    if a.scale_sd > 0.2 || a.wander_sd > 0.2 {
+        return fail(
+            key_path!["robot", "actuation"],
+            "expected speed-scale errors of at most 0.2 (20 %)",
+        );
+    }
+    if a.wander_tau_s.is_nan() || a.wander_tau_s <= 0.0 {
+        return fail(
+            key_path!["robot", "actuation", "wander_tau_s"],
+            "expected a positive correlation time",
+        );
+    }
+    Ok(())
 }
 
 fn drive(s: &Scenario) -> Check {

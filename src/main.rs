@@ -5,6 +5,7 @@
 
 mod cli;
 mod commands;
+mod decode_cmd;
 mod metrics;
 
 use std::io::Write;
@@ -21,7 +22,10 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => commands::run::run(args, &mut out),
         Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
-        Command::Decode(_) => Err(anyhow::anyhow!("decode is not available in this build yet")),
+        Command::Decode(args) => {
+            decode_cmd::run(&args.input, args.csv.as_deref(), args.json, &mut out)
+                .map(|()| ExitCode::SUCCESS)
+        }
         Command::Scenario(ScenarioCommand::Test(args)) => {
             commands::scenario_test::test(args, &mut out)
         }

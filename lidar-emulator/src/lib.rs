@@ -10,6 +10,7 @@ pub mod neato_packet;
 mod odometer;
 mod range_model;
 mod sonar;
+pub mod wire;
 
 pub use emulation::{Emulation, Run, StepSamples};
 pub use lidar::{Lidar, LidarReading};

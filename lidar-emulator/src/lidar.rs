@@ -155,8 +155,7 @@ impl Lidar {
     /// Takes every reading whose instant falls in `[step.t0, step.t1)`.
     pub fn observe(&mut self, world: &World, step: &StepState, out: &mut Vec<LidarReading>) {
         loop {
-            let period = reading_period_s(self.rev_rpm);
-            let t = self.rev_start_s + f64::from(self.index) * period;
+            let t = reading_time_s(self.rev_start_s, self.index, self.rev_rpm);
             if t >= step.t1 {
                 return;
             }
@@ -167,7 +166,7 @@ impl Lidar {
             self.index += 1;
             if self.index == READINGS_PER_REV {
                 self.index = 0;
-                self.rev_start_s += f64::from(READINGS_PER_REV) * period;
+                self.rev_start_s = next_revolution_start_s(self.rev_start_s, self.rev_rpm);
                 self.rev += 1;
                 self.rev_rpm = self.rpm_of_revolution(self.rev);
             }
@@ -230,4 +229,18 @@ impl Lidar {
 #[must_use]
 pub fn reading_period_s(rpm: f64) -> f64 {
     60.0 / (rpm * f64::from(READINGS_PER_REV))
+}
+
+/// When reading `index` of a revolution that started at `rev_start_s` and turns at `rpm` is
+/// taken. The emulator and every decoder of its stream compute times with this one function, so
+/// timestamps rebuilt from the wire equal the emulator's bit for bit.
+#[must_use]
+pub fn reading_time_s(rev_start_s: f64, index: u16, rpm: f64) -> f64 {
+    rev_start_s + f64::from(index) * reading_period_s(rpm)
+}
+
+/// When the revolution after one that started at `rev_start_s` at `rpm` starts.
+#[must_use]
+pub fn next_revolution_start_s(rev_start_s: f64, rpm: f64) -> f64 {
+    rev_start_s + f64::from(READINGS_PER_REV) * reading_period_s(rpm)
 }

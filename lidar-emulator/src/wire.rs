@@ -1,0 +1,129 @@
+//! Between the emulated lidar and the Neato wire format: readings into whole revolutions of
+//! packets, and decoded revolutions back into recording rows with their timestamps.
+
+use hilsim_recording::LidarSample;
+
+use crate::lidar::{next_revolution_start_s, reading_time_s, LidarReading, READINGS_PER_REV};
+use crate::neato_packet::{encode_revolution, Reading, Revolution, READINGS_PER_REVOLUTION};
+
+/// The wire form of one emulated reading. An invalid reading carries its error code and no
+/// strength, as real units send it.
+#[must_use]
+pub fn to_wire(reading: &LidarReading) -> Reading {
+    match reading.error_code {
+        Some(code) => Reading::error(code),
+        None => Reading {
+            distance_mm: reading.distance_mm,
+            invalid: false,
+            strength_warning: reading.warning,
+            strength: reading.strength,
+        },
+    }
+}
+
+/// One complete revolution ready for the wire.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RevolutionFrame {
+    /// Revolution counter.
+    pub rev: u64,
+    /// Motor speed the packets report.
+    pub rpm: f64,
+    /// When its first reading was taken, simulation seconds.
+    pub start_s: f64,
+    /// The 360 readings, index = angle in degrees.
+    pub readings: [Reading; READINGS_PER_REVOLUTION],
+}
+
+impl RevolutionFrame {
+    /// Appends the revolution's 90 packets (1,980 bytes) to `out`.
+    pub fn encode(&self, out: &mut Vec<u8>) {
+        encode_revolution(&self.readings, self.rpm, out);
+    }
+
+    /// When the reading at `angle` was taken, simulation seconds.
+    #[must_use]
+    pub fn reading_time_s(&self, angle: u16) -> f64 {
+        reading_time_s(self.start_s, angle, self.rpm)
+    }
+}
+
+/// Collects emulated readings into complete revolutions; a revolution the run ended inside is
+/// never emitted (real units only send whole revolutions).
+#[derive(Debug, Clone)]
+pub struct RevolutionCollector {
+    current: Option<(u64, f64)>,
+    readings: [Reading; READINGS_PER_REVOLUTION],
+    filled: u16,
+}
+
+impl Default for RevolutionCollector {
+    fn default() -> Self {
+        Self {
+            current: None,
+            readings: [Reading::default(); READINGS_PER_REVOLUTION],
+            filled: 0,
+        }
+    }
+}
+
+impl RevolutionCollector {
+    /// Adds the next reading; `rpm` is the motor speed of its revolution
+    /// ([`crate::Lidar::rpm_of_revolution`]). Returns the revolution it completes.
+    pub fn push(&mut self, reading: &LidarReading, rpm: f64) -> Option<RevolutionFrame> {
+        if self.current.map(|(rev, _)| rev) != Some(reading.rev) {
+            self.current = Some((reading.rev, reading.t_s));
+            self.filled = 0;
+        }
+        self.readings[usize::from(reading.angle_deg)] = to_wire(reading);
+        self.filled += 1;
+        let (rev, start_s) = self.current?;
+        (reading.angle_deg == READINGS_PER_REV - 1 && self.filled == READINGS_PER_REV).then(|| {
+            RevolutionFrame {
+                rev,
+                rpm,
+                start_s,
+                readings: self.readings,
+            }
+        })
+    }
+}
+
+/// Rebuilds recording rows from decoded revolutions, timing each reading from the motor speed
+/// the packets report, exactly as the emulator timed it. The first revolution received starts
+/// at t = 0; a revolution's time advances whether or not all its packets arrived.
+#[derive(Debug, Clone, Default)]
+pub struct WireTimeline {
+    next_start_s: f64,
+    next_rev: u64,
+}
+
+impl WireTimeline {
+    /// A timeline starting at t = 0, revolution 0.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The rows of one decoded revolution (its lost packets' readings are absent), appended to
+    /// `out`. The true range is unknown on the wire.
+    pub fn push(&mut self, revolution: &Revolution, out: &mut Vec<LidarSample>) {
+        let Some(rpm) = revolution.packets.iter().flatten().map(|p| p.rpm()).next() else {
+            return;
+        };
+        let (rev, start_s) = (self.next_rev, self.next_start_s);
+        for (angle, reading) in revolution.readings() {
+            out.push(LidarSample {
+                t_s: reading_time_s(start_s, angle, rpm),
+                rev,
+                angle_deg: angle,
+                range_m: reading.range_m().unwrap_or(0.0),
+                strength: reading.strength,
+                invalid: reading.invalid,
+                warning: reading.strength_warning,
+                true_range_m: None,
+            });
+        }
+        self.next_rev += 1;
+        self.next_start_s = next_revolution_start_s(start_s, rpm);
+    }
+}

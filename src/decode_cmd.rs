@@ -1,0 +1,417 @@
+//! `hilsim decode INPUT [--csv OUT] [--json]`: decode a raw Neato XV-11 byte stream.
+//!
+//! INPUT is a capture file or a serial device path. Either is opened read-only and read until
+//! the stream ends, in chunks, so a capture of any size or a live port works in constant memory
+//! (apart from the rpm histogram, bounded by 65,536 distinct speeds). A live port is therefore
+//! read until its writer goes away: end of file, or `EIO`, which is what a pseudo-terminal
+//! returns once the other side is closed. A real serial port is read as it is configured
+//! (set 115200 8N1 raw with `stty` first); interrupt to stop reading a unit that never stops.
+//!
+//! `--csv OUT` writes one row per reading, in stream order:
+//! `rev,packet_index,angle_deg,distance_mm,range_m,strength,invalid,warning,error_code,rpm`
+//! where `rev` counts revolutions from 0 (a partial first one included; a revolution ends on
+//! index 89 or when the index wraps), `packet_index` is 0..=89, `angle_deg` is
+//! `4 * packet_index + slot` (0..=359, counter-clockwise as the ROS driver reads it),
+//! `distance_mm` and `range_m` are 0 for an invalid reading, `invalid` and `warning` are 0/1,
+//! `error_code` is the invalid reading's code as `0x21`-style hex (empty when valid) and `rpm`
+//! is that packet's motor speed. The file is written to a hidden temporary sibling and renamed
+//! into place when complete, so a failed run never leaves half a file where a good one was.
+//!
+//! `--json` prints one object: `bytes`, `packets`, `bad_checksum`, `skipped_bytes`,
+//! `index_gaps`, `readings`, `invalid`, `strength_warning` (integers) and `rpm_min`,
+//! `rpm_median`, `rpm_max` (floats over accepted packets, 0.0 when there are none).
+
+use std::fs::File;
+use std::io::{BufWriter, ErrorKind, Read, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use hilsim_lidar_emulator::neato_packet::{
+    Decoder, DecoderStats, Packet, PacketSummary, Revolution, RevolutionAssembler,
+};
+use serde::Serialize;
+
+/// Bytes read from the input at a time.
+const CHUNK_LEN: usize = 64 * 1024;
+
+/// `EIO` on Linux and the BSDs: what a pty master's reader gets once the slave side is closed.
+#[cfg(unix)]
+const EIO: i32 = 5;
+
+/// The `--json` object; field names are the interface (`interfaces.md`).
+#[derive(Debug, Serialize)]
+struct DecodeCounts {
+    bytes: u64,
+    packets: u64,
+    bad_checksum: u64,
+    skipped_bytes: u64,
+    index_gaps: u64,
+    readings: u64,
+    invalid: u64,
+    strength_warning: u64,
+    rpm_min: f64,
+    rpm_median: f64,
+    rpm_max: f64,
+}
+
+impl DecodeCounts {
+    fn new(stats: &DecoderStats, summary: &PacketSummary) -> Self {
+        Self {
+            bytes: stats.bytes,
+            packets: stats.packets,
+            bad_checksum: stats.bad_checksum,
+            skipped_bytes: stats.skipped_bytes,
+            index_gaps: stats.index_gaps,
+            readings: summary.readings(),
+            invalid: summary.invalid(),
+            strength_warning: summary.strength_warning(),
+            rpm_min: summary.rpm_min(),
+            rpm_median: summary.rpm_median(),
+            rpm_max: summary.rpm_max(),
+        }
+    }
+}
+
+/// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
+/// (one JSON object with `json`, else a short human summary).
+///
+/// # Errors
+/// The input cannot be opened or read (a directory, a missing file…), the CSV cannot be
+/// written, or `stdout` fails; each message names the path concerned.
+pub fn run(
+    input: &Path,
+    csv: Option<&Path>,
+    json: bool,
+    stdout: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let mut source = open_input(input)?;
+    let mut csv_out = csv.map(CsvOut::create).transpose()?;
+
+    let mut decoder = Decoder::new();
+    let mut summary = PacketSummary::new();
+    let mut assembler = RevolutionAssembler::new();
+    let mut chunk = vec![0; CHUNK_LEN];
+    loop {
+        let len = match source.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(len) => len,
+            Err(err) if err.kind() == ErrorKind::Interrupted => continue,
+            Err(err) if is_closed_pty(&err) => break,
+            Err(err) => bail!("{}: cannot read: {err}", input.display()),
+        };
+        for packet in decoder.feed(&chunk[..len]) {
+            summary.add(&packet);
+            if let Some(out) = csv_out.as_mut() {
+                if let Some(revolution) = assembler.push(packet) {
+                    out.write_revolution(&revolution)?;
+                }
+            }
+        }
+    }
+    if let Some(mut out) = csv_out {
+        if let Some(revolution) = assembler.finish() {
+            out.write_revolution(&revolution)?;
+        }
+        out.commit()?;
+    }
+
+    let counts = DecodeCounts::new(&decoder.finish(), &summary);
+    report(input, &counts, json, stdout).context("stdout: cannot write")
+}
+
+fn open_input(input: &Path) -> anyhow::Result<File> {
+    let file = match File::open(input) {
+        Ok(file) => file,
+        Err(err) if err.kind() == ErrorKind::NotFound => {
+            bail!("{}: cannot open: no such file or device", input.display())
+        }
+        Err(err) => bail!("{}: cannot open: {err}", input.display()),
+    };
+    // Opening a directory succeeds on Unix; reading it would fail with a vaguer message.
+    let is_dir = file
+        .metadata()
+        .map(|meta| meta.is_dir())
+        .with_context(|| format!("{}: cannot open", input.display()))?;
+    if is_dir {
+        bail!(
+            "{}: is a directory, expected a capture file or a serial device",
+            input.display()
+        );
+    }
+    Ok(file)
+}
+
+#[cfg(unix)]
+fn is_closed_pty(err: &std::io::Error) -> bool {
+    err.raw_os_error() == Some(EIO)
+}
+
+#[cfg(not(unix))]
+fn is_closed_pty(_err: &std::io::Error) -> bool {
+    false
+}
+
+fn report(
+    input: &Path,
+    counts: &DecodeCounts,
+    json: bool,
+    stdout: &mut dyn Write,
+) -> anyhow::Result<()> {
+    if json {
+        serde_json::to_writer(&mut *stdout, counts)?;
+        writeln!(stdout)?;
+    } else {
+        writeln!(
+            stdout,
+            "{}: {} bytes, {} packets ({} readings), {} bad checksums, {} bytes skipped, {} index gaps",
+            input.display(),
+            counts.bytes,
+            counts.packets,
+            counts.readings,
+            counts.bad_checksum,
+            counts.skipped_bytes,
+            counts.index_gaps,
+        )?;
+        writeln!(
+            stdout,
+            "readings: {} invalid, {} with strength warning",
+            counts.invalid, counts.strength_warning
+        )?;
+        if counts.packets > 0 {
+            writeln!(
+                stdout,
+                "motor: {:.2} rpm median ({:.2} to {:.2})",
+                counts.rpm_median, counts.rpm_min, counts.rpm_max
+            )?;
+        } else {
+            writeln!(stdout, "motor: no packets, no speed")?;
+        }
+    }
+    stdout.flush()?;
+    Ok(())
+}
+
+/// The CSV being written: a temporary sibling of `path`, renamed over it by [`CsvOut::commit`]
+/// and removed if anything fails before that.
+struct CsvOut {
+    path: PathBuf,
+    tmp: PathBuf,
+    writer: Option<BufWriter<File>>,
+    committed: bool,
+}
+
+impl CsvOut {
+    const HEADER: &'static str =
+        "rev,packet_index,angle_deg,distance_mm,range_m,strength,invalid,warning,error_code,rpm";
+
+    fn create(path: &Path) -> anyhow::Result<Self> {
+        let Some(name) = path.file_name() else {
+            bail!("{}: not a file name for the CSV output", path.display());
+        };
+        // Hidden and in the same directory, so the final rename is atomic; unique per process.
+        let tmp = path.with_file_name(format!(
+            ".{}.tmp.{}",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        let file =
+            File::create(&tmp).with_context(|| format!("{}: cannot create", path.display()))?;
+        let mut out = Self {
+            path: path.to_path_buf(),
+            tmp,
+            writer: Some(BufWriter::new(file)),
+            committed: false,
+        };
+        out.write_line(format_args!("{}", Self::HEADER))?;
+        Ok(out)
+    }
+
+    fn write_revolution(&mut self, revolution: &Revolution) -> anyhow::Result<()> {
+        for packet in revolution.packets.iter().flatten() {
+            self.write_packet(revolution.number, packet)?;
+        }
+        Ok(())
+    }
+
+    fn write_packet(&mut self, rev: u64, packet: &Packet) -> anyhow::Result<()> {
+        for (angle_deg, reading) in (packet.first_angle_deg()..).zip(&packet.readings) {
+            let distance_mm = if reading.invalid {
+                0
+            } else {
+                reading.distance_mm
+            };
+            let error_code = reading
+                .error_code()
+                .map(|code| format!("{code:#04x}"))
+                .unwrap_or_default();
+            self.write_line(format_args!(
+                "{rev},{},{angle_deg},{distance_mm},{:.3},{},{},{},{error_code},{}",
+                packet.index,
+                f64::from(distance_mm) / 1000.0,
+                reading.strength,
+                u8::from(reading.invalid),
+                u8::from(reading.strength_warning),
+                packet.rpm(),
+            ))?;
+        }
+        Ok(())
+    }
+
+    fn write_line(&mut self, line: std::fmt::Arguments<'_>) -> anyhow::Result<()> {
+        let Some(writer) = self.writer.as_mut() else {
+            bail!("{}: already closed", self.path.display());
+        };
+        writeln!(writer, "{line}").with_context(|| format!("{}: cannot write", self.path.display()))
+    }
+
+    /// Flushes, syncs and renames the temporary file over `path`.
+    fn commit(mut self) -> anyhow::Result<()> {
+        let context = || format!("{}: cannot write", self.path.display());
+        if let Some(writer) = self.writer.take() {
+            let file = writer
+                .into_inner()
+                .map_err(|err| err.into_error())
+                .with_context(context)?;
+            file.sync_all().with_context(context)?;
+        }
+        std::fs::rename(&self.tmp, &self.path).with_context(context)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for CsvOut {
+    fn drop(&mut self) {
+        if !self.committed {
+            // Close before removing, then drop the half-written file; nothing else to report
+            // from a destructor, and the error that got us here is already on its way.
+            self.writer.take();
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hilsim_lidar_emulator::neato_packet::{encode_revolution, Reading};
+
+    /// Two revolutions, the second with a damaged packet (index 5) and a lost one (index 6).
+    fn sample_capture() -> Vec<u8> {
+        let mut readings: [Reading; 360] =
+            std::array::from_fn(|angle| Reading::distance(1000 + angle as u16, 50));
+        readings[2] = Reading::error(0x35);
+        readings[3].strength_warning = true;
+        let mut wire = Vec::new();
+        encode_revolution(&readings, 300.0, &mut wire);
+        encode_revolution(&readings, 310.0, &mut wire);
+        let second = 1980;
+        wire[second + 5 * 22 + 9] ^= 0xFF;
+        wire.drain(second + 6 * 22..second + 7 * 22);
+        wire
+    }
+
+    fn run_on(bytes: &[u8], csv: bool, json: bool) -> (String, Option<String>) {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let input = dir.path().join("capture.bin");
+        std::fs::write(&input, bytes).expect("write capture");
+        let csv_path = dir.path().join("out.csv");
+        let mut stdout = Vec::new();
+        run(&input, csv.then_some(csv_path.as_path()), json, &mut stdout).expect("decode runs");
+        let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+            .expect("list dir")
+            .filter_map(|entry| entry.ok())
+            .filter(|entry| entry.file_name().to_string_lossy().contains(".tmp."))
+            .collect();
+        assert!(leftovers.is_empty(), "temporary file left behind");
+        let csv_text = csv.then(|| std::fs::read_to_string(&csv_path).expect("csv written"));
+        (String::from_utf8(stdout).expect("utf-8"), csv_text)
+    }
+
+    #[test]
+    fn json_has_the_interface_keys_and_counts() {
+        let (stdout, _) = run_on(&sample_capture(), false, true);
+        let value: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
+        assert_eq!(value["bytes"], 1980 * 2 - 22);
+        assert_eq!(value["packets"], 178);
+        assert_eq!(value["bad_checksum"], 1);
+        assert_eq!(value["skipped_bytes"], 22);
+        assert_eq!(value["index_gaps"], 1);
+        assert_eq!(value["readings"], 4 * 178);
+        assert_eq!(value["invalid"], 2);
+        assert_eq!(value["strength_warning"], 2);
+        assert_eq!(value["rpm_min"], 300.0);
+        // 90 packets at 300 and 88 at 310: the two middle ones (ranks 88 and 89) are at 300.
+        assert_eq!(value["rpm_median"], 300.0);
+        assert_eq!(value["rpm_max"], 310.0);
+        assert_eq!(stdout.lines().count(), 1);
+    }
+
+    #[test]
+    fn csv_has_one_row_per_reading() {
+        let (stdout, csv) = run_on(&sample_capture(), true, false);
+        assert!(stdout.contains("178 packets"), "{stdout}");
+        let csv = csv.expect("csv requested");
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some(CsvOut::HEADER));
+        let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
+        assert_eq!(rows.len(), 4 * 178);
+        assert_eq!(
+            rows[0],
+            ["0", "0", "0", "1000", "1.000", "50", "0", "0", "", "300"]
+        );
+        assert_eq!(
+            rows[2],
+            ["0", "0", "2", "0", "0.000", "0", "1", "0", "0x35", "300"]
+        );
+        assert_eq!(rows[3][7], "1");
+        let second: Vec<_> = rows.iter().filter(|row| row[0] == "1").collect();
+        assert_eq!(second.len(), 4 * 88);
+        assert!(second.iter().all(|row| row[1] != "5" && row[1] != "6"));
+        assert_eq!(second[4 * 5][2], "28", "angles 20..27 are missing");
+    }
+
+    #[test]
+    fn empty_input_reports_zeros_not_nan() {
+        let (stdout, csv) = run_on(&[], true, true);
+        let value: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
+        assert_eq!(value["packets"], 0);
+        assert_eq!(value["rpm_median"], 0.0);
+        assert_eq!(
+            csv.as_deref(),
+            Some(format!("{}\n", CsvOut::HEADER).as_str())
+        );
+    }
+
+    #[test]
+    fn missing_input_names_the_file_and_leaves_the_csv_alone() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let input = dir.path().join("nope.bin");
+        let csv = dir.path().join("good.csv");
+        std::fs::write(&csv, "keep me").expect("write csv");
+        let err = run(&input, Some(&csv), true, &mut Vec::new()).expect_err("missing input");
+        let message = format!("{err:#}");
+        assert!(
+            message.contains("nope.bin") && message.contains("cannot open"),
+            "{message}"
+        );
+        assert_eq!(std::fs::read_to_string(&csv).expect("csv kept"), "keep me");
+    }
+
+    #[test]
+    fn directory_input_is_a_clean_error() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let err = run(dir.path(), None, false, &mut Vec::new()).expect_err("directory");
+        assert!(format!("{err:#}").contains("is a directory"));
+    }
+
+    #[test]
+    fn unwritable_csv_names_the_csv() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let input = dir.path().join("capture.bin");
+        std::fs::write(&input, sample_capture()).expect("write capture");
+        let csv = dir.path().join("no-such-dir").join("out.csv");
+        let err = run(&input, Some(&csv), false, &mut Vec::new()).expect_err("bad csv dir");
+        assert!(format!("{err:#}").contains("out.csv"), "{err:#}");
+    }
+}

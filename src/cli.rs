@@ -22,6 +22,8 @@ pub enum Command {
     Run(RunArgs),
     /// Simulate a scenario and write a recording, nothing else.
     Record(RecordArgs),
+    /// Stream the emulated lidar over a serial link in the Neato XV-11 format.
+    Serve(ServeArgs),
     /// Decode a raw Neato XV-11 byte capture (a file or a serial device path) into readings.
     Decode(DecodeArgs),
     /// Work with scenario files.
@@ -59,6 +61,27 @@ pub struct RecordArgs {
     /// The recording directory to write (replaced atomically when complete).
     #[arg(long)]
     pub out: PathBuf,
+    /// Seed of every random stream (default: the scenario's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct ServeArgs {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// Create a pseudo-terminal pair and print the path a client should open (the default).
+    #[arg(long, conflicts_with = "port")]
+    pub pty: bool,
+    /// Write to this existing serial device instead (opened at 115200 8N1).
+    #[arg(long, value_name = "PATH")]
+    pub port: Option<PathBuf>,
+    /// Pace the stream as a real unit would (the default).
+    #[arg(long, conflicts_with = "fast")]
+    pub realtime: bool,
+    /// Stream as fast as the link takes it.
+    #[arg(long)]
+    pub fast: bool,
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,

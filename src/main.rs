@@ -22,6 +22,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => commands::run::run(args, &mut out),
         Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
+        Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
         Command::Decode(args) => {
             decode_cmd::run(&args.input, args.csv.as_deref(), args.json, &mut out)
                 .map(|()| ExitCode::SUCCESS)

@@ -1,5 +1,19 @@
-//! Hardware in the loop without the hardware: serial links behind a port trait, pseudo-terminal
-//! pairs, and firmware in the loop (the robot command port).
-//!
-//! The links arrive with their issues (#4, #8); until then this crate holds no code.
+//! Hardware in the loop without the hardware: serial links behind one trait ([`SerialLink`]),
+//! pseudo-terminal pairs, a paced lidar streamer that never lets a reader stall the simulation,
+//! `hilsim serve`, and the loopback that sends the lidar through a pty and the decoder for
+//! `hilsim run --via serial`.
 #![warn(missing_docs)]
+
+mod device;
+mod link;
+pub mod loopback;
+mod pty;
+pub mod serve;
+mod streamer;
+
+pub use device::{DeviceLink, XV11_BAUD};
+pub use link::{MemoryLink, SerialLink};
+pub use pty::PtyLink;
+pub use streamer::{
+    Pacing, StreamStats, Streamer, BACKLOG_LIMIT, FAST_STALL_GRACE, LOSSLESS_TIMEOUT, STALL_DETECT,
+};

@@ -7,7 +7,7 @@ use hilsim_recording::{
 };
 use hilsim_sim::{Collision, Scenario, Simulation, StepState};
 
-use crate::lidar::{Lidar, LidarReading};
+use crate::lidar::{Lidar, LidarReading, READINGS_PER_REV};
 use crate::odometer::Odometer;
 use crate::range_model::ModelError;
 use crate::sonar::Sonar;
@@ -100,7 +100,14 @@ impl Emulation {
 
     /// Advances one physics step and returns the samples taken during it; `None` at the end.
     pub fn step(&mut self) -> Option<&StepSamples> {
-        let step = self.sim.step()?;
+        self.advance().then_some(&self.samples)
+    }
+
+    /// Advances one physics step, leaving its samples in `self.samples`; `false` at the end.
+    fn advance(&mut self) -> bool {
+        let Some(step) = self.sim.step() else {
+            return false;
+        };
         let s = &mut self.samples;
         s.step = Some(step);
         s.lidar.clear();
@@ -116,7 +123,7 @@ impl Emulation {
         if let Some(odometer) = &mut self.odometer {
             odometer.observe(&step, &mut s.odometry);
         }
-        Some(&self.samples)
+        true
     }
 
     /// The simulation (pose, time, collisions, wheel commands).
@@ -148,15 +155,26 @@ impl Emulation {
         (&self.scenario_name, self.seed)
     }
 
-    /// Runs to the end, collecting every sample into a recording (truth included).
+    /// Runs to the end, collecting every sample into a recording (truth included). The lidar
+    /// table holds whole revolutions only, as a real unit delivers them.
     #[must_use]
-    pub fn run(mut self) -> Run {
+    pub fn run(self) -> Run {
+        self.run_with(|_, _| {})
+    }
+
+    /// As [`Emulation::run`], also handing each lidar reading and the motor speed of its
+    /// revolution to `on_lidar` as it is taken (e.g. to stream it over a serial link).
+    pub fn run_with(mut self, mut on_lidar: impl FnMut(&LidarReading, f64)) -> Run {
         let mut lidar: Option<Vec<LidarSample>> = self.lidar.as_ref().map(|_| Vec::new());
         let mut sonar = self.sonar.as_ref().map(|_| Vec::new());
         let mut odometry = self.odometer.as_ref().map(|_| Vec::new());
-        while let Some(s) = self.step() {
-            if let Some(out) = &mut lidar {
-                out.extend(s.lidar.iter().map(LidarReading::to_sample));
+        while self.advance() {
+            let s = &self.samples;
+            if let (Some(out), Some(sensor)) = (&mut lidar, &self.lidar) {
+                for reading in &s.lidar {
+                    on_lidar(reading, sensor.rpm_of_revolution(reading.rev));
+                    out.push(reading.to_sample());
+                }
             }
             if let Some(out) = &mut sonar {
                 out.extend_from_slice(&s.sonar);
@@ -164,6 +182,12 @@ impl Emulation {
             if let Some(out) = &mut odometry {
                 out.extend_from_slice(&s.odometry);
             }
+        }
+        // A real unit only ever delivers whole revolutions: the one the run ended inside is not
+        // part of the recording (so the in-process and serial paths carry the same data).
+        if let Some(readings) = &mut lidar {
+            let whole = readings.len() - readings.len() % usize::from(READINGS_PER_REV);
+            readings.truncate(whole);
         }
         let (commands, truth, collisions) = self.sim.take_logs();
         Run {

@@ -77,13 +77,14 @@ impl RevolutionCollector {
         self.readings[usize::from(reading.angle_deg)] = to_wire(reading);
         self.filled += 1;
         let (rev, start_s) = self.current?;
-        (reading.angle_deg == READINGS_PER_REV - 1 && self.filled == READINGS_PER_REV).then(|| {
-            RevolutionFrame {
-                rev,
-                rpm,
-                start_s,
-                readings: self.readings,
-            }
+        if reading.angle_deg != READINGS_PER_REV - 1 || self.filled != READINGS_PER_REV {
+            return None;
+        }
+        Some(RevolutionFrame {
+            rev,
+            rpm,
+            start_s,
+            readings: self.readings,
         })
     }
 }

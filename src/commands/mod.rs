@@ -3,6 +3,7 @@
 pub mod record;
 pub mod run;
 pub mod scenario_test;
+pub mod serve;
 
 use std::path::Path;
 

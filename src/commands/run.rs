@@ -25,17 +25,25 @@ impl Report {
     }
 }
 
-/// Simulates, emulates the sensors, computes the metrics and checks the assertions.
-pub fn execute(scenario: Scenario, origin: &str) -> Result<Report> {
+/// Simulates, emulates the sensors, computes the metrics and checks the assertions; with
+/// `Via::Serial` the lidar data reaches the metrics through a pty and the decoder.
+pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report> {
     if let Some(method) = scenario.calibration.methods.first() {
         bail!(
             "{origin}: calibration method `{}` is not available in this build yet",
             method.name()
         );
     }
-    let run = Emulation::new(&scenario, scenario.seed)
-        .with_context(|| format!("{origin}: sensor model"))?
-        .run();
+    let emulation = Emulation::new(&scenario, scenario.seed)
+        .with_context(|| format!("{origin}: sensor model"))?;
+    let run = match via {
+        Via::Memory => emulation.run(),
+        Via::Serial => {
+            let (run, _) = hilsim_hil::loopback::run_through_pty(emulation)
+                .context("the serial path (pty)")?;
+            run
+        }
+    };
     let metrics = metrics::of_run(&run);
     let outcomes = metrics::check(&scenario.expect, &metrics);
     Ok(Report {
@@ -52,10 +60,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         |p| p.display().to_string(),
     );
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
-    if args.via == Via::Serial {
-        bail!("--via serial is not available in this build yet: use --via memory");
-    }
-    let report = execute(scenario, &origin)?;
+    let report = execute(scenario, &origin, args.via)?;
     summarise(&report, out)?;
     if let Some(dir) = &args.out {
         let results = results_json(&report);
@@ -76,7 +81,12 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
 /// The short human summary: what was simulated, samples per sensor, the checks.
 pub fn summarise(report: &Report, out: &mut dyn Write) -> Result<()> {
     let m = &report.metrics;
-    let get = |k: &str| m.get(k).copied().unwrap_or(f64::NAN);
+    let get = |k: &str| m.get(k).copied().unwrap_or(0.0);
+    // A metric that could not be computed (e.g. no truth on the serial path) reads "n/a".
+    let rms = |k: &str| {
+        m.get(k)
+            .map_or_else(|| "n/a".to_string(), |v| format!("{v:.4} m"))
+    };
     let rec = &report.run.recording;
     writeln!(
         out,
@@ -97,27 +107,28 @@ pub fn summarise(report: &Report, out: &mut dyn Write) -> Result<()> {
     if rec.lidar.is_some() {
         writeln!(
             out,
-            "  lidar     {:>8} readings in {} revolutions, {:.1}% valid, range error RMS {:.4} m",
+            "  lidar     {:>8} readings in {} revolutions, {:.1}% valid, range error RMS {}",
             get("lidar.readings"),
             get("lidar.revolutions"),
             100.0 * get("lidar.valid_fraction"),
-            get("lidar.rmse_m")
+            rms("lidar.rmse_m")
         )?;
     }
     if rec.sonar.is_some() {
         writeln!(
             out,
-            "  sonar     {:>8} pings, range error RMS {:.4} m",
+            "  sonar     {:>8} pings, range error RMS {}",
             get("sonar.readings"),
-            get("sonar.rmse_m")
+            rms("sonar.rmse_m")
         )?;
     }
     if rec.odometry.is_some() {
         writeln!(
             out,
-            "  odometer  {:>8} readings, reported/true travel {:.4}",
+            "  odometer  {:>8} readings, reported/true travel {}",
             get("odometer.readings"),
-            get("odometer.scale")
+            m.get("odometer.scale")
+                .map_or_else(|| "n/a".to_string(), |v| format!("{v:.4}"))
         )?;
     }
     if report.scenario.calibration.methods.is_empty() {

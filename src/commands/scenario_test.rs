@@ -70,7 +70,11 @@ fn run_all(scenarios: Vec<(PathBuf, Scenario)>) -> Result<Vec<(PathBuf, super::r
                 let Some((path, scenario)) = scenarios.get(i) else {
                     break;
                 };
-                let report = super::run::execute(scenario.clone(), &path.display().to_string());
+                let report = super::run::execute(
+                    scenario.clone(),
+                    &path.display().to_string(),
+                    crate::cli::Via::Memory,
+                );
                 if let Ok(mut slots) = results.lock() {
                     slots[i] = Some(report);
                 }

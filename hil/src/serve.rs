@@ -1,0 +1,57 @@
+//! `hilsim serve`: the emulated lidar streamed over a serial link in the Neato format.
+
+use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use hilsim_lidar_emulator::wire::RevolutionCollector;
+use hilsim_lidar_emulator::Emulation;
+
+use crate::link::SerialLink;
+use crate::streamer::{StreamStats, Streamer};
+
+/// What a serve run did.
+#[derive(Debug, Clone)]
+pub struct ServeReport {
+    /// The stream's counts and packet lateness.
+    pub stream: StreamStats,
+    /// Simulated seconds streamed.
+    pub simulated_s: f64,
+    /// Whether it ended because `stop` was raised.
+    pub interrupted: bool,
+}
+
+/// Streams the emulation's lidar until the scenario ends or `stop` is raised. Only whole
+/// revolutions are sent; the simulation is never held up by the reader (see [`Streamer`]).
+///
+/// # Errors
+/// The link failed.
+pub fn serve<L: SerialLink>(
+    mut emulation: Emulation,
+    streamer: &mut Streamer<L>,
+    stop: &AtomicBool,
+) -> io::Result<ServeReport> {
+    let mut collector = RevolutionCollector::default();
+    let mut readings = Vec::new();
+    let mut interrupted = false;
+    while let Some(samples) = emulation.step() {
+        readings.clear();
+        readings.extend_from_slice(&samples.lidar);
+        for reading in &readings {
+            let rpm = emulation
+                .lidar()
+                .map_or(0.0, |l| l.rpm_of_revolution(reading.rev));
+            if let Some(frame) = collector.push(reading, rpm) {
+                streamer.send(&frame)?;
+            }
+        }
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+    }
+    Ok(ServeReport {
+        stream: streamer.stats().clone(),
+        simulated_s: emulation.simulation().time_s(),
+        interrupted,
+    })
+}

@@ -1,0 +1,327 @@
+//! Writing whole revolutions to a serial link, paced as a real unit would send them, without
+//! ever letting a slow, stalled or absent reader hold up the simulation.
+
+use std::io::{self, ErrorKind};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use hilsim_lidar_emulator::neato_packet::{
+    PACKETS_PER_REVOLUTION, PACKET_LEN, READINGS_PER_PACKET,
+};
+use hilsim_lidar_emulator::wire::RevolutionFrame;
+
+use crate::link::SerialLink;
+
+/// How the stream is paced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pacing {
+    /// As a real XV-11: each packet leaves when its last reading has been taken, on the
+    /// simulation clock mapped to the wall clock.
+    Realtime,
+    /// As fast as the reader takes it; a reader that stalls for longer than
+    /// [`FAST_STALL_GRACE`] loses whole revolutions.
+    Fast,
+    /// As fast as the reader takes it, never dropping: for hilsim's own reader
+    /// (`hilsim run --via serial`). Fails after [`LOSSLESS_TIMEOUT`] without progress.
+    Lossless,
+}
+
+/// Bytes a reader may leave unread before it counts as fallen behind: one revolution.
+pub const BACKLOG_LIMIT: usize = PACKETS_PER_REVOLUTION * PACKET_LEN;
+/// How long a fast stream waits for a slow reader before dropping revolutions.
+pub const FAST_STALL_GRACE: Duration = Duration::from_millis(50);
+/// How long a reader may take nothing before it counts as stalled.
+pub const STALL_DETECT: Duration = Duration::from_millis(5);
+/// How long a lossless stream waits for its reader before giving up.
+pub const LOSSLESS_TIMEOUT: Duration = Duration::from_secs(10);
+/// Packet lateness histogram resolution.
+const LATENESS_BUCKET: Duration = Duration::from_micros(100);
+/// Lateness histogram range (later packets land in the last bucket).
+const LATENESS_BUCKETS: usize = 1000;
+
+/// What the stream did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamStats {
+    /// Revolutions written whole.
+    pub revolutions_sent: u64,
+    /// Revolutions thrown away because the reader was absent, stalled or too slow.
+    pub revolutions_dropped: u64,
+    /// Bytes written.
+    pub bytes_written: u64,
+    lateness: Vec<u64>,
+}
+
+impl Default for StreamStats {
+    fn default() -> Self {
+        Self {
+            revolutions_sent: 0,
+            revolutions_dropped: 0,
+            bytes_written: 0,
+            lateness: vec![0; LATENESS_BUCKETS],
+        }
+    }
+}
+
+impl StreamStats {
+    /// Packets whose lateness was measured (realtime pacing only).
+    #[must_use]
+    pub fn paced_packets(&self) -> u64 {
+        self.lateness.iter().sum()
+    }
+
+    /// The `q`-quantile (0..=1) of packet lateness: how long after its due time each packet was
+    /// written, to 0.1 ms. `None` without paced packets.
+    #[must_use]
+    pub fn lateness_quantile(&self, q: f64) -> Option<Duration> {
+        let total = self.paced_packets();
+        if total == 0 {
+            return None;
+        }
+        let rank = ((q.clamp(0.0, 1.0) * total as f64).ceil() as u64).max(1);
+        let mut seen = 0;
+        for (bucket, count) in self.lateness.iter().enumerate() {
+            seen += count;
+            if seen >= rank {
+                return Some(LATENESS_BUCKET * (bucket as u32 + 1));
+            }
+        }
+        Some(LATENESS_BUCKET * LATENESS_BUCKETS as u32)
+    }
+}
+
+/// Streams revolutions over a link.
+pub struct Streamer<L: SerialLink> {
+    link: L,
+    pacing: Pacing,
+    origin: Option<Instant>,
+    stats: StreamStats,
+    bytes: Vec<u8>,
+}
+
+impl<L: SerialLink> Streamer<L> {
+    /// A streamer over `link`.
+    pub fn new(link: L, pacing: Pacing) -> Self {
+        Self {
+            link,
+            pacing,
+            origin: None,
+            stats: StreamStats::default(),
+            bytes: Vec::with_capacity(BACKLOG_LIMIT),
+        }
+    }
+
+    /// The link.
+    pub fn link(&mut self) -> &mut L {
+        &mut self.link
+    }
+
+    /// What the stream did so far.
+    #[must_use]
+    pub fn stats(&self) -> &StreamStats {
+        &self.stats
+    }
+
+    /// Sends one revolution (or drops it, counted, if the reader cannot take it).
+    ///
+    /// # Errors
+    /// The link failed, or a lossless reader made no progress for [`LOSSLESS_TIMEOUT`].
+    pub fn send(&mut self, frame: &RevolutionFrame) -> io::Result<()> {
+        self.bytes.clear();
+        frame.encode(&mut self.bytes);
+        self.link.allow_reconnect()?;
+        if !self.make_room()? {
+            self.stats.revolutions_dropped += 1;
+            return Ok(());
+        }
+        let sent = match self.pacing {
+            Pacing::Realtime => self.send_paced(frame)?,
+            Pacing::Fast | Pacing::Lossless => {
+                let bytes = std::mem::take(&mut self.bytes);
+                let sent = self.write_all(&bytes)?;
+                self.bytes = bytes;
+                sent
+            }
+        };
+        if sent {
+            self.stats.revolutions_sent += 1;
+        } else {
+            self.stats.revolutions_dropped += 1;
+        }
+        Ok(())
+    }
+
+    /// Brings the backlog under [`BACKLOG_LIMIT`]: waits for a reader that is making progress
+    /// (as the pacing allows), and discards what a stalled or absent one left. Returns `false`
+    /// when this revolution must be dropped.
+    fn make_room(&mut self) -> io::Result<bool> {
+        let give_up = Instant::now()
+            + match self.pacing {
+                Pacing::Realtime => Duration::ZERO,
+                Pacing::Fast => FAST_STALL_GRACE,
+                Pacing::Lossless => LOSSLESS_TIMEOUT,
+            };
+        let mut backlog = self.link.backlog()?;
+        let mut progress_at = Instant::now();
+        while backlog > BACKLOG_LIMIT {
+            let now = Instant::now();
+            // A reader that took nothing for STALL_DETECT is stalled or gone: waiting longer
+            // would only slow the simulation down.
+            let stalled = self.pacing != Pacing::Lossless && now - progress_at >= STALL_DETECT;
+            if now >= give_up || stalled {
+                if self.pacing == Pacing::Lossless {
+                    return Err(io::Error::new(
+                        ErrorKind::TimedOut,
+                        "the reader took nothing for 10 s",
+                    ));
+                }
+                // The stale data would reach a late reader first: throw it away, counting the
+                // whole revolutions it held.
+                self.link.discard_backlog()?;
+                self.stats.revolutions_dropped += (backlog / BACKLOG_LIMIT) as u64;
+                return Ok(true);
+            }
+            thread::sleep(Duration::from_millis(1));
+            let now_backlog = self.link.backlog()?;
+            if now_backlog < backlog {
+                progress_at = Instant::now();
+            }
+            backlog = now_backlog;
+        }
+        Ok(true)
+    }
+
+    /// Writes all of `bytes`, waiting for the link as the pacing allows. Returns `false` when
+    /// the link stayed full (the partial revolution is then discarded).
+    fn write_all(&mut self, mut bytes: &[u8]) -> io::Result<bool> {
+        let wait = match self.pacing {
+            Pacing::Realtime => Duration::from_millis(2),
+            Pacing::Fast => FAST_STALL_GRACE,
+            Pacing::Lossless => LOSSLESS_TIMEOUT,
+        };
+        let mut deadline = Instant::now() + wait;
+        while !bytes.is_empty() {
+            match self.link.write(bytes) {
+                Ok(0) => {}
+                Ok(n) => {
+                    self.stats.bytes_written += n as u64;
+                    bytes = &bytes[n..];
+                    deadline = Instant::now() + wait;
+                    continue;
+                }
+                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            }
+            if Instant::now() >= deadline {
+                if self.pacing == Pacing::Lossless {
+                    return Err(io::Error::new(
+                        ErrorKind::TimedOut,
+                        "the reader took nothing for 10 s",
+                    ));
+                }
+                self.link.discard_backlog()?;
+                return Ok(false);
+            }
+            thread::sleep(Duration::from_micros(200));
+        }
+        Ok(true)
+    }
+
+    /// Writes the revolution packet by packet, each when its last reading has been taken.
+    fn send_paced(&mut self, frame: &RevolutionFrame) -> io::Result<bool> {
+        let origin = *self.origin.get_or_insert_with(|| {
+            Instant::now() - Duration::from_secs_f64(frame.start_s.max(0.0))
+        });
+        let bytes = std::mem::take(&mut self.bytes);
+        let mut all_sent = true;
+        for (k, packet) in bytes.chunks_exact(PACKET_LEN).enumerate() {
+            // The packet is complete once its fourth reading's instant has passed.
+            let last_angle = ((k + 1) * READINGS_PER_PACKET) as u16;
+            let due = origin + Duration::from_secs_f64(frame.reading_time_s(last_angle).max(0.0));
+            let now = Instant::now();
+            if due > now {
+                thread::sleep(due - now);
+            }
+            if !self.write_all(packet)? {
+                all_sent = false;
+                break;
+            }
+            let late = Instant::now().saturating_duration_since(due);
+            let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
+            self.stats.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
+        }
+        self.bytes = bytes;
+        Ok(all_sent)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MemoryLink;
+    use hilsim_lidar_emulator::neato_packet::{Decoder, Reading};
+
+    fn frame(rev: u64) -> RevolutionFrame {
+        RevolutionFrame {
+            rev,
+            rpm: 300.0,
+            start_s: rev as f64 * 0.2,
+            readings: [Reading::distance(1000 + rev as u16, 100); 360],
+        }
+    }
+
+    #[test]
+    fn a_reader_that_keeps_up_gets_every_revolution_whole() {
+        let mut s = Streamer::new(MemoryLink::with_capacity(4 * BACKLOG_LIMIT), Pacing::Fast);
+        let mut decoder = Decoder::new();
+        let mut packets = 0;
+        for rev in 0..20 {
+            s.send(&frame(rev)).unwrap();
+            packets += decoder.feed(&s.link().take()).count();
+        }
+        assert_eq!(packets, 20 * 90);
+        assert_eq!(s.stats().revolutions_sent, 20);
+        assert_eq!(s.stats().revolutions_dropped, 0);
+    }
+
+    #[test]
+    fn an_absent_reader_costs_revolutions_not_time_and_a_late_one_gets_fresh_data() {
+        let mut s = Streamer::new(MemoryLink::with_capacity(8 * BACKLOG_LIMIT), Pacing::Fast);
+        for rev in 0..50 {
+            s.send(&frame(rev)).unwrap();
+        }
+        let stats = s.stats().clone();
+        // Every revolution is either sent or counted as dropped; the backlog never exceeds two
+        // revolutions, so of 50 at most 2 can still be waiting.
+        assert_eq!(stats.revolutions_sent, 50);
+        assert!(stats.revolutions_dropped >= 48 - 2, "{stats:?}");
+        // What a reader connecting now finds is at most two revolutions, the newest ones.
+        let backlog = s.link().take();
+        assert!(backlog.len() <= 2 * BACKLOG_LIMIT, "{}", backlog.len());
+        let first = Decoder::new().feed(&backlog).next().unwrap();
+        assert!(first.readings[0].distance_mm >= 1048, "{first:?}");
+        assert!(s.link().discarded() >= 46 * BACKLOG_LIMIT);
+    }
+
+    #[test]
+    fn realtime_sends_each_packet_no_earlier_than_its_last_reading() {
+        let mut s = Streamer::new(
+            MemoryLink::with_capacity(8 * BACKLOG_LIMIT),
+            Pacing::Realtime,
+        );
+        let start = Instant::now();
+        for rev in 0..3 {
+            s.send(&frame(rev)).unwrap();
+            s.link().take();
+        }
+        // Three revolutions at 300 rpm end 0.6 s after the first began: pacing may be late,
+        // never early (a lower bound only: shared machines make upper bounds flaky).
+        assert!(
+            start.elapsed() >= Duration::from_millis(599),
+            "{:?}",
+            start.elapsed()
+        );
+        assert_eq!(s.stats().paced_packets(), 270);
+        assert!(s.stats().lateness_quantile(0.99).is_some());
+    }
+}

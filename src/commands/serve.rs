@@ -1,0 +1,71 @@
+//! `hilsim serve SCENARIO [--pty | --port PATH] [--realtime | --fast] [--seed N]`.
+
+use std::io::Write;
+use std::sync::atomic::AtomicBool;
+
+use anyhow::{Context, Result};
+use hilsim_hil::serve::{serve as stream, ServeReport};
+use hilsim_hil::{DeviceLink, Pacing, PtyLink, SerialLink, Streamer};
+use hilsim_lidar_emulator::Emulation;
+
+use crate::cli::ServeArgs;
+
+pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
+    let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
+    if scenario.sensors.lidar.is_none() {
+        anyhow::bail!(
+            "{}: the scenario has no [sensors.lidar] to serve",
+            args.scenario.display()
+        );
+    }
+    let pacing = if args.fast {
+        Pacing::Fast
+    } else {
+        Pacing::Realtime
+    };
+    let emulation = Emulation::new(&scenario, scenario.seed)
+        .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
+    let stop = AtomicBool::new(false);
+    let report = match &args.port {
+        Some(path) => {
+            let link = DeviceLink::open(&path.to_string_lossy())
+                .with_context(|| format!("{}: cannot open", path.display()))?;
+            writeln!(out, "serial: {}", path.display())?;
+            out.flush()?;
+            run(emulation, link, pacing, &stop)?
+        }
+        None => {
+            let link = PtyLink::open().context("cannot create a pseudo-terminal")?;
+            // The client's path on its own line, before any data: scripts wait for it.
+            writeln!(out, "serial: {}", link.client_path())?;
+            out.flush()?;
+            run(emulation, link, pacing, &stop)?
+        }
+    };
+    let s = &report.stream;
+    write!(
+        out,
+        "served {:.1} s: {} revolutions sent, {} dropped (no reader or a stalled one), {} bytes",
+        report.simulated_s, s.revolutions_sent, s.revolutions_dropped, s.bytes_written
+    )?;
+    if let (Some(p50), Some(p99)) = (s.lateness_quantile(0.5), s.lateness_quantile(0.99)) {
+        write!(
+            out,
+            "; packet lateness median {:.1} ms, p99 {:.1} ms",
+            p50.as_secs_f64() * 1e3,
+            p99.as_secs_f64() * 1e3
+        )?;
+    }
+    writeln!(out)?;
+    Ok(())
+}
+
+fn run<L: SerialLink>(
+    emulation: Emulation,
+    link: L,
+    pacing: Pacing,
+    stop: &AtomicBool,
+) -> Result<ServeReport> {
+    let mut streamer = Streamer::new(link, pacing);
+    stream(emulation, &mut streamer, stop).context("the serial link failed")
+}

@@ -9,8 +9,9 @@
 //! - a pty buffers ~15 KB when nobody reads (measured here: 15,564 bytes before a non-blocking
 //!   write would block, of which the slave reports at most 4,095 as readable), so a client that
 //!   connects late would first read stale data. The streamer keeps the backlog under one
-//!   revolution by discarding it (through hilsim's own slave handle) whenever the reader falls
-//!   behind: a late or returning client reads data at most one revolution old, then live data;
+//!   revolution at each revolution's start by discarding it (through hilsim's own slave handle)
+//!   whenever the reader falls behind: a late or returning client reads at most two revolutions
+//!   of older data, then live data;
 //! - a client that sets exclusive mode (serialport does by default) would lock the next client
 //!   out while hilsim's handle keeps the port open, so exclusivity is cleared before each
 //!   revolution.

@@ -6,3 +6,4 @@ mod common;
 mod record;
 mod run;
 mod scenario_test;
+mod serve;

@@ -73,6 +73,9 @@ fn via_serial_gives_the_in_process_summary_but_the_true_range() {
         .collect();
     // Only the lidar's error against the truth differs: true ranges are not on the wire.
     assert_eq!(differing.len(), 1, "{differing:?}");
-    assert!(differing[0].1.ends_with("range error RMS n/a"), "{differing:?}");
+    assert!(
+        differing[0].1.ends_with("range error RMS n/a"),
+        "{differing:?}"
+    );
     assert!(!serial.contains("NaN"));
 }

@@ -238,10 +238,7 @@ impl<L: SerialLink> Streamer<L> {
             // The packet is complete once its fourth reading's instant has passed.
             let last_angle = ((k + 1) * READINGS_PER_PACKET) as u16;
             let due = origin + Duration::from_secs_f64(frame.reading_time_s(last_angle).max(0.0));
-            let now = Instant::now();
-            if due > now {
-                thread::sleep(due - now);
-            }
+            sleep_until(due);
             if !self.write_all(packet)? {
                 all_sent = false;
                 break;
@@ -252,6 +249,19 @@ impl<L: SerialLink> Streamer<L> {
         }
         self.bytes = bytes;
         Ok(all_sent)
+    }
+}
+
+/// The OS may wake a sleeper late by its timer slack (~50 µs) or more; sleep to just before
+/// `due`, then yield until it.
+fn sleep_until(due: Instant) {
+    const SPIN: Duration = Duration::from_micros(300);
+    let now = Instant::now();
+    if due > now + SPIN {
+        thread::sleep(due - now - SPIN);
+    }
+    while Instant::now() < due {
+        thread::yield_now();
     }
 }
 

@@ -2,6 +2,7 @@
 //! each at its own instant from the robot's pose at that instant.
 
 use hilsim_recording::LidarSample;
+use hilsim_sim::pose::wrap_angle;
 use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
@@ -154,14 +155,15 @@ impl Lidar {
 
     /// Takes every reading whose instant falls in `[step.t0, step.t1)`.
     pub fn observe(&mut self, world: &World, step: &StepState, out: &mut Vec<LidarReading>) {
+        let track = SensorTrack::new(step, self.mount);
         loop {
             let t = reading_time_s(self.rev_start_s, self.index, self.rev_rpm);
             if t >= step.t1 {
                 return;
             }
             if t >= step.t0 {
-                let robot = step.pose_at(t);
-                out.push(self.read(world, &robot, t));
+                let (origin, yaw) = track.at(t);
+                out.push(self.read(world, origin, yaw, t));
             }
             self.index += 1;
             if self.index == READINGS_PER_REV {
@@ -173,12 +175,11 @@ impl Lidar {
         }
     }
 
-    /// One reading at the current (rev, index) from the robot pose `robot`.
-    fn read(&mut self, world: &World, robot: &hilsim_sim::Pose, t: f64) -> LidarReading {
-        let sensor = self.mount.in_world(robot);
+    /// One reading at the current (rev, index) from the lidar at `origin` with its 0° axis along
+    /// `yaw` (world frame, radians, not necessarily wrapped).
+    fn read(&mut self, world: &World, origin: [f64; 2], yaw: f64, t: f64) -> LidarReading {
         let angle_noise: f64 = StandardNormal.sample(&mut self.rng);
-        let beam =
-            sensor.yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
+        let beam = yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
         // Cast past the maximum so that a far target is seen as "beyond range", not "nothing".
         let cast_limit = (self.max_mm / 1000.0 * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0);
         let mut reading = LidarReading {
@@ -191,14 +192,15 @@ impl Lidar {
             warning: false,
             true_range_m: None,
         };
-        let Some(hit) = world.cast_ray([sensor.x, sensor.y], beam, cast_limit) else {
+        let Some(hit) = world.cast_ray(origin, beam, cast_limit) else {
             return reading;
         };
         let d = hit.distance;
         reading.true_range_m = Some(d);
         let measured_mm = (self.model.sample(d, &mut self.rng) * 1000.0).round();
         // Diffuse return: proportional to reflectivity and to the cosine of the incidence.
-        let cos_incidence = (hit.normal[0] * beam.cos() + hit.normal[1] * beam.sin()).abs();
+        let (sin, cos) = beam.sin_cos();
+        let cos_incidence = (hit.normal[0] * cos + hit.normal[1] * sin).abs();
         let speckle: f64 = StandardNormal.sample(&mut self.rng);
         let strength = STRENGTH_AT_1M
             * (hit.reflectivity / REFERENCE_REFLECTIVITY)
@@ -222,6 +224,47 @@ impl Lidar {
             reading.warning = strength < STRENGTH_WARNING_BELOW;
         }
         reading
+    }
+}
+
+/// The lidar's pose through one physics step: the robot's pose interpolated as
+/// [`StepState::pose_at`] does, composed with the mount.
+///
+/// The heading is left unwrapped: a beam direction needs no wrapping, and `pose_at` followed by
+/// `Mount::in_world` wrapped it three times per reading (each a floating-point remainder, about a
+/// tenth of the lidar's time in a sparse world). The step's heading change is wrapped once here.
+struct SensorTrack {
+    t0: f64,
+    t1: f64,
+    from: [f64; 3],
+    delta: [f64; 3],
+    mount: Mount,
+}
+
+impl SensorTrack {
+    fn new(step: &StepState, mount: Mount) -> Self {
+        let (p0, p1) = (step.pose0, step.pose1);
+        Self {
+            t0: step.t0,
+            t1: step.t1,
+            from: [p0.x, p0.y, p0.yaw],
+            delta: [p1.x - p0.x, p1.y - p0.y, wrap_angle(p1.yaw - p0.yaw)],
+            mount,
+        }
+    }
+
+    /// The lidar's origin and the direction of its 0° axis at `t` (clamped to the step).
+    fn at(&self, t: f64) -> ([f64; 2], f64) {
+        let u = ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0);
+        let [x, y, yaw] = [0, 1, 2].map(|i| self.from[i] + self.delta[i] * u);
+        let m = &self.mount;
+        let origin = if m.x_m == 0.0 && m.y_m == 0.0 {
+            [x, y]
+        } else {
+            let (sin, cos) = yaw.sin_cos();
+            [x + cos * m.x_m - sin * m.y_m, y + sin * m.x_m + cos * m.y_m]
+        };
+        (origin, yaw + m.yaw_rad)
     }
 }
 

@@ -26,9 +26,17 @@ pub enum Command {
     Serve(ServeArgs),
     /// Decode a raw Neato XV-11 byte capture (a file or a serial device path) into readings.
     Decode(DecodeArgs),
+    /// Calibrate the sensors from a recording.
+    Calibrate(CalibrateArgs),
+    /// Apply a trained calibration to a new recording with one smoother pass (EM paper, Sec. V).
+    Smooth(SmoothArgs),
     /// Work with scenario files.
     #[command(subcommand)]
     Scenario(ScenarioCommand),
+    /// Generate many seeded, varied runs of a scenario: resumable, shardable.
+    Dataset(crate::commands::dataset::DatasetArgs),
+    /// Run a firmware build in the loop with the lidar and robot command ports.
+    Hil(crate::commands::hil::HilArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -97,6 +105,52 @@ pub struct DecodeArgs {
     /// Print one JSON object of counts.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct CalibrateArgs {
+    /// A recording directory.
+    pub recording: PathBuf,
+    /// The calibration method.
+    #[arg(long, value_enum)]
+    pub method: MethodArg,
+    /// Print the result as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// The lidar beam facing the target, degrees in the lidar frame (EM, groundtruth; default 0).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub beam: Option<f64>,
+    /// Lidar-to-target distance at t = 0 (default: `target_start_distance_m` of meta.toml).
+    #[arg(long, value_name = "M")]
+    pub start_distance: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Ground-truth-less EM with a Kalman smoother.
+    Em,
+    /// Cylinders in unknown positions.
+    Landmarks,
+    /// Fit against truth.csv.
+    Groundtruth,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SmoothArgs {
+    /// A recording directory.
+    pub recording: PathBuf,
+    /// A calibration as printed by `hilsim calibrate --json`.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: PathBuf,
+    /// Write `t_s,distance_m,sd_m` here (atomically) instead of to stdout.
+    #[arg(long, value_name = "OUT")]
+    pub csv: Option<PathBuf>,
+    /// The lidar beam facing the target, degrees (default 0).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub beam: Option<f64>,
+    /// Lidar-to-target distance at t = 0 (default: meta.toml).
+    #[arg(long, value_name = "M")]
+    pub start_distance: Option<f64>,
 }
 
 #[derive(Debug, Subcommand)]

@@ -22,6 +22,12 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => commands::run::run(args, &mut out),
         Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
+        Command::Calibrate(args) => {
+            commands::calibrate::calibrate(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
+        Command::Smooth(args) => {
+            commands::calibrate::smooth(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
         Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
         Command::Decode(args) => {
             decode_cmd::run(&args.input, args.csv.as_deref(), args.json, &mut out)
@@ -30,6 +36,8 @@ fn main() -> ExitCode {
         Command::Scenario(ScenarioCommand::Test(args)) => {
             commands::scenario_test::test(args, &mut out)
         }
+        Command::Dataset(args) => commands::dataset::dataset(args, &mut out),
+        Command::Hil(args) => commands::hil::hil(args, &mut out),
     };
     let _ = out.flush();
     match result {

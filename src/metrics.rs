@@ -80,6 +80,30 @@ pub fn of_run(run: &Run) -> Metrics {
     m
 }
 
+/// The metrics of one calibration: `<method>.lidar.mse_ratio` and friends (see the catalogue).
+pub fn of_calibration(c: &hilsim_calibrator::Calibration) -> Metrics {
+    let mut m = Metrics::new();
+    let method = c.method.name();
+    let mut put = |name: &str, value: f64| {
+        if value.is_finite() {
+            m.insert(format!("{method}.{name}"), value);
+        }
+    };
+    put("iterations", c.iterations as f64);
+    put("converged", f64::from(u8::from(c.converged)));
+    if let Some(order) = c.order {
+        put("order", order as f64);
+    }
+    if let Some(metrics) = c.metrics {
+        put("lidar.mse_raw", metrics.mse_raw);
+        put("lidar.mse_calibrated", metrics.mse_calibrated);
+        put("lidar.mse_ratio", metrics.mse_ratio());
+        put("lidar.nmse_raw", metrics.nmse_raw);
+        put("lidar.nmse_calibrated", metrics.nmse_calibrated);
+    }
+    m
+}
+
 fn rms(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
     if n == 0 {

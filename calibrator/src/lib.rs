@@ -13,6 +13,7 @@ pub mod error;
 pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
+pub mod smoothing;
 pub mod target_samples;
 
 pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};

@@ -1,12 +1,17 @@
 //! Hardware in the loop without the hardware: serial links behind one trait ([`SerialLink`]),
 //! pseudo-terminal pairs, a paced lidar streamer that never lets a reader stall the simulation,
-//! `hilsim serve`, and the loopback that sends the lidar through a pty and the decoder for
-//! `hilsim run --via serial`.
+//! `hilsim serve`, the loopback that sends the lidar through a pty and the decoder for
+//! `hilsim run --via serial`, and firmware in the loop (`hilsim hil`: [`hil_run`], with the
+//! robot [`command_port`], the [`motion`] controller and the [`firmware`] process).
 #![warn(missing_docs)]
 
+pub mod command_port;
 mod device;
+pub mod firmware;
+pub mod hil_run;
 mod link;
 pub mod loopback;
+pub mod motion;
 mod pty;
 pub mod serve;
 mod streamer;

@@ -29,8 +29,9 @@ pub struct LoopbackReport {
 }
 
 /// Runs the emulation with its lidar readings taking the serial path. The returned run's lidar
-/// table is what the decoder rebuilt (true ranges are not on the wire, so they are absent); the
-/// other tables are the emulation's own.
+/// table is what the decoder rebuilt; the true ranges, which are not on the wire, are the
+/// simulator's, attached by revolution and angle for scoring. The other tables are the
+/// emulation's own.
 ///
 /// # Errors
 /// The pty cannot be opened or read, or the wire lost data (it must not, on a lossless link).
@@ -105,7 +106,23 @@ pub fn run_through_pty(emulation: Emulation) -> io::Result<(Run, LoopbackReport)
             decoder.bad_checksum
         )));
     }
-    if run.recording.lidar.is_some() {
+    if let Some(emulated) = &run.recording.lidar {
+        // The wire carries no truth; the harness has it. Attach each decoded reading's true
+        // range (matched by revolution, angle and time) so that a run is scored against the
+        // same truth on both paths; everything else is what the decoder produced.
+        let mut samples = samples;
+        for (decoded, truth) in samples.iter_mut().zip(emulated) {
+            if (decoded.rev, decoded.angle_deg, decoded.t_s)
+                != (truth.rev, truth.angle_deg, truth.t_s)
+            {
+                return Err(io::Error::other(format!(
+                    "the serial path reordered readings: revolution {} angle {} arrived where \
+                     revolution {} angle {} was sent",
+                    decoded.rev, decoded.angle_deg, truth.rev, truth.angle_deg
+                )));
+            }
+            decoded.true_range_m = truth.true_range_m;
+        }
         run.recording.lidar = Some(samples);
     }
     Ok((

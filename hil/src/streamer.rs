@@ -6,7 +6,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use hilsim_lidar_emulator::neato_packet::{
-    PACKETS_PER_REVOLUTION, PACKET_LEN, READINGS_PER_PACKET,
+    Packet, PACKETS_PER_REVOLUTION, PACKET_LEN, READINGS_PER_PACKET,
 };
 use hilsim_lidar_emulator::wire::RevolutionFrame;
 
@@ -48,6 +48,9 @@ pub struct StreamStats {
     pub revolutions_dropped: u64,
     /// Bytes written.
     pub bytes_written: u64,
+    /// Bytes written but thrown away unread (a reader that fell behind, or none): what a reader
+    /// took is `bytes_written - bytes_discarded - backlog`.
+    pub bytes_discarded: u64,
     lateness: Vec<u64>,
 }
 
@@ -57,6 +60,7 @@ impl Default for StreamStats {
             revolutions_sent: 0,
             revolutions_dropped: 0,
             bytes_written: 0,
+            bytes_discarded: 0,
             lateness: vec![0; LATENESS_BUCKETS],
         }
     }
@@ -96,6 +100,9 @@ pub struct Streamer<L: SerialLink> {
     origin: Option<Instant>,
     stats: StreamStats,
     bytes: Vec<u8>,
+    /// For [`Streamer::send_packet`]: inside a revolution, whether all its packets so far went
+    /// out (`None` before the first revolution start and after each revolution's end).
+    packets_whole: Option<bool>,
 }
 
 impl<L: SerialLink> Streamer<L> {
@@ -107,6 +114,7 @@ impl<L: SerialLink> Streamer<L> {
             origin: None,
             stats: StreamStats::default(),
             bytes: Vec::with_capacity(BACKLOG_LIMIT),
+            packets_whole: None,
         }
     }
 
@@ -150,6 +158,49 @@ impl<L: SerialLink> Streamer<L> {
         Ok(())
     }
 
+    /// Sends one packet of a realtime stream now, never waiting for its time: for a caller
+    /// that paces the simulation itself and must not be held up (firmware in the loop), and
+    /// hands over each packet once its last reading's instant has passed. `due` is that
+    /// instant on the wall clock, for the lateness statistics.
+    ///
+    /// Revolutions are still the unit: a packet with index 0 starts one and gets what
+    /// [`Streamer::send`] gives a whole revolution (the reader may reconnect; a reader that fell
+    /// behind has its backlog discarded at once, as in [`Pacing::Realtime`]). Packets before the
+    /// first revolution start are not sent, and when the link cannot take a packet the rest of
+    /// its revolution is dropped (counted once). A revolution counts as sent when its last
+    /// packet (index 89) goes out.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn send_packet(&mut self, packet: &Packet, due: Instant) -> io::Result<()> {
+        let index = usize::from(packet.index) % PACKETS_PER_REVOLUTION;
+        if index == 0 {
+            if self.packets_whole.take() == Some(true) {
+                // The previous revolution never got its last packet.
+                self.stats.revolutions_dropped += 1;
+            }
+            self.link.allow_reconnect()?;
+            self.make_room()?;
+            self.packets_whole = Some(true);
+        }
+        if self.packets_whole != Some(true) {
+            return Ok(());
+        }
+        if !self.write_all(&packet.encode())? {
+            self.packets_whole = Some(false);
+            self.stats.revolutions_dropped += 1;
+            return Ok(());
+        }
+        let late = Instant::now().saturating_duration_since(due);
+        let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
+        self.stats.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
+        if index == PACKETS_PER_REVOLUTION - 1 {
+            self.packets_whole = None;
+            self.stats.revolutions_sent += 1;
+        }
+        Ok(())
+    }
+
     /// Brings the backlog under [`BACKLOG_LIMIT`]: waits for a reader that is making progress
     /// (as the pacing allows), and discards what a stalled or absent one left. Returns `false`
     /// when this revolution must be dropped.
@@ -177,6 +228,7 @@ impl<L: SerialLink> Streamer<L> {
                 // The stale data would reach a late reader first: throw it away, counting the
                 // whole revolutions it held.
                 self.link.discard_backlog()?;
+                self.stats.bytes_discarded += backlog as u64;
                 self.stats.revolutions_dropped += (backlog / BACKLOG_LIMIT) as u64;
                 return Ok(true);
             }
@@ -219,6 +271,7 @@ impl<L: SerialLink> Streamer<L> {
                         "the reader took nothing for 10 s",
                     ));
                 }
+                self.stats.bytes_discarded += self.link.backlog()? as u64;
                 self.link.discard_backlog()?;
                 return Ok(false);
             }
@@ -311,6 +364,75 @@ mod tests {
         let first = Decoder::new().feed(&backlog).next().unwrap();
         assert!(first.readings[0].distance_mm >= 1048, "{first:?}");
         assert!(s.link().discarded() >= 46 * BACKLOG_LIMIT);
+    }
+
+    fn packet(rev: u64, index: u8) -> Packet {
+        Packet {
+            index,
+            rpm_fixed: hilsim_lidar_emulator::neato_packet::rpm_to_fixed(300.0),
+            readings: [Reading::distance(1000 + rev as u16, 100); 4],
+        }
+    }
+
+    fn send_revolution(s: &mut Streamer<MemoryLink>, rev: u64) {
+        for index in 0..90 {
+            s.send_packet(&packet(rev, index), Instant::now()).unwrap();
+        }
+    }
+
+    #[test]
+    fn packets_sent_one_at_a_time_make_whole_revolutions_and_count_what_a_reader_took() {
+        let mut s = Streamer::new(
+            MemoryLink::with_capacity(8 * BACKLOG_LIMIT),
+            Pacing::Realtime,
+        );
+        // The tail of a revolution before the first start is not sent.
+        for index in 45..90 {
+            s.send_packet(&packet(0, index), Instant::now()).unwrap();
+        }
+        assert_eq!(s.stats().bytes_written, 0);
+        send_revolution(&mut s, 1);
+        let taken = s.link().take();
+        assert_eq!(Decoder::new().feed(&taken).count(), 90);
+        // Nobody reads revolutions 2..=5: the backlog is discarded at a revolution start once it
+        // holds more than one revolution, and what the reader took can be told from the counts.
+        for rev in 2..=5 {
+            send_revolution(&mut s, rev);
+        }
+        let stats = s.stats().clone();
+        assert_eq!(stats.revolutions_sent, 5);
+        assert_eq!(stats.revolutions_dropped, 2);
+        assert_eq!(stats.bytes_written, 5 * BACKLOG_LIMIT as u64);
+        assert_eq!(stats.bytes_discarded, 2 * BACKLOG_LIMIT as u64);
+        let backlog = s.link().backlog().unwrap() as u64;
+        assert_eq!(
+            stats.bytes_written - stats.bytes_discarded - backlog,
+            taken.len() as u64
+        );
+        assert_eq!(stats.paced_packets(), 5 * 90);
+        let left = s.link().take();
+        let first = Decoder::new().feed(&left).next().unwrap();
+        assert_eq!(first.readings[0].distance_mm, 1004);
+    }
+
+    #[test]
+    fn a_packet_the_link_cannot_take_drops_the_rest_of_its_revolution_once() {
+        let mut s = Streamer::new(
+            MemoryLink::with_capacity(BACKLOG_LIMIT + 100),
+            Pacing::Realtime,
+        );
+        send_revolution(&mut s, 0);
+        // The link fills up five packets into the next revolution.
+        send_revolution(&mut s, 1);
+        assert_eq!(s.stats().revolutions_sent, 1);
+        assert_eq!(s.stats().revolutions_dropped, 1);
+        assert!(
+            s.link().take().is_empty(),
+            "the partial revolution was discarded"
+        );
+        send_revolution(&mut s, 2);
+        assert_eq!(s.stats().revolutions_sent, 2);
+        assert_eq!(Decoder::new().feed(&s.link().take()).count(), 90);
     }
 
     #[test]

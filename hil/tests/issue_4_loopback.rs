@@ -3,7 +3,6 @@
 
 use hilsim_hil::loopback::run_through_pty;
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::LidarSample;
 use hilsim_sim::Scenario;
 
 #[test]
@@ -12,13 +11,11 @@ fn the_serial_path_delivers_exactly_the_in_process_readings() {
     let scenario = Scenario::load(path.as_ref()).unwrap();
     let memory = Emulation::new(&scenario, 21).unwrap().run();
     let (serial, report) = run_through_pty(Emulation::new(&scenario, 21).unwrap()).unwrap();
-    let strip = |v: &[LidarSample]| -> Vec<LidarSample> {
-        v.iter().map(|s| LidarSample { true_range_m: None, ..*s }).collect()
-    };
-    let memory_lidar = strip(memory.recording.lidar.as_ref().unwrap());
+    let memory_lidar = memory.recording.lidar.clone().unwrap();
     let serial_lidar = serial.recording.lidar.as_ref().unwrap();
     assert!(memory_lidar.len() > 100 * 360);
     assert_eq!(serial_lidar.len(), memory_lidar.len());
+    // Ranges, flags, strengths and timestamps decoded from the wire; true ranges attached.
     assert_eq!(*serial_lidar, memory_lidar);
     // The rest of the recording does not travel the wire and is untouched.
     assert_eq!(serial.recording.sonar, memory.recording.sonar);

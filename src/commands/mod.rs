@@ -1,5 +1,8 @@
 //! One module per subcommand; each validates its arguments before opening anything.
 
+pub mod calibrate;
+pub mod dataset;
+pub mod hil;
 pub mod record;
 pub mod run;
 pub mod scenario_test;

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use hilsim_lidar_emulator::{Emulation, Run};
 use hilsim_recording::write_file_atomically;
 use hilsim_sim::Scenario;
@@ -15,6 +15,7 @@ use crate::metrics::{self, Metrics, Outcome};
 pub struct Report {
     pub scenario: Scenario,
     pub run: Run,
+    pub calibrations: Vec<hilsim_calibrator::Calibration>,
     pub metrics: Metrics,
     pub outcomes: Vec<Outcome>,
 }
@@ -28,12 +29,6 @@ impl Report {
 /// Simulates, emulates the sensors, computes the metrics and checks the assertions; with
 /// `Via::Serial` the lidar data reaches the metrics through a pty and the decoder.
 pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report> {
-    if let Some(method) = scenario.calibration.methods.first() {
-        bail!(
-            "{origin}: calibration method `{}` is not available in this build yet",
-            method.name()
-        );
-    }
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{origin}: sensor model"))?;
     let run = match via {
@@ -44,11 +39,28 @@ pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report> {
             run
         }
     };
-    let metrics = metrics::of_run(&run);
+    let mut metrics = metrics::of_run(&run);
+    let mut calibrations = Vec::new();
+    for method in &scenario.calibration.methods {
+        let method = match method {
+            hilsim_sim::scenario::Method::Em => hilsim_calibrator::Method::Em,
+            hilsim_sim::scenario::Method::Landmarks => hilsim_calibrator::Method::Landmarks,
+            hilsim_sim::scenario::Method::Groundtruth => hilsim_calibrator::Method::Groundtruth,
+        };
+        let calibration = super::calibrate::calibrate_recording(
+            &run.recording,
+            method,
+            super::calibrate::TargetOptions::default(),
+        )
+        .with_context(|| format!("{origin}: {} calibration", method.name()))?;
+        metrics.extend(metrics::of_calibration(&calibration));
+        calibrations.push(calibration);
+    }
     let outcomes = metrics::check(&scenario.expect, &metrics);
     Ok(Report {
         scenario,
         run,
+        calibrations,
         metrics,
         outcomes,
     })
@@ -131,8 +143,13 @@ pub fn summarise(report: &Report, out: &mut dyn Write) -> Result<()> {
                 .map_or_else(|| "n/a".to_string(), |v| format!("{v:.4}"))
         )?;
     }
-    if report.scenario.calibration.methods.is_empty() {
+    if report.calibrations.is_empty() {
         writeln!(out, "  calibration: none requested by the scenario")?;
+    }
+    for calibration in &report.calibrations {
+        for line in super::calibrate::describe(calibration).lines() {
+            writeln!(out, "  {line}")?;
+        }
     }
     for o in &report.outcomes {
         writeln!(out, "  {}", o.describe())?;
@@ -145,6 +162,7 @@ fn results_json(report: &Report) -> String {
         "scenario": report.scenario.name,
         "seed": report.scenario.seed,
         "metrics": report.metrics,
+        "calibrations": report.calibrations.iter().map(hilsim_calibrator::Calibration::to_json).collect::<Vec<_>>(),
         "expectations": report.outcomes,
         "passed": report.passed(),
     });

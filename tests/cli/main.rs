@@ -3,6 +3,7 @@
 
 mod bad_input;
 mod common;
+mod dataset;
 mod record;
 mod run;
 mod scenario_test;

@@ -37,8 +37,28 @@ pub const METRICS: &[(&str, &str)] = &[
     ),
 ];
 
+/// Calibration metrics, each prefixed by a method: `em.`, `landmarks.` or `groundtruth.`
+/// (computed when the scenario's `[calibration] methods` names it; the `lidar.*` ones need
+/// truth).
+pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
+    ("iterations", "iterations the method ran"),
+    ("converged", "1 when the method met its convergence criterion, else 0"),
+    ("order", "the selected polynomial order (landmarks)"),
+    ("lidar.mse_raw", "MSE of the raw lidar distances against the truth, m²"),
+    ("lidar.mse_calibrated", "MSE of the calibrated distance estimates, m²"),
+    ("lidar.mse_ratio", "raw over calibrated MSE (the landmark paper's eq. 31)"),
+    ("lidar.nmse_raw", "raw MSE normalised by the mean squared true distance"),
+    ("lidar.nmse_calibrated", "calibrated MSE normalised likewise (the EM paper's Fig. 3)"),
+];
+
+/// The calibration methods a calibration metric may be prefixed with.
+pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth"];
+
 /// Whether `name` is in the catalogue.
 #[must_use]
 pub fn is_known(name: &str) -> bool {
     METRICS.iter().any(|(n, _)| *n == name)
+        || name.split_once('.').is_some_and(|(method, rest)| {
+            METHODS.contains(&method) && CALIBRATION_METRICS.iter().any(|(n, _)| *n == rest)
+        })
 }

@@ -60,6 +60,16 @@ impl Scenario {
     /// # Errors
     /// The file cannot be read, is not UTF-8 TOML, does not match the format, or fails a check.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
+        Self::load_with_duration(path, None)
+    }
+
+    /// As [`Scenario::load`], with `duration_s` replaced by `duration_s` when given, before
+    /// validation: `hilsim hil --duration` bounds a run whose drive program is empty (the
+    /// firmware drives) in a file that sets no `duration_s`.
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn load_with_duration(path: &Path, duration_s: Option<f64>) -> Result<Self, ScenarioError> {
         let bytes = std::fs::read(path).map_err(|err| ScenarioError {
             file: path.to_path_buf(),
             line: None,
@@ -75,7 +85,7 @@ impl Scenario {
             ),
             message: "not a text file: expected UTF-8 TOML".to_string(),
         })?;
-        Self::from_toml(&text, path)
+        Self::from_toml_with_duration(&text, path, duration_s)
     }
 
     /// Parses and validates scenario text; `origin` names it in errors.
@@ -83,11 +93,27 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::load`].
     pub fn from_toml(text: &str, origin: &Path) -> Result<Self, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text).map_err(|err| ScenarioError {
+        Self::from_toml_with_duration(text, origin, None)
+    }
+
+    /// As [`Scenario::from_toml`], with `duration_s` replaced by `duration_s` when given, before
+    /// validation (see [`Scenario::load_with_duration`]).
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn from_toml_with_duration(
+        text: &str,
+        origin: &Path,
+        duration_s: Option<f64>,
+    ) -> Result<Self, ScenarioError> {
+        let mut scenario: Scenario = toml::from_str(text).map_err(|err| ScenarioError {
             file: origin.to_path_buf(),
             line: Some(err.span().map_or(1, |s| locate::line_at(text, s.start))),
             message: err.message().trim().replace('\n', " "),
         })?;
+        if duration_s.is_some() {
+            scenario.duration_s = duration_s;
+        }
         validate::validate(&scenario).map_err(|invalid| ScenarioError {
             file: origin.to_path_buf(),
             line: locate::line_of(text, &invalid.path),

@@ -1,0 +1,181 @@
+//! The M-step: closed forms per sensor (the paper's Sec. IV-C and Appendix, derived again from
+//! the expected complete-data log-likelihood; see `docs/em-calibration.md`).
+//!
+//! For a sensor `y_k = α · φ(d_k) + β d_k^p e_k` (φ = `[1, d, d²]` or `[1, d]`), the terms of
+//! the expected log-likelihood that depend on `(α, β)` are
+//!
+//! ```text
+//! Σ_k  −log β − E[ w(d_k) (y_k − α · φ(d_k))² ] / (2β²),     w(d) = d^(−2p)
+//! ```
+//!
+//! so `α = S_yφ S_φφ⁻¹` with `S_φφ = Σ E[w φ φᵀ]`, `S_yφ = Σ y E[w φ]`, and
+//! `β² = (Σ y² E[w] − α · S_yφ) / N`, sums over the steps where the sensor observed.
+//! The expectations are taken
+//! - as the paper does: `w` frozen at the previous smoothed state (`x̂^(t−1)[3]⁻²` for the
+//!   lidar), `E[φ φᵀ] = x̂ x̂ᵀ + P` from the redundant state's smoothed moments;
+//! - or (second-order variants) under the smoothed Gaussian of `d` itself, `w` included.
+
+use nalgebra::{Cholesky, Matrix2, Matrix3, Vector2, Vector3};
+
+use super::model::{moment, Data, Lin, Params, FLOOR_D_M, SENSORS};
+use crate::CalibrationError;
+
+/// Sensor names for messages, by slot.
+pub(crate) const NAMES: [&str; SENSORS] = ["lidar", "odometer", "sonar"];
+
+/// The smoothed moments the M-step reads.
+pub(crate) struct Posterior<'a> {
+    /// Smoothed means of `[d, d²]`.
+    pub means: &'a [Vector2<f64>],
+    /// Smoothed covariances.
+    pub covs: &'a [Matrix2<f64>],
+    /// Lag-one covariances `Cov(z_{k+1}, z_k | Y)` (needed only to estimate q).
+    pub lag_one: &'a [Matrix2<f64>],
+}
+
+/// One M-step. `lin` is the linearisation point the E-step used (the paper's weights);
+/// `second_order` selects the expectation under the Gaussian of `d`.
+pub(crate) fn m_step(
+    data: &Data,
+    params: &Params,
+    post: &Posterior<'_>,
+    lin: &[Lin],
+    second_order: bool,
+    estimate_q: bool,
+) -> Result<Params, CalibrationError> {
+    let mut next = *params;
+    // One pass over the steps for every sensor: S_φφ (full 3×3, of which each sensor uses its
+    // n_alpha block), S_yφ, Σ w y², N.
+    let mut sxx = [Matrix3::<f64>::zeros(); SENSORS];
+    let mut sxy = [Vector3::<f64>::zeros(); SENSORS];
+    let mut syy = [0.0; SENSORS];
+    let mut count = [0usize; SENSORS];
+    let active = params.sensors.map(|s| s.active);
+    let power = params.sensors.map(|s| s.power as i32);
+    for (k, step) in data.steps.iter().enumerate() {
+        let (m, cov) = (post.means[k], post.covs[k]);
+        if second_order {
+            // E[d^j] for j = −4..=4 (index j + 4) under the smoothed Gaussian of d.
+            let v = cov[(0, 0)].max(0.0);
+            let mut e = [0.0; 9];
+            for (i, e) in e.iter_mut().enumerate() {
+                *e = moment(m[0], v, i as i32 - 4);
+            }
+            for slot in 0..SENSORS {
+                if !(active[slot] && step.has[slot]) {
+                    continue;
+                }
+                let y = step.y[slot];
+                // E[w φ_i φ_j] = E[d^(i + j − 2p)].
+                let base = (4 - 2 * power[slot]) as usize;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        sxx[slot][(i, j)] += e[base + i + j];
+                    }
+                    sxy[slot][i] += y * e[base + i];
+                }
+                syy[slot] += y * y * e[base];
+                count[slot] += 1;
+            }
+        } else {
+            let phi = Vector3::new(1.0, m[0], m[1]);
+            let mut e = phi * phi.transpose();
+            e[(1, 1)] += cov[(0, 0)];
+            e[(1, 2)] += cov[(0, 1)];
+            e[(2, 1)] += cov[(1, 0)];
+            e[(2, 2)] += cov[(1, 1)];
+            for slot in 0..SENSORS {
+                if !(active[slot] && step.has[slot]) {
+                    continue;
+                }
+                let y = step.y[slot];
+                // The paper's weight: the noise shape at the previous smoothed state.
+                let shape = match power[slot] {
+                    0 => 1.0,
+                    1 => lin[k].m * lin[k].m,
+                    _ => lin[k].d2 * lin[k].d2,
+                };
+                let w = 1.0 / shape;
+                sxx[slot] += w * e;
+                sxy[slot] += (w * y) * phi;
+                syy[slot] += w * y * y;
+                count[slot] += 1;
+            }
+        }
+    }
+    for (slot, sensor) in next.sensors.iter_mut().enumerate() {
+        if !sensor.active {
+            continue;
+        }
+        let (n_alpha, n, name) = (sensor.n_alpha, count[slot], NAMES[slot]);
+        if n <= n_alpha {
+            return Err(CalibrationError::TooFewSamples(format!(
+                "{n} {name} readings cannot fit {n_alpha} bias coefficients and a noise level"
+            )));
+        }
+        let (mut a, mut b) = (sxx[slot], sxy[slot]);
+        // An affine sensor: pin the unused d² coefficient to 0 with an identity row.
+        for i in n_alpha..3 {
+            for j in 0..3 {
+                a[(i, j)] = 0.0;
+                a[(j, i)] = 0.0;
+            }
+            a[(i, i)] = 1.0;
+            b[i] = 0.0;
+        }
+        let alpha = Cholesky::new(a).map(|c| c.solve(&b)).ok_or_else(|| {
+            CalibrationError::Diverged(format!(
+                "the {name} normal equations are singular (the distances do not vary enough to \
+                 separate the bias coefficients)"
+            ))
+        })?;
+        let beta2 = (syy[slot] - alpha.dot(&b)) / n as f64;
+        if !(beta2 > 0.0 && beta2.is_finite() && alpha.iter().all(|a| a.is_finite())) {
+            return Err(CalibrationError::Diverged(format!(
+                "the {name} noise variance came out {beta2:e} (non-positive or non-finite)"
+            )));
+        }
+        sensor.alpha = [alpha[0], alpha[1], alpha[2]];
+        sensor.beta = [0.0; 3];
+        sensor.beta[sensor.power] = beta2.sqrt();
+    }
+    if estimate_q {
+        next.q_rel = q_step(data, post, params.q_rel)?;
+    }
+    Ok(next)
+}
+
+/// The M-step for `q` in `σ_k = q |u_k|` (Shumway–Stoffer's `Q` update, restricted to this
+/// structure): `q² = mean over moving steps of (E[(d_{k+1} − d_k − u_k)²] − f²) / u_k²`, where
+/// the expectation needs the lag-one covariance:
+/// `E[(Δ)²] = (m_{k+1} − m_k − u_k)² + P_{k+1} + P_k − 2 P_{k+1,k}`. The floor `f²` is
+/// subtracted so that it is not counted twice; this is the exact M-step when every `|u_k|` is
+/// equal (constant speed, the paper's runs) and a moment estimate otherwise.
+fn q_step(data: &Data, post: &Posterior<'_>, previous: f64) -> Result<f64, CalibrationError> {
+    let f2 = FLOOR_D_M * FLOOR_D_M;
+    let (mut sum, mut count) = (0.0, 0usize);
+    for k in 0..data.steps.len().saturating_sub(1) {
+        let u = data.steps[k].u;
+        // Steps shorter than the floor carry no information about a speed-scale error.
+        if u.abs() < 10.0 * FLOOR_D_M {
+            continue;
+        }
+        let r = post.means[k + 1][0] - post.means[k][0] - u;
+        let e =
+            r * r + post.covs[k + 1][(0, 0)] + post.covs[k][(0, 0)] - 2.0 * post.lag_one[k][(0, 0)];
+        sum += (e - f2) / (u * u);
+        count += 1;
+    }
+    if count == 0 {
+        return Ok(previous);
+    }
+    let q2 = sum / count as f64;
+    if !q2.is_finite() {
+        return Err(CalibrationError::Diverged(
+            "the process-noise estimate is not finite".into(),
+        ));
+    }
+    // Never exactly zero: a vanishing q would make the commands infallible, and EM could not
+    // grow it back (a fixed point of the update).
+    Ok(q2.max(1e-12).sqrt())
+}

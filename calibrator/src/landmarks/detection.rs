@@ -1,0 +1,461 @@
+//! Cylinders in a stop's averaged scan: segment the scan where the range jumps, fit a circle of
+//! the landmark radius to each segment, and keep the segments that a cylinder explains and a wall
+//! or clutter does not.
+//!
+//! What a landmark measurement is, precisely:
+//! * its **bearing** ψ is the direction, in the lidar frame, of the centre of the circle of the
+//!   landmark radius R fitted to the segment's averaged points (geometric least squares);
+//! * its **range** r̃ estimates the mean reading of the beam towards that centre, whose true
+//!   value is the distance to the nearest surface point, d = |c − s| − R. It averages, over the
+//!   stop's revolutions, the readings of the central beams (|φ − ψ| within a fraction of the
+//!   cylinder's angular half-width, at least the beam nearest ψ), each less the circle's extra
+//!   depth at its angle, Δ(a) = D cos a − √(R² − D² sin² a) − (D − R), D = |c|. Δ is
+//!   computed with a unit slope of the reading against distance, so r̃ is off by |f′ − 1|·Δ̄,
+//!   at most ~1.3 mm for the paper's model at 3 m, far below the noise of r̃.
+
+use super::circle_fit::{dist, fit_free, fit_known_radius, line_rms};
+use super::options::DetectionOptions;
+use super::scan::{StopScan, BEAMS};
+
+/// One landmark seen at one stop.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Detection {
+    /// Index of the stop.
+    pub stop: usize,
+    /// Bearing of the fitted centre in the lidar frame, radians.
+    pub bearing_rad: f64,
+    /// Bearing of the circle fit's centre, radians (the fallback when the edges are unclear).
+    pub fit_bearing_rad: f64,
+    /// Whether the bearing came from the edges' hit fractions (else from the circle fit).
+    pub from_edges: bool,
+    /// Distance of the fitted centre from the lidar, in reading units (metres, raw).
+    pub centre_range_m: f64,
+    /// r̃: the mean reading towards the centre (the nearest surface point), metres.
+    pub range_m: f64,
+    /// How many readings r̃ averages.
+    pub count: usize,
+    /// Each averaged (depth-corrected) reading less r̃: the reading noise about the stop mean.
+    pub residuals: Vec<f64>,
+    /// The same estimator applied to the simulator's true ranges, when the recording has them.
+    pub true_range_m: Option<f64>,
+    /// First beam of the segment, degrees.
+    pub first_beam: usize,
+    /// Beams in the segment.
+    pub beams: usize,
+    /// Radius of a free circle fit, when the segment has enough beams for one.
+    pub free_radius_m: Option<f64>,
+}
+
+/// Why segments were not taken for landmarks, counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Rejections {
+    /// Fewer beams than `min_beams`.
+    pub short: usize,
+    /// A neighbouring beam is nearer: something in front hides part of it.
+    pub occluded: usize,
+    /// Longer than a cylinder of the landmark radius can be (walls).
+    pub too_long: usize,
+    /// Its edges are not where a cylinder of the landmark radius would put them.
+    pub edges: usize,
+    /// A line fits it better than the circle (walls).
+    pub straight: usize,
+    /// Its free-fit radius is far from the landmark radius (clutter).
+    pub radius: usize,
+    /// The circle fit failed or put the centre in front of the surface.
+    pub fit: usize,
+    /// Its beams return only intermittently (a surface near the end of the range).
+    pub intermittent: usize,
+    /// Beyond the largest range used.
+    pub far: usize,
+}
+
+/// Why one segment is not a landmark.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reject {
+    /// Fewer beams than `min_beams`.
+    Short,
+    /// A neighbouring beam is nearer.
+    Occluded,
+    /// Longer than a cylinder of the landmark radius.
+    TooLong,
+    /// Edges not where a cylinder would put them.
+    Edges,
+    /// A line fits better than the circle.
+    Straight,
+    /// Free-fit radius far from the landmark radius.
+    Radius,
+    /// The circle fit failed.
+    Fit,
+    /// Its beams return only intermittently.
+    Intermittent,
+    /// Beyond the largest range used.
+    Far,
+}
+
+impl Rejections {
+    /// Counts one rejection.
+    pub fn count(&mut self, r: Reject) {
+        match r {
+            Reject::Short => self.short += 1,
+            Reject::Occluded => self.occluded += 1,
+            Reject::TooLong => self.too_long += 1,
+            Reject::Edges => self.edges += 1,
+            Reject::Straight => self.straight += 1,
+            Reject::Radius => self.radius += 1,
+            Reject::Fit => self.fit += 1,
+            Reject::Intermittent => self.intermittent += 1,
+            Reject::Far => self.far += 1,
+        }
+    }
+
+    /// Adds another count.
+    pub fn add(&mut self, o: &Rejections) {
+        self.short += o.short;
+        self.occluded += o.occluded;
+        self.too_long += o.too_long;
+        self.edges += o.edges;
+        self.straight += o.straight;
+        self.radius += o.radius;
+        self.fit += o.fit;
+        self.intermittent += o.intermittent;
+        self.far += o.far;
+    }
+
+    /// Total rejected segments.
+    #[must_use]
+    pub fn total(&self) -> usize {
+        self.short
+            + self.occluded
+            + self.too_long
+            + self.edges
+            + self.straight
+            + self.radius
+            + self.fit
+            + self.intermittent
+            + self.far
+    }
+}
+
+/// A run of neighbouring valid beams without a range jump.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Segment {
+    /// First beam (degrees, lidar frame).
+    pub first: usize,
+    /// Number of beams; beam `first + i` wraps modulo 360.
+    pub len: usize,
+}
+
+/// Fewest beams for a free-radius fit to say anything about the radius.
+const FREE_FIT_MIN_BEAMS: usize = 6;
+
+/// Splits the scan into segments.
+#[must_use]
+pub fn segments(scan: &StopScan, opts: &DetectionOptions) -> Vec<Segment> {
+    let b = &scan.beams;
+    let jump = |i: usize, j: usize| -> bool {
+        let (x, y) = (&b[i], &b[j]);
+        let sigma = (x.sem_m().powi(2) + y.sem_m().powi(2)).sqrt();
+        let tol = opts.jump_abs_m
+            + opts.jump_rel * x.mean_m.min(y.mean_m)
+            + opts.jump_sigmas * if sigma.is_finite() { sigma } else { 0.0 };
+        (x.mean_m - y.mean_m).abs() > tol
+    };
+    let breaks_before = |i: usize| {
+        !b[i].valid || !b[(i + BEAMS - 1) % BEAMS].valid || jump((i + BEAMS - 1) % BEAMS, i)
+    };
+    let Some(start) = (0..BEAMS).find(|&i| breaks_before(i)) else {
+        return if b.iter().all(|x| x.valid) {
+            vec![Segment {
+                first: 0,
+                len: BEAMS,
+            }]
+        } else {
+            Vec::new()
+        };
+    };
+    let mut out = Vec::new();
+    let mut current: Option<Segment> = None;
+    for k in 0..BEAMS {
+        let i = (start + k) % BEAMS;
+        if !b[i].valid {
+            out.extend(current.take());
+            continue;
+        }
+        match &mut current {
+            Some(seg) if !breaks_before(i) => seg.len += 1,
+            _ => {
+                out.extend(current.take());
+                current = Some(Segment { first: i, len: 1 });
+            }
+        }
+    }
+    out.extend(current);
+    out
+}
+
+/// The landmarks of radius `radius_m` in a stop's scan.
+#[must_use]
+pub fn detect(
+    scan: &StopScan,
+    stop: usize,
+    radius_m: f64,
+    opts: &DetectionOptions,
+) -> (Vec<Detection>, Rejections) {
+    let mut rej = Rejections::default();
+    let mut out = Vec::new();
+    for (_, verdict) in classify(scan, stop, radius_m, opts) {
+        match verdict {
+            Ok(d) => out.push(d),
+            Err(reason) => rej.count(reason),
+        }
+    }
+    (out, rej)
+}
+
+/// Every segment of the scan with its verdict: a detection, or why it is not one.
+#[must_use]
+pub fn classify(
+    scan: &StopScan,
+    stop: usize,
+    radius_m: f64,
+    opts: &DetectionOptions,
+) -> Vec<(Segment, Result<Detection, Reject>)> {
+    segments(scan, opts)
+        .into_iter()
+        .map(|seg| (seg, judge(scan, seg, stop, radius_m, opts)))
+        .collect()
+}
+
+/// The free-fit radii of the segments that could be cylinders (short, unoccluded, convex): the
+/// evidence from which an unknown landmark radius is estimated.
+#[must_use]
+pub fn candidate_radii(scan: &StopScan, opts: &DetectionOptions) -> Vec<f64> {
+    segments(scan, opts)
+        .into_iter()
+        .filter(|s| s.len >= FREE_FIT_MIN_BEAMS && !occluded(scan, *s))
+        .filter_map(|s| {
+            let (pts, _) = points(scan, s);
+            if dist(pts[0], pts[pts.len() - 1]) > 2.0 * opts.max_radius_m {
+                return None;
+            }
+            let c = fit_free(&pts, &vec![1.0; pts.len()])?;
+            let near = pts
+                .iter()
+                .map(|p| p[0].hypot(p[1]))
+                .fold(f64::INFINITY, f64::min);
+            (c.centre[0].hypot(c.centre[1]) > near && c.radius < opts.max_radius_m)
+                .then_some(c.radius)
+        })
+        .collect()
+}
+
+fn judge(
+    scan: &StopScan,
+    seg: Segment,
+    stop: usize,
+    r: f64,
+    opts: &DetectionOptions,
+) -> Result<Detection, Reject> {
+    if seg.len < opts.min_beams {
+        return Err(Reject::Short);
+    }
+    if occluded(scan, seg) {
+        return Err(Reject::Occluded);
+    }
+    // A landmark within range returns in (nearly) every revolution; a surface near the end of the
+    // XV-11's range drops out whenever the noise pushes a reading past it, and breaks into
+    // fragments that a cylinder's extent can match. The edge beams are excused (beam jitter).
+    let interior: Vec<usize> = if seg.len > 2 {
+        (1..seg.len - 1).collect()
+    } else {
+        (0..seg.len).collect()
+    };
+    let returns = interior
+        .iter()
+        .map(|&i| {
+            let b = beam(scan, seg, i);
+            b.readings.len() as f64 / b.samples.max(1) as f64
+        })
+        .sum::<f64>()
+        / interior.len() as f64;
+    if returns < opts.min_return_fraction {
+        return Err(Reject::Intermittent);
+    }
+    let (pts, angles) = points(scan, seg);
+    let n = pts.len();
+    let ranges: Vec<f64> = (0..n).map(|i| beam(scan, seg, i).mean_m).collect();
+    let near = ranges.iter().copied().fold(f64::INFINITY, f64::min);
+    if near > opts.max_range_m {
+        return Err(Reject::Far);
+    }
+    // Beam spacing at the segment's range, plus the noise of the averaged ends.
+    let spacing = near * 1f64.to_radians();
+    let end_noise = 2.0 * (beam(scan, seg, 0).sem_m() + beam(scan, seg, n - 1).sem_m());
+    if dist(pts[0], pts[n - 1]) > 2.0 * r + 2.0 * spacing + end_noise + 0.02 {
+        return Err(Reject::TooLong);
+    }
+    let mid = (angles[0] + angles[n - 1]) / 2.0;
+    let init = [(near + r) * mid.cos(), (near + r) * mid.sin()];
+    let w = vec![1.0; n];
+    let Some(circle) = fit_known_radius(&pts, &w, r, init) else {
+        return Err(Reject::Fit);
+    };
+    let d_c = circle.centre[0].hypot(circle.centre[1]);
+    if !(d_c > r && d_c > near) {
+        return Err(Reject::Fit);
+    }
+    let psi = circle.centre[1].atan2(circle.centre[0]);
+    // Unwrap ψ next to the segment's angles.
+    let psi = mid + super::pose::wrap(psi - mid);
+    let half = (r / d_c).asin().to_degrees();
+    let lo = (psi - angles[0]).to_degrees();
+    let hi = (angles[n - 1] - psi).to_degrees();
+    let tol = opts.edge_tolerance_deg;
+    let edge_ok = |e: f64| e >= half - 1.0 - tol && e <= half + tol;
+    if !(edge_ok(lo) && edge_ok(hi)) {
+        return Err(Reject::Edges);
+    }
+    if n >= 4 && line_rms(&pts, &w) < 0.5 * circle.rms {
+        return Err(Reject::Straight);
+    }
+    let free = if n >= FREE_FIT_MIN_BEAMS {
+        // Weighted by the averaged beams' inverse variances, so the radius's standard error is
+        // that of the data: a noisy far segment cannot be told apart by its radius.
+        let wv: Vec<f64> = (0..n)
+            .map(|i| 1.0 / beam(scan, seg, i).sem_m().max(1e-3).powi(2))
+            .collect();
+        fit_free(&pts, &wv)
+    } else {
+        None
+    };
+    if let Some(fr) = free {
+        if (fr.radius - r).abs() > opts.radius_tolerance * r + 3.0 * fr.radius_se {
+            return Err(Reject::Radius);
+        }
+    }
+    let free_radius_m = free.map(|c| c.radius);
+    let (psi_fit, from_edges) = (psi, true);
+    let (psi, from_edges) = match edge_bearing(scan, seg, &angles) {
+        Some(b)
+            if from_edges && (b - psi_fit).abs() < 1f64.to_radians() + half.to_radians() / 2.0 =>
+        {
+            (b, true)
+        }
+        _ => (psi_fit, false),
+    };
+    // The central beams measure the range (module docs).
+    let window = (opts.central_fraction * half).max(0.5 + 1e-9);
+    let (mut sum, mut tsum, mut count, mut tcount) = (0.0, 0.0, 0usize, 0usize);
+    let mut corrected = Vec::new();
+    for (i, angle) in angles.iter().enumerate() {
+        let a = angle - psi;
+        if a.to_degrees().abs() > window {
+            continue;
+        }
+        let s = d_c * a.sin();
+        if s.abs() >= r {
+            continue;
+        }
+        let depth = d_c * a.cos() - (r * r - s * s).sqrt() - (d_c - r);
+        for reading in &beam(scan, seg, i).readings {
+            let v = reading.range_m - depth;
+            sum += v;
+            count += 1;
+            corrected.push(v);
+            if let Some(t) = reading.true_range_m {
+                tsum += t - depth;
+                tcount += 1;
+            }
+        }
+    }
+    if count == 0 {
+        return Err(Reject::Fit);
+    }
+    let range_m = sum / count as f64;
+    Ok(Detection {
+        stop,
+        bearing_rad: super::pose::wrap(psi),
+        fit_bearing_rad: super::pose::wrap(psi_fit),
+        from_edges,
+        centre_range_m: d_c,
+        range_m,
+        count,
+        residuals: corrected.iter().map(|v| v - range_m).collect(),
+        true_range_m: (tcount == count).then(|| tsum / tcount as f64),
+        first_beam: seg.first,
+        beams: seg.len,
+        free_radius_m,
+    })
+}
+
+/// The bearing as the centroid of the beams' hit fractions: the fraction of a beam's samples
+/// that returned from the landmark (nearer than halfway to the background on that side). The
+/// hit profile is the cylinder's angular extent blurred by the beam jitter, symmetric about the
+/// centre's direction, so its centroid is the bearing, resolved below the beam spacing and free
+/// of the range noise that moves a circle fit. `None` when the background on either side is too
+/// close behind the landmark to tell a hit from a miss (four single-reading deviations).
+fn edge_bearing(scan: &StopScan, seg: Segment, angles: &[f64]) -> Option<f64> {
+    let b = &scan.beams;
+    let n = seg.len;
+    let at = |k: isize| &b[(seg.first as isize + k).rem_euclid(BEAMS as isize) as usize];
+    let side = |edge: &super::scan::Beam, out: &super::scan::Beam| -> Option<f64> {
+        if out.valid {
+            let gap = out.mean_m - edge.mean_m;
+            (gap > 4.0 * edge.sd_m.max(out.sd_m)).then_some(edge.mean_m + gap / 2.0)
+        } else {
+            // No background return: a reading is a hit if it is near the edge's range.
+            Some(edge.mean_m + (4.0 * edge.sd_m).max(0.1))
+        }
+    };
+    let left = side(at(0), at(-1))?;
+    let right = side(at(n as isize - 1), at(n as isize))?;
+    let step = angles.get(1).map_or(1f64.to_radians(), |a| a - angles[0]);
+    let (mut sw, mut swa) = (0.0, 0.0);
+    for k in -2..(n as isize + 2) {
+        let beam = at(k);
+        if beam.samples == 0 {
+            continue;
+        }
+        let tau = if k < (n as isize) / 2 { left } else { right };
+        let hits = beam.all_m.iter().filter(|r| **r < tau).count();
+        let p = hits as f64 / beam.samples as f64;
+        let outside = k < 0 || k >= n as isize;
+        if outside && p > 0.5 {
+            // Another object next to this one: the profile is no longer this landmark's alone.
+            return None;
+        }
+        let a = angles[0] + k as f64 * step;
+        sw += p;
+        swa += p * a;
+    }
+    (sw > 0.0).then(|| swa / sw)
+}
+
+fn beam(scan: &StopScan, seg: Segment, i: usize) -> &super::scan::Beam {
+    &scan.beams[(seg.first + i) % BEAMS]
+}
+
+/// The segment's averaged points in the lidar frame and their beam angles (radians, unwrapped
+/// from the first beam).
+fn points(scan: &StopScan, seg: Segment) -> (Vec<[f64; 2]>, Vec<f64>) {
+    (0..seg.len)
+        .map(|i| {
+            let a = ((seg.first + i) as f64).to_radians();
+            let m = beam(scan, seg, i).mean_m;
+            ([m * a.cos(), m * a.sin()], a)
+        })
+        .unzip()
+}
+
+/// A neighbour just outside the segment is valid and nearer than the segment's end next to it.
+fn occluded(scan: &StopScan, seg: Segment) -> bool {
+    if seg.len >= BEAMS {
+        return false;
+    }
+    let b = &scan.beams;
+    let before = &b[(seg.first + BEAMS - 1) % BEAMS];
+    let after = &b[(seg.first + seg.len) % BEAMS];
+    let first = &b[seg.first];
+    let last = &b[(seg.first + seg.len - 1) % BEAMS];
+    (before.valid && before.mean_m < first.mean_m) || (after.valid && after.mean_m < last.mean_m)
+}

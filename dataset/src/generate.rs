@@ -1,0 +1,346 @@
+//! Making a dataset, or the share of it one machine makes: on all cores, resumable, each run
+//! written to a temporary directory and renamed when complete.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::num::NonZeroUsize;
+use std::panic::AssertUnwindSafe;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::{replace_dir_atomically, write_file_atomically, Recording};
+use rayon::prelude::*;
+
+use crate::content::{scan_run, RunContent};
+use crate::dataset::RunFailure;
+use crate::layout::{
+    entries, leftover, manifest_name, remove_leftovers, run_dir_name, run_dirs, Leftover,
+    DATASET_FILE,
+};
+use crate::manifest::{self, Outcome, Row};
+use crate::params::Params;
+use crate::progress::{Plan, Progress, RunReport, Summary};
+use crate::{Dataset, Error, Shard};
+
+/// The manifest is rewritten at most this often while runs complete (and always at the end): an
+/// interruption loses at most this much of it, and the next call rebuilds it from the run
+/// directories.
+const MANIFEST_INTERVAL: Duration = Duration::from_millis(500);
+
+/// How to make a dataset: how many threads, and which share of the runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Options {
+    /// Worker threads; `None`: one per core.
+    pub jobs: Option<NonZeroUsize>,
+    /// The share of the runs to make (default: all).
+    pub shard: Shard,
+    /// Make only this run (in the shard's manifest, with the others already there).
+    pub only: Option<u64>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            jobs: None,
+            shard: Shard::ALL,
+            only: None,
+        }
+    }
+}
+
+/// What one worker sends back: the run, how it ended (or an error that stops the dataset), and
+/// its wall time.
+type Finished = (u64, Result<Result<RunContent, RunFailure>, Error>, Duration);
+
+impl Dataset {
+    /// Makes the dataset's runs in `dir`, or the share `options` selects, skipping those already
+    /// made; see the crate docs for the layout.
+    ///
+    /// In order: `dir` is created, or checked to hold this dataset (its `dataset.toml`, else it
+    /// must be empty); leftovers of interrupted writes of this share are removed; the runs already
+    /// made are rescanned (hashes recomputed) and the manifest rebuilt from them; then the missing
+    /// runs are made on `options.jobs` threads in index order. The manifest is rewritten as runs
+    /// complete (at most every 0.5 s) and at the end. A run that fails is recorded with its
+    /// reason and the others go on; runs that failed before are tried again.
+    ///
+    /// # Errors
+    /// `dir` holds something else, a run directory was damaged by hand, `options` name a run
+    /// outside the dataset or shard, or a file cannot be written (the runs made so far stay, and
+    /// the manifest is written for them).
+    pub fn generate(
+        &self,
+        dir: &Path,
+        options: &Options,
+        progress: &mut dyn Progress,
+    ) -> Result<Summary, Error> {
+        let start = Instant::now();
+        let p = self.params();
+        let shard = options.shard;
+        if let Some(r) = options.only {
+            if r >= p.runs {
+                return Err(Error::Parameter(format!(
+                    "--run {r}: the dataset's runs are 0 to {}",
+                    p.runs - 1
+                )));
+            }
+            if !shard.contains(r) {
+                return Err(Error::Parameter(format!(
+                    "--run {r} is not in shard {shard}"
+                )));
+            }
+        }
+        let pool = build_pool(options.jobs)?;
+        let jobs = pool.current_num_threads();
+        open_dir(dir, p)?;
+        let manifest_file = manifest_name(shard);
+        let manifest_path = dir.join(&manifest_file);
+        remove_leftovers(dir, |l| match l {
+            Leftover::Run(r) => *r < p.runs && shard.contains(*r),
+            Leftover::File(name) => *name == manifest_file,
+        })?;
+
+        // The runs made before, as their files say now.
+        let made: Vec<u64> = run_dirs(dir, p.runs)?
+            .into_iter()
+            .filter(|&r| shard.contains(r))
+            .collect();
+        let scanned: Vec<(u64, RunContent)> = pool.install(|| {
+            made.par_iter()
+                .map(|&r| scan_run(&dir.join(run_dir_name(r))).map(|c| (r, c)))
+                .collect::<Result<_, _>>()
+        })?;
+        let mut rows: BTreeMap<u64, Row> = scanned
+            .into_iter()
+            .map(|(r, c)| (r, self.row(r, Outcome::Made(c))))
+            .collect();
+        let to_make: Vec<u64> = match options.only {
+            Some(r) if rows.contains_key(&r) => Vec::new(),
+            Some(r) => vec![r],
+            None => (0..p.runs)
+                .filter(|&r| shard.contains(r) && !rows.contains_key(&r))
+                .collect(),
+        };
+        // Failures recorded before, of runs not tried again now (only with `only`).
+        if let Some(only) = options.only {
+            if manifest_path.is_file() {
+                for e in manifest::read(&manifest_path)? {
+                    if e.sha256.is_none()
+                        && e.run != only
+                        && e.run < p.runs
+                        && shard.contains(e.run)
+                        && !rows.contains_key(&e.run)
+                    {
+                        rows.insert(e.run, self.row(e.run, Outcome::Failed(e.reason)));
+                    }
+                }
+            }
+        }
+        let keys: Vec<&str> = p.varies.iter().map(|v| v.key()).collect();
+        let write_manifest = |rows: &BTreeMap<u64, Row>| {
+            write_file_atomically(&manifest_path, manifest::render(&keys, rows).as_bytes())
+                .map_err(Error::from)
+        };
+        write_manifest(&rows)?;
+        let share = match options.only {
+            Some(_) => 1,
+            None => (0..p.runs).filter(|&r| shard.contains(r)).count() as u64,
+        };
+        let skipped = share - to_make.len() as u64;
+        progress.planned(&Plan {
+            share,
+            skipped,
+            to_make: to_make.len() as u64,
+            jobs,
+        });
+
+        let next = AtomicUsize::new(0);
+        let stop = AtomicBool::new(false);
+        let (tx, rx) = mpsc::channel::<Finished>();
+        let mut fatal: Option<Error> = None;
+        let (mut made_now, mut failed_now) = (0, 0);
+        let mut last_write = Instant::now();
+        let mut dirty = false;
+        pool.in_place_scope(|scope| {
+            for _ in 0..jobs.min(to_make.len()) {
+                let tx = tx.clone();
+                let (next, stop, to_make) = (&next, &stop, &to_make);
+                scope.spawn(move |_| {
+                    while !stop.load(Ordering::Relaxed) {
+                        let Some(&r) = to_make.get(next.fetch_add(1, Ordering::Relaxed)) else {
+                            break;
+                        };
+                        let t = Instant::now();
+                        let result = self.make_run(dir, r);
+                        if tx.send((r, result, t.elapsed())).is_err() {
+                            break;
+                        }
+                    }
+                });
+            }
+            drop(tx);
+            for (r, result, elapsed) in rx {
+                let outcome = match result {
+                    Ok(Ok(content)) => {
+                        made_now += 1;
+                        Outcome::Made(content)
+                    }
+                    Ok(Err(failure)) => {
+                        failed_now += 1;
+                        Outcome::Failed(failure.reason)
+                    }
+                    Err(err) => {
+                        stop.store(true, Ordering::Relaxed);
+                        fatal.get_or_insert(err);
+                        continue;
+                    }
+                };
+                let report = RunReport {
+                    run: r,
+                    seed: self.run_seed(r),
+                    failure: match &outcome {
+                        Outcome::Failed(reason) => Some(reason.clone()),
+                        Outcome::Made(_) => None,
+                    },
+                    elapsed,
+                };
+                rows.insert(r, self.row(r, outcome));
+                dirty = true;
+                if last_write.elapsed() >= MANIFEST_INTERVAL {
+                    match write_manifest(&rows) {
+                        Ok(()) => dirty = false,
+                        Err(err) => {
+                            stop.store(true, Ordering::Relaxed);
+                            fatal.get_or_insert(err);
+                        }
+                    }
+                    last_write = Instant::now();
+                }
+                progress.run_finished(&report);
+            }
+        });
+        if dirty {
+            let written = write_manifest(&rows);
+            if fatal.is_none() {
+                written?;
+            }
+        }
+        if let Some(err) = fatal {
+            return Err(err);
+        }
+        Ok(Summary {
+            share,
+            made: made_now,
+            skipped,
+            failed: failed_now,
+            elapsed: start.elapsed(),
+            manifest: manifest_path,
+        })
+    }
+
+    /// Run `run`'s recording and scenario file text, in memory (nothing is written).
+    ///
+    /// # Errors
+    /// The run's varied scenario is invalid, or its sensor model makes no sense.
+    pub fn emulate(&self, run: u64) -> Result<(String, Recording), RunFailure> {
+        let (text, scenario) = self.scenario(run)?;
+        let emulation = Emulation::new(&scenario, scenario.seed).map_err(|err| RunFailure {
+            reason: format!("sensor model: {err}"),
+        })?;
+        Ok((text, emulation.run().recording))
+    }
+
+    /// Makes run `run` in `dir/run-NNNNNN`: its recording and `scenario.toml`, written into a
+    /// temporary directory that is renamed when complete. A panic in the models is a failure of
+    /// this run, not of the dataset.
+    fn make_run(&self, dir: &Path, run: u64) -> Result<Result<RunContent, RunFailure>, Error> {
+        let (text, recording) =
+            match std::panic::catch_unwind(AssertUnwindSafe(|| self.emulate(run))) {
+                Ok(Ok(made)) => made,
+                Ok(Err(failure)) => return Ok(Err(failure)),
+                Err(payload) => {
+                    let what = payload
+                        .downcast_ref::<&str>()
+                        .map(|s| (*s).to_string())
+                        .or_else(|| payload.downcast_ref::<String>().cloned())
+                        .unwrap_or_default();
+                    return Ok(Err(RunFailure {
+                        reason: format!("internal error: the run panicked: {what}"),
+                    }));
+                }
+            };
+        let target = dir.join(run_dir_name(run));
+        let mut content = None;
+        replace_dir_atomically(&target, |tmp| -> Result<(), Error> {
+            recording.write_files(tmp)?;
+            write_file_atomically(&tmp.join("scenario.toml"), text.as_bytes())?;
+            content = Some(scan_run(tmp)?);
+            Ok(())
+        })?;
+        content
+            .map(Ok)
+            .ok_or_else(|| Error::corrupt(&target, "the run was not scanned"))
+    }
+
+    /// Run `run`'s manifest row.
+    pub(crate) fn row(&self, run: u64, outcome: Outcome) -> Row {
+        Row {
+            run,
+            seed: self.run_seed(run),
+            values: self.values(run),
+            outcome,
+        }
+    }
+}
+
+/// A thread pool of `jobs` threads (default: one per core).
+pub(crate) fn build_pool(jobs: Option<NonZeroUsize>) -> Result<rayon::ThreadPool, Error> {
+    let n = jobs.map_or(0, NonZeroUsize::get);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .thread_name(|i| format!("dataset-{i}"))
+        .build()
+        .map_err(|err| Error::Parameter(format!("cannot start {n} worker threads: {err}")))
+}
+
+/// Creates `dir` for the dataset `params`, or checks that it holds this dataset.
+fn open_dir(dir: &Path, params: &Params) -> Result<(), Error> {
+    match fs::metadata(dir) {
+        Ok(m) if !m.is_dir() => return Err(Error::mismatch(dir, "not a directory")),
+        Ok(_) => {}
+        Err(err) if err.kind() == std::io::ErrorKind::NotFound => {
+            fs::create_dir_all(dir).map_err(|err| Error::io(dir, err))?;
+        }
+        Err(err) => return Err(Error::io(dir, err)),
+    }
+    let file = dir.join(DATASET_FILE);
+    if file.exists() {
+        let stored = Params::read(&file)?;
+        return match stored.difference(params) {
+            None => Ok(()),
+            Some(diff) => Err(Error::mismatch(
+                &file,
+                format!(
+                    "this directory holds another dataset: it was {diff}; give the same \
+                     parameters to resume it, or choose another --out"
+                ),
+            )),
+        };
+    }
+    // Only an empty directory becomes a dataset (a leftover of writing dataset.toml aside).
+    let others = entries(dir)?
+        .into_iter()
+        .filter(|(name, _)| leftover(name) != Some(Leftover::File(DATASET_FILE.to_string())))
+        .count();
+    if others > 0 {
+        return Err(Error::mismatch(
+            dir,
+            "exists and is not a dataset (no dataset.toml): choose a new or empty directory",
+        ));
+    }
+    remove_leftovers(dir, |l| *l == Leftover::File(DATASET_FILE.to_string()))?;
+    write_file_atomically(&file, params.to_toml().as_bytes())?;
+    Ok(())
+}

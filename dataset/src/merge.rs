@@ -1,0 +1,272 @@
+//! Merging the shards of a dataset: their run directories into one directory, and one manifest
+//! rebuilt from what is there.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fs;
+use std::num::NonZeroUsize;
+use std::path::{Path, PathBuf};
+
+use hilsim_recording::{replace_dir_atomically, write_file_atomically};
+use rayon::prelude::*;
+
+use crate::content::{scan_run, RunContent};
+use crate::generate::build_pool;
+use crate::layout::{
+    entries, is_manifest, is_shard_manifest, leftover, remove_leftovers, run_dir_name, run_dirs,
+    DATASET_FILE, MANIFEST_FILE,
+};
+use crate::manifest::{self, Outcome, Row};
+use crate::params::Params;
+use crate::{draw, run_seed, Error};
+
+/// What a merge did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MergeSummary {
+    /// Runs in the dataset (`N`).
+    pub runs: u64,
+    /// Runs whose directories are in the output (made).
+    pub made: u64,
+    /// Runs recorded as failed by a shard (and with no directory anywhere).
+    pub failed: u64,
+    /// Runs neither made nor recorded as failed (a shard has not finished, or was not given).
+    pub missing: u64,
+    /// Run directories brought into the output from the other directories.
+    pub copied: u64,
+    /// The manifest written.
+    pub manifest: PathBuf,
+}
+
+/// Merges the dataset directories `sources` into `out` and rebuilds `out/manifest.csv`.
+///
+/// `out` may be new, or a dataset directory itself (then it is one of the sources: with no
+/// `sources`, its own shards' runs and manifests are merged in place, when the shards shared one
+/// directory). Every directory must hold the same dataset (`dataset.toml` parameters). Run
+/// directories missing from `out` are brought in (files hard-linked when on the same file
+/// system, else copied; each run directory is renamed into place when complete). The manifest
+/// then has a row for each run directory in `out` (content hash recomputed) and for each run a
+/// source's manifest records as failed; the shard manifests in `out` are removed (the merged
+/// manifest holds their rows). Leftovers of interrupted writes in `out` are removed: merge after
+/// every shard has finished.
+///
+/// # Errors
+/// A directory is not a dataset or holds another one, a run differs between two directories or
+/// from the content hash a source's manifest recorded, or a file cannot be read or written.
+pub fn merge(
+    out: &Path,
+    sources: &[PathBuf],
+    jobs: Option<NonZeroUsize>,
+) -> Result<MergeSummary, Error> {
+    let out_is_dataset = out.join(DATASET_FILE).is_file();
+    let out_canon = fs::canonicalize(out).ok();
+    let mut others: Vec<PathBuf> = Vec::new();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for s in sources {
+        let canon = fs::canonicalize(s).map_err(|err| Error::io(s, err))?;
+        if Some(&canon) == out_canon.as_ref() || seen.contains(&canon) {
+            continue;
+        }
+        seen.push(canon);
+        others.push(s.clone());
+    }
+    let mut all: Vec<PathBuf> = Vec::new();
+    if out_is_dataset {
+        all.push(out.to_path_buf());
+    }
+    all.extend(others.iter().cloned());
+    if all.is_empty() {
+        return Err(Error::mismatch(
+            out,
+            "not a dataset (no dataset.toml), and no dataset directories were given to merge \
+             into it",
+        ));
+    }
+    let (reference_file, params) = same_dataset(&all)?;
+
+    if !out_is_dataset {
+        if out.exists() {
+            let clutter = entries(out)?
+                .into_iter()
+                .filter(|(name, _)| leftover(name).is_none())
+                .count();
+            if clutter > 0 {
+                return Err(Error::mismatch(
+                    out,
+                    "exists and is not a dataset (no dataset.toml): choose a new or empty \
+                     directory",
+                ));
+            }
+        } else {
+            fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
+        }
+        let bytes = fs::read(&reference_file).map_err(|err| Error::io(&reference_file, err))?;
+        write_file_atomically(&out.join(DATASET_FILE), &bytes)?;
+    }
+    remove_leftovers(out, |_| true)?;
+
+    // Bring in the runs `out` lacks; note the ones that are in more than one place.
+    let pool = build_pool(jobs)?;
+    let mut present: BTreeSet<u64> = run_dirs(out, params.runs)?.into_iter().collect();
+    let mut copies: Vec<(PathBuf, u64)> = Vec::new();
+    let mut duplicates: Vec<(PathBuf, u64)> = Vec::new();
+    for s in &others {
+        for r in run_dirs(s, params.runs)? {
+            let src = s.join(run_dir_name(r));
+            if present.insert(r) {
+                copies.push((src, r));
+            } else {
+                duplicates.push((src, r));
+            }
+        }
+    }
+    pool.install(|| {
+        copies
+            .par_iter()
+            .try_for_each(|(src, r)| copy_run(src, &out.join(run_dir_name(*r))))
+    })?;
+
+    // Rows: every run directory in `out`, hashes recomputed.
+    let made: Vec<u64> = present.into_iter().collect();
+    let scanned: Vec<(u64, RunContent)> = pool.install(|| {
+        made.par_iter()
+            .map(|&r| scan_run(&out.join(run_dir_name(r))).map(|c| (r, c)))
+            .collect::<Result<_, _>>()
+    })?;
+    let mut rows: BTreeMap<u64, Row> = BTreeMap::new();
+    let row = |r: u64, outcome: Outcome| Row {
+        run: r,
+        seed: run_seed(params.seed, r),
+        values: params
+            .varies
+            .iter()
+            .map(|v| draw(params.seed, r, v.key(), v.lo(), v.hi()))
+            .collect(),
+        outcome,
+    };
+    for (r, c) in scanned {
+        rows.insert(r, row(r, Outcome::Made(c)));
+    }
+    let hash_of = |rows: &BTreeMap<u64, Row>, r: u64| match rows.get(&r).map(|row| &row.outcome) {
+        Some(Outcome::Made(c)) => Some(c.sha256.clone()),
+        _ => None,
+    };
+    let dup_hashes: Vec<(PathBuf, u64, RunContent)> = pool.install(|| {
+        duplicates
+            .par_iter()
+            .map(|(src, r)| scan_run(src).map(|c| (src.clone(), *r, c)))
+            .collect::<Result<_, _>>()
+    })?;
+    for (src, r, c) in dup_hashes {
+        if hash_of(&rows, r).as_deref() != Some(c.sha256.as_str()) {
+            return Err(Error::mismatch(
+                &src,
+                format!(
+                    "differs from {} (content hash {}): the same run made twice differently",
+                    out.join(run_dir_name(r)).display(),
+                    hash_of(&rows, r).unwrap_or_default()
+                ),
+            ));
+        }
+    }
+    // The manifests: failures of runs made nowhere, and a check of every recorded hash.
+    let mut failures: BTreeMap<u64, String> = BTreeMap::new();
+    for d in &all {
+        for (name, path) in entries(d)? {
+            if !is_manifest(&name) {
+                continue;
+            }
+            for e in manifest::read(&path)? {
+                if e.run >= params.runs {
+                    continue;
+                }
+                match (&e.sha256, hash_of(&rows, e.run)) {
+                    (Some(recorded), Some(now)) if *recorded != now => {
+                        return Err(Error::mismatch(
+                            &path,
+                            format!(
+                                "run {} has content hash {recorded} here, but {} has {now}: the \
+                                 run's files changed after it was made",
+                                e.run,
+                                out.join(run_dir_name(e.run)).display()
+                            ),
+                        ));
+                    }
+                    (None, None) => {
+                        failures.entry(e.run).or_insert(e.reason);
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    let failed = failures.len() as u64;
+    for (r, reason) in failures {
+        rows.insert(r, row(r, Outcome::Failed(reason)));
+    }
+    let keys: Vec<&str> = params.varies.iter().map(|v| v.key()).collect();
+    let manifest_path = out.join(MANIFEST_FILE);
+    write_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
+    for (name, path) in entries(out)? {
+        if is_shard_manifest(&name) {
+            fs::remove_file(&path).map_err(|err| Error::io(&path, err))?;
+        }
+    }
+    Ok(MergeSummary {
+        runs: params.runs,
+        made: made.len() as u64,
+        failed,
+        missing: params.runs - rows.len() as u64,
+        copied: copies.len() as u64,
+        manifest: manifest_path,
+    })
+}
+
+/// Reads every directory's `dataset.toml`; all must define the same dataset. Returns the first
+/// file and its parameters.
+fn same_dataset(dirs: &[PathBuf]) -> Result<(PathBuf, Params), Error> {
+    let mut reference: Option<(PathBuf, Params)> = None;
+    for d in dirs {
+        let file = d.join(DATASET_FILE);
+        if !file.is_file() {
+            return Err(Error::mismatch(
+                d,
+                "not a dataset directory (no dataset.toml)",
+            ));
+        }
+        let p = Params::read(&file)?;
+        match &reference {
+            None => reference = Some((file, p)),
+            Some((first, q)) => {
+                if let Some(diff) = q.difference(&p) {
+                    return Err(Error::mismatch(
+                        &file,
+                        format!(
+                            "another dataset than {}: that one was {diff}",
+                            first.display()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    reference.ok_or_else(|| Error::Parameter("no dataset directories to merge".to_string()))
+}
+
+/// Brings run directory `src` to `dst`: its files hard-linked (never modified in place, so
+/// sharing them is safe) or, across file systems, copied; renamed into place when complete.
+fn copy_run(src: &Path, dst: &Path) -> Result<(), Error> {
+    replace_dir_atomically(dst, |tmp| -> Result<(), Error> {
+        for (name, path) in entries(src)? {
+            if !path.is_file() {
+                return Err(Error::corrupt(
+                    src,
+                    format!("`{name}` is not a file: a run directory holds only files"),
+                ));
+            }
+            let to = tmp.join(&name);
+            if fs::hard_link(&path, &to).is_err() {
+                fs::copy(&path, &to).map_err(|err| Error::io(&to, err))?;
+            }
+        }
+        Ok(())
+    })
+}

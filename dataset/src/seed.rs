@@ -1,0 +1,50 @@
+//! Per-run seeds and per-run draws of varied parameters: pure functions of the dataset's seed,
+//! the run's index and (for a draw) the key, so any run can be made again on its own.
+
+use rand::RngCore as _;
+
+/// SplitMix64's increment: 2^64 divided by the golden ratio.
+const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// The largest seed a scenario file can hold: TOML integers are signed 64-bit.
+pub const MAX_SEED: u64 = i64::MAX as u64;
+
+/// The seed of run `run` in a dataset seeded with `base`: the `(run + 1)`-th output of
+/// SplitMix64 (Steele, Lea & Flood, OOPSLA 2014) started from `base`, shifted right by one bit so
+/// that it fits a TOML integer (below 2^63).
+///
+/// It depends on `base` and `run` alone: not on the number of runs, the shard or the jobs.
+///
+/// ```
+/// use hilsim_dataset::run_seed;
+/// assert_eq!(run_seed(0, 0), 0xe220_a839_7b1d_cdaf >> 1); // SplitMix64(0)'s first output
+/// assert_ne!(run_seed(11, 0), run_seed(11, 1));
+/// assert!(run_seed(u64::MAX, 7) <= hilsim_dataset::MAX_SEED);
+/// ```
+#[must_use]
+pub fn run_seed(base: u64, run: u64) -> u64 {
+    let mut z = base.wrapping_add(run.wrapping_add(1).wrapping_mul(GAMMA));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)) >> 1
+}
+
+/// A value drawn uniformly from `[lo, hi]` for `key` in run `run` of a dataset seeded with
+/// `base`: `lo + (hi − lo)·u`, where `u` is the top 53 bits of the first output of the random
+/// stream named `dataset.vary.KEY` of the run's seed ([`hilsim_sim::rng::stream`]) divided by
+/// 2^53. Each key has its own stream, so adding or removing another `--vary` never changes this
+/// one's values.
+///
+/// ```
+/// use hilsim_dataset::draw;
+/// let x = draw(11, 42, "robot.start.x", 0.5, 1.5);
+/// assert!((0.5..=1.5).contains(&x));
+/// assert_eq!(x, draw(11, 42, "robot.start.x", 0.5, 1.5));
+/// assert_ne!(x, draw(11, 43, "robot.start.x", 0.5, 1.5));
+/// ```
+#[must_use]
+pub fn draw(base: u64, run: u64, key: &str, lo: f64, hi: f64) -> f64 {
+    let mut rng = hilsim_sim::rng::stream(run_seed(base, run), &format!("dataset.vary.{key}"));
+    let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+    (lo + (hi - lo) * u).clamp(lo, hi)
+}

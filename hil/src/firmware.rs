@@ -1,0 +1,500 @@
+//! The firmware under test as a child process: started from a command line split like a shell
+//! would (no shell runs), in a process group of its own, with its stderr captured (the last
+//! [`STDERR_TAIL_LINES`] lines are kept for the report) and its stdout passed through.
+//!
+//! Whatever way the run ends, the whole process group is killed: [`Firmware::shut_down`] asks
+//! politely first (the ports close, then `SIGTERM`), and dropping a [`Firmware`] on any other
+//! path (a harness error, a panic) kills the group with `SIGKILL` and reaps the child. The ptys
+//! are close-on-exec, so the firmware holds only the ports it opens itself.
+
+use std::collections::VecDeque;
+use std::fmt;
+use std::io::{self, BufRead, BufReader};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::process::{Child, ChildStderr, Command, ExitStatus, Stdio};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use nix::sys::signal::{killpg, Signal};
+use nix::unistd::Pid;
+
+/// How many of the firmware's last stderr lines are kept.
+pub const STDERR_TAIL_LINES: usize = 20;
+/// Longest stderr line kept, characters (longer lines are cut).
+const STDERR_LINE_CHARS: usize = 240;
+/// How long a firmware has to leave after `SIGTERM` before it is killed.
+pub const TERM_GRACE: Duration = Duration::from_secs(1);
+/// How often a waiting harness looks at the child.
+const POLL: Duration = Duration::from_millis(5);
+
+/// A firmware command line that cannot be split into words.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SplitError {
+    /// Nothing to run.
+    Empty,
+    /// A quote (`'` or `"`) is never closed.
+    UnterminatedQuote(char),
+    /// The line ends with a lone backslash.
+    TrailingBackslash,
+}
+
+impl fmt::Display for SplitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Empty => write!(f, "the firmware command line is empty"),
+            Self::UnterminatedQuote(q) => {
+                write!(f, "unterminated {q} quote in the firmware command line")
+            }
+            Self::TrailingBackslash => {
+                write!(f, "the firmware command line ends with a lone backslash")
+            }
+        }
+    }
+}
+
+impl std::error::Error for SplitError {}
+
+/// Splits a command line into words the way a POSIX shell does, without expanding anything:
+/// blanks separate words; `'…'` is literal; inside `"…"` a backslash escapes only `\`, `"`,
+/// `$` and `` ` ``; elsewhere a backslash escapes the next character. `$VAR`, `~`, globs and
+/// operators (`|`, `;`, `>`…) are ordinary characters: for those, run `sh -c '…'`.
+///
+/// ```
+/// use hilsim_hil::firmware::split_command_line;
+/// assert_eq!(
+///     split_command_line(r#"fw --name 'my robot' "a \"b\"" c\ d ''"#).unwrap(),
+///     ["fw", "--name", "my robot", "a \"b\"", "c d", ""]
+/// );
+/// assert!(split_command_line("fw 'oops").is_err());
+/// ```
+///
+/// # Errors
+/// An empty line, an unterminated quote or a trailing backslash.
+pub fn split_command_line(line: &str) -> Result<Vec<String>, SplitError> {
+    let mut words = Vec::new();
+    let mut word: Option<String> = None;
+    let mut chars = line.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            c if c.is_whitespace() => {
+                if let Some(w) = word.take() {
+                    words.push(w);
+                }
+            }
+            '\'' => {
+                let w = word.get_or_insert_with(String::new);
+                loop {
+                    match chars.next() {
+                        Some('\'') => break,
+                        Some(c) => w.push(c),
+                        None => return Err(SplitError::UnterminatedQuote('\'')),
+                    }
+                }
+            }
+            '"' => {
+                let w = word.get_or_insert_with(String::new);
+                loop {
+                    match chars.next() {
+                        Some('"') => break,
+                        Some('\\') => match chars.next() {
+                            Some(e @ ('\\' | '"' | '$' | '`')) => w.push(e),
+                            Some(other) => {
+                                w.push('\\');
+                                w.push(other);
+                            }
+                            None => return Err(SplitError::UnterminatedQuote('"')),
+                        },
+                        Some(c) => w.push(c),
+                        None => return Err(SplitError::UnterminatedQuote('"')),
+                    }
+                }
+            }
+            '\\' => match chars.next() {
+                Some(e) => word.get_or_insert_with(String::new).push(e),
+                None => return Err(SplitError::TrailingBackslash),
+            },
+            c => word.get_or_insert_with(String::new).push(c),
+        }
+    }
+    words.extend(word);
+    if words.is_empty() {
+        return Err(SplitError::Empty);
+    }
+    Ok(words)
+}
+
+/// How the firmware ended once the run was over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ended {
+    /// It exited by itself (during the run, or when its ports closed).
+    ByItself,
+    /// It left on `SIGTERM`.
+    Terminated,
+    /// It ignored `SIGTERM` for [`TERM_GRACE`] and was killed.
+    Killed,
+}
+
+/// The firmware's exit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FirmwareExit {
+    /// Its exit status.
+    pub status: ExitStatus,
+    /// How it came to exit.
+    pub ended: Ended,
+}
+
+/// An exit status in words: `exit status 3`, `signal 11 (SIGSEGV)`.
+#[must_use]
+pub fn describe_status(status: ExitStatus) -> String {
+    match (status.code(), status.signal()) {
+        (Some(code), _) => format!("exit status {code}"),
+        (None, Some(sig)) => match Signal::try_from(sig) {
+            Ok(signal) => format!("signal {sig} ({})", signal.as_str()),
+            Err(_) => format!("signal {sig}"),
+        },
+        (None, None) => status.to_string(),
+    }
+}
+
+/// The last lines of the firmware's stderr.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct StderrTail {
+    /// The last [`STDERR_TAIL_LINES`] lines, oldest first.
+    pub lines: Vec<String>,
+    /// Lines written in all.
+    pub total: u64,
+}
+
+#[derive(Debug, Default)]
+struct TailState {
+    lines: VecDeque<String>,
+    total: u64,
+    closed: bool,
+}
+
+#[derive(Debug, Default)]
+struct Tail {
+    state: Mutex<TailState>,
+    closed: Condvar,
+}
+
+/// A running firmware.
+#[derive(Debug)]
+pub struct Firmware {
+    child: Child,
+    pgid: Pid,
+    status: Option<ExitStatus>,
+    tail: Arc<Tail>,
+}
+
+impl Firmware {
+    /// Starts `argv` (the program, then its arguments) with `env` added to the environment,
+    /// stdin from `/dev/null`, stdout inherited and stderr captured, as the leader of a new
+    /// process group.
+    ///
+    /// # Errors
+    /// `argv` is empty, or the program cannot be started.
+    pub fn spawn(argv: &[String], env: &[(&str, &str)]) -> io::Result<Self> {
+        let (program, args) = argv
+            .split_first()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, SplitError::Empty))?;
+        let mut child = Command::new(program)
+            .args(args)
+            .envs(env.iter().copied())
+            .stdin(Stdio::null())
+            .stderr(Stdio::piped())
+            .process_group(0)
+            .spawn()?;
+        let pgid = Pid::from_raw(i32::try_from(child.id()).unwrap_or(i32::MAX));
+        let tail = Arc::new(Tail::default());
+        if let Some(stderr) = child.stderr.take() {
+            let tail = Arc::clone(&tail);
+            // Detached: a grandchild that escaped the group could keep the pipe open forever.
+            let spawned = thread::Builder::new()
+                .name("firmware-stderr".into())
+                .spawn(move || collect_stderr(stderr, &tail));
+            if let Err(err) = spawned {
+                let _ = killpg(pgid, Signal::SIGKILL);
+                let _ = child.wait();
+                return Err(err);
+            }
+        }
+        Ok(Self {
+            child,
+            pgid,
+            status: None,
+            tail,
+        })
+    }
+
+    /// The firmware's process id (also its process group id).
+    #[must_use]
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// The exit status, once the firmware has exited (it is then reaped).
+    ///
+    /// # Errors
+    /// The child cannot be waited for.
+    pub fn try_exit(&mut self) -> io::Result<Option<ExitStatus>> {
+        if self.status.is_none() {
+            self.status = self.child.try_wait()?;
+        }
+        Ok(self.status)
+    }
+
+    /// Ends the firmware after the run: waits up to `grace` for it to leave by itself (its ports
+    /// have closed), then sends its group `SIGTERM`, then after [`TERM_GRACE`] `SIGKILL`. What
+    /// is left of the group afterwards is killed too.
+    ///
+    /// # Errors
+    /// The child cannot be waited for or signalled.
+    pub fn shut_down(&mut self, grace: Duration) -> io::Result<FirmwareExit> {
+        let exit = if let Some(status) = self.wait_for(grace)? {
+            FirmwareExit {
+                status,
+                ended: Ended::ByItself,
+            }
+        } else {
+            signal_group(self.pgid, Signal::SIGTERM)?;
+            if let Some(status) = self.wait_for(TERM_GRACE)? {
+                FirmwareExit {
+                    status,
+                    ended: Ended::Terminated,
+                }
+            } else {
+                signal_group(self.pgid, Signal::SIGKILL)?;
+                let status = self.child.wait()?;
+                self.status = Some(status);
+                FirmwareExit {
+                    status,
+                    ended: Ended::Killed,
+                }
+            }
+        };
+        // Whatever the leader left running in its group goes too.
+        signal_group(self.pgid, Signal::SIGKILL)?;
+        self.wait_for_stderr(Duration::from_millis(500));
+        Ok(exit)
+    }
+
+    /// The last lines of stderr so far.
+    #[must_use]
+    pub fn stderr_tail(&self) -> StderrTail {
+        let state = self
+            .tail
+            .state
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        StderrTail {
+            lines: state.lines.iter().cloned().collect(),
+            total: state.total,
+        }
+    }
+
+    /// Waits up to `limit` for the child to exit.
+    fn wait_for(&mut self, limit: Duration) -> io::Result<Option<ExitStatus>> {
+        let deadline = Instant::now() + limit;
+        loop {
+            if let Some(status) = self.try_exit()? {
+                return Ok(Some(status));
+            }
+            if Instant::now() >= deadline {
+                return Ok(None);
+            }
+            thread::sleep(POLL);
+        }
+    }
+
+    /// Waits up to `limit` for every writer of the stderr pipe to close it.
+    fn wait_for_stderr(&self, limit: Duration) {
+        let state = self
+            .tail
+            .state
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        let _ = self
+            .tail
+            .closed
+            .wait_timeout_while(state, limit, |s| !s.closed);
+    }
+}
+
+impl Drop for Firmware {
+    fn drop(&mut self) {
+        // Every path out of the harness comes through here: nothing of the firmware survives.
+        let _ = killpg(self.pgid, Signal::SIGKILL);
+        if self.status.is_none() {
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// Signals the group; a group that is already gone is not an error.
+fn signal_group(pgid: Pid, signal: Signal) -> io::Result<()> {
+    match killpg(pgid, signal) {
+        Ok(()) | Err(nix::errno::Errno::ESRCH) => Ok(()),
+        Err(err) => Err(io::Error::from(err)),
+    }
+}
+
+/// Reads stderr to its end, keeping the last lines.
+fn collect_stderr(stderr: ChildStderr, tail: &Tail) {
+    let mut reader = BufReader::new(stderr);
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        match reader.read_until(b'\n', &mut line) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {
+                let text = String::from_utf8_lossy(&line);
+                let text = text.trim_end_matches(['\n', '\r']);
+                let kept: String = text.chars().take(STDERR_LINE_CHARS).collect();
+                let mut state = tail.state.lock().unwrap_or_else(PoisonError::into_inner);
+                state.total += 1;
+                if state.lines.len() == STDERR_TAIL_LINES {
+                    state.lines.pop_front();
+                }
+                state.lines.push_back(kept);
+            }
+        }
+    }
+    // The pipe is closed before anyone is told it is.
+    drop(reader);
+    tail.state
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .closed = true;
+    tail.closed.notify_all();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(line: &str) -> Vec<String> {
+        split_command_line(line).unwrap()
+    }
+
+    #[test]
+    fn splits_like_a_shell_without_expanding() {
+        assert_eq!(words("  fw   a\tb \n c "), ["fw", "a", "b", "c"]);
+        assert_eq!(
+            words("sh -c 'echo $HOME; exit 3'"),
+            ["sh", "-c", "echo $HOME; exit 3"]
+        );
+        assert_eq!(
+            words(r#""x\$y\\z\n" it's"#.replace("it's", "'it'\\''s'").as_str()),
+            [r"x$y\z\n", "it's"]
+        );
+        assert_eq!(words(r"a\ b\'c"), ["a b'c"]);
+        assert_eq!(words(r#"pre"mid"'post'"#), ["premidpost"]);
+        assert_eq!(words(r#"'' """#), ["", ""]);
+        assert_eq!(words("fw >out | x"), ["fw", ">out", "|", "x"]);
+    }
+
+    #[test]
+    fn refuses_what_a_shell_would_refuse() {
+        assert_eq!(split_command_line(""), Err(SplitError::Empty));
+        assert_eq!(split_command_line("   "), Err(SplitError::Empty));
+        assert_eq!(
+            split_command_line("fw 'a"),
+            Err(SplitError::UnterminatedQuote('\''))
+        );
+        assert_eq!(
+            split_command_line("fw \"a"),
+            Err(SplitError::UnterminatedQuote('"'))
+        );
+        assert_eq!(
+            split_command_line("fw \"a\\"),
+            Err(SplitError::UnterminatedQuote('"'))
+        );
+        assert_eq!(
+            split_command_line("fw a\\"),
+            Err(SplitError::TrailingBackslash)
+        );
+    }
+
+    fn sh(script: &str) -> Firmware {
+        Firmware::spawn(
+            &["sh".into(), "-c".into(), script.into()],
+            &[("HILSIM_TEST", "42")],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn keeps_the_last_stderr_lines_and_reports_the_exit() {
+        let mut fw = sh("i=0; while [ $i -lt 30 ]; do echo \"line $i $HILSIM_TEST\" >&2; i=$((i+1)); done; exit 3");
+        let exit = fw.shut_down(Duration::from_secs(5)).unwrap();
+        assert_eq!(exit.ended, Ended::ByItself);
+        assert_eq!(exit.status.code(), Some(3));
+        assert_eq!(describe_status(exit.status), "exit status 3");
+        let tail = fw.stderr_tail();
+        assert_eq!(tail.total, 30);
+        assert_eq!(tail.lines.len(), STDERR_TAIL_LINES);
+        assert_eq!(tail.lines[0], "line 10 42");
+        assert_eq!(tail.lines[19], "line 29 42");
+    }
+
+    #[test]
+    fn a_firmware_that_ignores_its_ports_is_terminated_and_its_group_goes_with_it() {
+        let mut fw = sh("sleep 30 & echo $! >&2; wait");
+        let pid = fw.pid();
+        // The background sleep's pid arrives on stderr.
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while fw.stderr_tail().lines.is_empty() {
+            assert!(Instant::now() < deadline);
+            thread::sleep(POLL);
+        }
+        let grandchild: i32 = fw.stderr_tail().lines[0].parse().unwrap();
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::Terminated);
+        assert_eq!(describe_status(exit.status), "signal 15 (SIGTERM)");
+        assert!(gone(pid as i32) && gone(grandchild), "{pid} {grandchild}");
+    }
+
+    #[test]
+    fn dropping_a_firmware_kills_its_whole_group() {
+        let fw = sh("sleep 30 & echo $! >&2; trap '' TERM; wait");
+        let pid = fw.pid() as i32;
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while fw.stderr_tail().lines.is_empty() {
+            assert!(Instant::now() < deadline);
+            thread::sleep(POLL);
+        }
+        let grandchild: i32 = fw.stderr_tail().lines[0].parse().unwrap();
+        drop(fw);
+        assert!(gone(pid) && gone(grandchild), "{pid} {grandchild}");
+    }
+
+    #[test]
+    fn a_program_that_does_not_exist_is_an_error() {
+        let err = Firmware::spawn(&["/nonexistent/firmware".into()], &[]).unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::NotFound);
+        assert!(Firmware::spawn(&[], &[]).is_err());
+    }
+
+    /// The process no longer runs (gone, or a zombie waiting for init to reap it).
+    fn gone(pid: i32) -> bool {
+        let deadline = Instant::now() + Duration::from_secs(2);
+        loop {
+            match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+                Err(_) => return true,
+                Ok(stat)
+                    if stat
+                        .rsplit(')')
+                        .next()
+                        .is_some_and(|s| s.trim_start().starts_with('Z')) =>
+                {
+                    return true
+                }
+                Ok(_) if Instant::now() > deadline => return false,
+                Ok(_) => thread::sleep(POLL),
+            }
+        }
+    }
+}

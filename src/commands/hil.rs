@@ -1,0 +1,226 @@
+//! `hilsim hil SCENARIO --firmware 'CMD ARGS…' [--out DIR] [--duration S] [--watchdog S]
+//! [--seed N]`: firmware in the loop.
+//!
+//! Exit codes: 0 the run ended on time or the firmware exited with status 0; 1 a firmware fault
+//! (crash, hang, flood, lidar never read) or an interrupted run; 2 bad input, or the harness
+//! itself failed.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{anyhow, bail, Context, Result};
+use hilsim_hil::firmware::{describe_status, split_command_line, Ended, Firmware};
+use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilReport, HilWorld};
+use hilsim_sim::Scenario;
+
+/// The longest run or watchdog accepted, seconds (a day: anything longer is a typo).
+const MAX_SECONDS: f64 = 86_400.0;
+
+#[derive(Debug, clap::Args)]
+pub struct HilArgs {
+    /// Scenario file; its drive program is not run (the firmware drives).
+    pub scenario: PathBuf,
+    /// The firmware's command line, split into words as a shell would (no shell runs): it gets
+    /// HILSIM_LIDAR_PORT and HILSIM_ROBOT_PORT in its environment.
+    #[arg(long, value_name = "'CMD ARGS…'")]
+    pub firmware: String,
+    /// Write the run as a recording (truth included) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// The run's length in seconds, overriding the scenario's `duration_s`.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Seconds the firmware may go without a request (or, at the start, without reading the
+    /// lidar) before it counts as hung.
+    #[arg(long, value_name = "S", default_value_t = 5.0)]
+    pub watchdog: f64,
+    /// Seed of every random stream (default: the scenario's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+}
+
+fn seconds(flag: &str, value: f64) -> Result<Duration> {
+    if !(value.is_finite() && value > 0.0 && value <= MAX_SECONDS) {
+        bail!("{flag} must be a number of seconds in (0, {MAX_SECONDS}], got {value}");
+    }
+    Ok(Duration::from_secs_f64(value))
+}
+
+pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
+    // Everything is checked before a port is opened or the firmware started.
+    if let Some(d) = args.duration {
+        seconds("--duration", d)?;
+    }
+    let watchdog = seconds("--watchdog", args.watchdog)?;
+    let argv = split_command_line(&args.firmware).map_err(|e| anyhow!("--firmware: {e}"))?;
+    let origin = args.scenario.display().to_string();
+    let mut scenario = Scenario::load_with_duration(&args.scenario, args.duration)?;
+    if let Some(seed) = args.seed {
+        scenario.seed = seed;
+    }
+    let duration_s = scenario.duration_s.ok_or_else(|| {
+        anyhow!("{origin}: under `hil` the firmware drives: set `duration_s` or pass --duration")
+    })?;
+    let duration = seconds("duration_s", duration_s).with_context(|| origin.clone())?;
+    if let Some(dir) = &args.out {
+        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+        if parent.is_some_and(|p| !p.is_dir()) {
+            bail!("{}: the parent directory does not exist", dir.display());
+        }
+    }
+    let world = HilWorld::new(&scenario, scenario.seed)
+        .with_context(|| format!("{origin}: sensor model"))?;
+    let config = HilConfig {
+        watchdog,
+        ..HilConfig::new(duration)
+    };
+
+    // Ctrl-C must reach the harness, which then shuts the firmware down: the firmware is in a
+    // process group of its own, out of the terminal's reach.
+    let stop = Arc::new(AtomicBool::new(false));
+    hil_run::stop_on_signals(Arc::clone(&stop)).context("cannot set up signal handling")?;
+    let ports = HilPorts::open().context("cannot create the pseudo-terminals")?;
+    writeln!(out, "lidar: {}", ports.lidar_path())?;
+    writeln!(out, "robot: {}", ports.robot_path())?;
+    out.flush()?;
+    let env = [
+        ("HILSIM_LIDAR_PORT", ports.lidar_path()),
+        ("HILSIM_ROBOT_PORT", ports.robot_path()),
+    ];
+    let firmware = Firmware::spawn(&argv, &env)
+        .with_context(|| format!("--firmware: cannot start `{}`", argv[0]))?;
+    writeln!(
+        out,
+        "firmware: pid {} `{}`; {} ({}) for {:.1} s in real time",
+        firmware.pid(),
+        args.firmware,
+        scenario.name,
+        origin,
+        duration.as_secs_f64()
+    )?;
+    out.flush()?;
+    let report = hil_run::run(world, ports, Some(firmware), &config, &stop)
+        .context("firmware in the loop")?;
+    summarise(&report, out)?;
+    if let Some(dir) = &args.out {
+        report.run.recording.write_dir(dir)?;
+        writeln!(out, "wrote {}", dir.display())?;
+    }
+    Ok(match report.ending {
+        Ending::TimeUp | Ending::FirmwareExited => ExitCode::SUCCESS,
+        Ending::Fault(_) | Ending::Stopped => ExitCode::from(1),
+    })
+}
+
+fn summarise(report: &HilReport, out: &mut dyn Write) -> Result<()> {
+    let at = report.ended_at_s;
+    match &report.ending {
+        Ending::TimeUp => writeln!(out, "ended: the run's time was up at {at:.2} s")?,
+        Ending::FirmwareExited => {
+            writeln!(out, "ended: the firmware exited with status 0 at {at:.2} s")?
+        }
+        Ending::Fault(fault) => writeln!(out, "FAULT at {at:.2} s: {fault}")?,
+        Ending::Stopped => writeln!(out, "interrupted at {at:.2} s: the run did not finish")?,
+    }
+    let rec = &report.run.recording;
+    if let Some(truth) = &rec.truth {
+        if let (Some(first), Some(last)) = (truth.first(), truth.last()) {
+            let path: f64 = truth
+                .windows(2)
+                .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
+                .sum();
+            writeln!(
+                out,
+                "robot: drove {path:.3} m in {:.2} s simulated, from ({:.3}, {:.3}) to ({:.3}, {:.3}) \
+                 heading {:.1}°; {} collision(s)",
+                report.simulated_s,
+                first.x_m,
+                first.y_m,
+                last.x_m,
+                last.y_m,
+                last.yaw_rad.to_degrees(),
+                report.run.collisions.len()
+            )?;
+        }
+    }
+    for c in &report.run.collisions {
+        writeln!(
+            out,
+            "  collision at t = {:.2} s with {:?}",
+            c.t_s, c.obstacle
+        )?;
+    }
+    let c = &report.commands;
+    writeln!(
+        out,
+        "requests: {} (TestMode {}, SetMotor {}, GetMotors {}, GetLDSScan {}, GetSonar {}), \
+         {} error(s), {} bytes",
+        c.requests,
+        c.test_mode,
+        c.set_motor,
+        c.get_motors,
+        c.get_lds_scan,
+        c.get_sonar,
+        c.errors,
+        c.bytes
+    )?;
+    for error in &c.first_errors {
+        writeln!(out, "  error: {error}")?;
+    }
+    if report.replies_dropped > 0 {
+        writeln!(
+            out,
+            "  {} replies dropped: the firmware did not read the robot port",
+            report.replies_dropped
+        )?;
+    }
+    if let Some(read) = report.lidar_bytes_read {
+        let s = &report.stream;
+        write!(
+            out,
+            "lidar: {} revolutions sent, {} dropped; the firmware read {read} of {} bytes",
+            s.revolutions_sent, s.revolutions_dropped, s.bytes_written
+        )?;
+        if let (Some(p50), Some(p99)) = (s.lateness_quantile(0.5), s.lateness_quantile(0.99)) {
+            write!(
+                out,
+                "; packet lateness median {:.1} ms, p99 {:.1} ms",
+                p50.as_secs_f64() * 1e3,
+                p99.as_secs_f64() * 1e3
+            )?;
+        }
+        writeln!(out)?;
+    }
+    writeln!(
+        out,
+        "real time: physics steps computed at most {:.1} ms late",
+        report.max_step_lateness.as_secs_f64() * 1e3
+    )?;
+    let mut failed = report.fault().is_some();
+    if let Some(exit) = report.firmware {
+        let how = match exit.ended {
+            Ended::ByItself => "exited by itself",
+            Ended::Terminated => "left on SIGTERM once the run was over",
+            Ended::Killed => "ignored SIGTERM and was killed",
+        };
+        writeln!(out, "firmware: {how}: {}", describe_status(exit.status))?;
+        failed |= exit.ended == Ended::ByItself && !exit.status.success();
+    }
+    let tail = &report.stderr;
+    if failed && !tail.lines.is_empty() {
+        writeln!(
+            out,
+            "firmware stderr (last {} of {} lines):",
+            tail.lines.len(),
+            tail.total
+        )?;
+        for line in &tail.lines {
+            writeln!(out, "  | {line}")?;
+        }
+    }
+    Ok(())
+}

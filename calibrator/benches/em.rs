@@ -18,8 +18,12 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
 use hilsim_calibrator::em::{self, EStep, EmOptions};
-use hilsim_calibrator::smoothing;
+use hilsim_calibrator::kalman_smoother::{
+    Gaussian, Observation, Observations, RtsSmoother, StateSpaceModel, Transition,
+};
 use hilsim_calibrator::target_samples::{self, SampleOptions, TargetSamples};
+use hilsim_calibrator::{smoothing, Calibration, Sensor};
+use nalgebra::{Matrix2, Vector2};
 use nalgebra::{Matrix3, Vector3};
 
 /// Samples of the benchmark recording (the brief's "10⁴-sample recording").
@@ -188,9 +192,140 @@ fn summary(rec: &hilsim_recording::Recording, s: &TargetSamples) {
     }
 }
 
+/// The E-step's lidar-only model at trained parameters, written out step by step, so that the
+/// same model can be handed to pykalman (`benches/pykalman/compare.py`).
+struct ExplicitModel {
+    prior: Gaussian<2>,
+    transitions: Vec<Transition<2>>,
+    observations: Vec<Option<Observation<2>>>,
+}
+
+impl StateSpaceModel<2> for ExplicitModel {
+    fn steps(&self) -> usize {
+        self.observations.len()
+    }
+    fn prior(&self) -> Gaussian<2> {
+        self.prior
+    }
+    fn transition(&self, k: usize) -> Transition<2> {
+        self.transitions[k]
+    }
+    fn observations(&self, k: usize, out: &mut Observations<2>) {
+        if let Some(o) = self.observations[k] {
+            out.push(o);
+        }
+    }
+}
+
+/// As the EM model (`em/model.rs`): `[d, d²]`, `A = [[1, 0], [2u, 1]]`, the process noise of a
+/// speed-scale error q = 0.02 plus the 0.1 mm floor, `R = (β2 d²)²` at dead reckoning.
+fn explicit_model(s: &TargetSamples, trained: &Calibration) -> ExplicitModel {
+    let lidar = &trained.sensors[&Sensor::Lidar];
+    let (a, b2) = (&lidar.alpha, lidar.beta[2]);
+    let d0 = s.start_distance_m.expect("start");
+    let (q, f) = (0.02, 1e-4);
+    let noise = |u: f64, m: f64| {
+        let s2 = (q * u) * (q * u);
+        let f2 = f * f;
+        Matrix2::new(
+            s2 + f2,
+            2.0 * m * s2,
+            2.0 * m * s2,
+            4.0 * m * m * s2 + 2.0 * s2 * s2 + 4.0 * m.max(0.1).powi(2) * f2,
+        )
+    };
+    let transitions = (0..s.len())
+        .map(|k| {
+            let u = s.u(k);
+            let m = d0 + s.commanded_m[k] + u;
+            Transition {
+                a: Matrix2::new(1.0, 0.0, 2.0 * u, 1.0),
+                b: Vector2::new(u, u * u + (q * u).powi(2)),
+                q: noise(u, m),
+            }
+        })
+        .collect();
+    let observations = (0..s.len())
+        .map(|k| {
+            s.lidar_m[k].map(|y| {
+                let d = d0 + s.commanded_m[k];
+                Observation {
+                    y,
+                    offset: a[0],
+                    h: Vector2::new(a[1], a[2]),
+                    r: (b2 * d * d).powi(2),
+                }
+            })
+        })
+        .collect();
+    let m0 = d0 + s.commanded_m[0];
+    ExplicitModel {
+        prior: Gaussian::new(Vector2::new(m0, m0 * m0), noise(0.0, m0)),
+        transitions,
+        observations,
+    }
+}
+
+/// Writes the explicit model and the Rust smoother's output and timing for
+/// `benches/pykalman/compare.py`.
+fn export_for_pykalman(dir: &std::path::Path, model: &ExplicitModel, ns_per_step: f64) {
+    use std::fmt::Write as _;
+    let mut smoother = RtsSmoother::<2>::new();
+    smoother.run(model).expect("runs");
+    let mut csv = String::from(
+        "a00,a01,a10,a11,b0,b1,q00,q01,q10,q11,y,h0,h1,offset,r,d_smoothed,d2_smoothed,var_d\n",
+    );
+    for k in 0..model.steps() {
+        let t = model.transitions[k];
+        let (y, h0, h1, off, r) = match model.observations[k] {
+            Some(o) => (o.y, o.h[0], o.h[1], o.offset, o.r),
+            None => (f64::NAN, 0.0, 0.0, 0.0, 1.0),
+        };
+        let (m, p) = (smoother.smoothed_means()[k], smoother.smoothed_covs()[k]);
+        let _ = writeln!(
+            csv,
+            "{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            t.a[(0, 0)], t.a[(0, 1)], t.a[(1, 0)], t.a[(1, 1)], t.b[0], t.b[1],
+            t.q[(0, 0)], t.q[(0, 1)], t.q[(1, 0)], t.q[(1, 1)],
+            y, h0, h1, off, r, m[0], m[1], p[(0, 0)]
+        );
+    }
+    let prior = format!(
+        "{:e},{:e},{:e},{:e},{:e},{:e}\n{ns_per_step}\n",
+        model.prior.mean[0],
+        model.prior.mean[1],
+        model.prior.cov[(0, 0)],
+        model.prior.cov[(0, 1)],
+        model.prior.cov[(1, 0)],
+        model.prior.cov[(1, 1)]
+    );
+    std::fs::create_dir_all(dir).expect("export directory");
+    std::fs::write(dir.join("model.csv"), csv).expect("writes model.csv");
+    std::fs::write(dir.join("prior_and_rust_ns.txt"), prior).expect("writes prior");
+}
+
 fn main() {
     let rec = fixtures::synthetic_recording(N, 1);
     let s = samples(&rec);
+    // `EM_BENCH_PYKALMAN_DIR=DIR cargo bench -p hilsim-calibrator --bench em -- --list` (any
+    // filter) exports the model for the pykalman comparison and times the Rust pass on it.
+    if let Some(dir) = std::env::var_os("EM_BENCH_PYKALMAN_DIR") {
+        let trained = em::calibrate(&rec, &EmOptions::default()).expect("calibrates");
+        let model = explicit_model(&s, &trained);
+        let mut smoother = RtsSmoother::<2>::new();
+        let ns = median_time(|| {
+            black_box(smoother.run(&model).expect("runs"));
+        })
+        .as_secs_f64()
+            * 1e9
+            / N as f64;
+        export_for_pykalman(dir.as_ref(), &model, ns);
+        println!(
+            "exported the model to {}; Rust RTS pass: {ns:.1} ns/step",
+            dir.to_string_lossy()
+        );
+        return;
+    }
     let mut c = Criterion::default().configure_from_args();
     {
         let mut g = c.benchmark_group("em");

@@ -7,9 +7,11 @@
 //! cargo bench -p hilsim-calibrator --bench landmarks
 //! ```
 //!
-//! Criterion reports each benchmark; a summary (wall time of 1,000 runs on 1 and 2 threads,
-//! runs per second, speed-up, and the projected time of the whole Fig. 9 grid) is measured
-//! again and printed at the end.
+//! Criterion reports each benchmark; a summary (wall and CPU time of 1,000 runs on 1 and 2
+//! threads, runs per second, speed-up, and the projected time of the whole Fig. 9 grid) is
+//! measured again and printed at the end (alone with `LANDMARKS_SUMMARY_ONLY=1`). The CPU time
+//! shows how many cores the run actually obtained: on a shared machine the wall-time speed-up
+//! is capped by the other processes, the CPU-time ratio is not.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -80,8 +82,22 @@ fn benches(c: &mut Criterion) {
     g.finish();
 }
 
-/// Median wall time of `reps` repetitions.
-fn median_time(reps: usize, mut f: impl FnMut()) -> f64 {
+/// This process's CPU time (user + system), seconds, from `/proc/self/stat` (Linux, 100 ticks
+/// per second); `None` elsewhere.
+fn cpu_time() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may hold spaces).
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// Median wall time of `reps` repetitions, and the mean CPU time of one (user + system, all
+/// threads): CPU over wall time is the number of cores actually obtained, below the thread count
+/// when other processes hold cores.
+fn median_time(reps: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
+    let c0 = cpu_time();
     let mut t: Vec<f64> = (0..reps)
         .map(|_| {
             let s = Instant::now();
@@ -89,38 +105,56 @@ fn median_time(reps: usize, mut f: impl FnMut()) -> f64 {
             s.elapsed().as_secs_f64()
         })
         .collect();
+    let cpu = c0.zip(cpu_time()).map(|(a, b)| (b - a) / reps as f64);
     t.sort_by(f64::total_cmp);
-    t[t.len() / 2]
+    (t[t.len() / 2], cpu)
 }
 
 fn summary() {
     let s = setup(true);
     let one = pool(1);
     let two = pool(2);
-    let t1 = median_time(3, || {
+    let (t1, c1) = median_time(3, || {
         one.install(|| black_box(monte_carlo(&s, RUNS, 2)));
     });
-    let t2 = median_time(3, || {
+    let (t2, c2) = median_time(3, || {
         two.install(|| black_box(monte_carlo(&s, RUNS, 2)));
     });
     let sp = setup(false);
-    let tp = median_time(3, || {
+    let (tp, _) = median_time(3, || {
         one.install(|| black_box(monte_carlo(&sp, RUNS, 2)));
     });
     let rec = landmarks5();
-    let tc = median_time(5, || {
+    let (tc, _) = median_time(5, || {
         black_box(calibrate(&rec, &Options::default()).expect("calibrates"));
     });
+    let cores = |c: Option<f64>, wall: f64| {
+        c.map_or(String::new(), |c| {
+            format!(", CPU {c:.3} s = {:.2} cores obtained", c / wall)
+        })
+    };
     println!("\nlandmarks summary (median of repetitions, this machine, this load):");
     println!(
-        "  1,000-run Monte Carlo, refined, 1 thread : {t1:7.3} s  ({:6.0} runs/s)",
-        RUNS as f64 / t1
+        "  1,000-run Monte Carlo, refined, 1 thread : {t1:7.3} s  ({:6.0} runs/s{})",
+        RUNS as f64 / t1,
+        cores(c1, t1)
     );
     println!(
-        "  1,000-run Monte Carlo, refined, 2 threads: {t2:7.3} s  ({:6.0} runs/s)",
-        RUNS as f64 / t2
+        "  1,000-run Monte Carlo, refined, 2 threads: {t2:7.3} s  ({:6.0} runs/s{})",
+        RUNS as f64 / t2,
+        cores(c2, t2)
     );
-    println!("  speed-up 2 threads over 1              : {:.2}x", t1 / t2);
+    println!("  speed-up 2 threads over 1 (wall)       : {:.2}x", t1 / t2);
+    if let (Some(a), Some(b)) = (c1, c2) {
+        // With both cores free, 2 threads would take (CPU time on 2 threads) / 2.
+        println!(
+            "  CPU-time ratio 1 thread / 2 threads    : {:.2} (parallel overhead {:+.0} %); \
+             speed-up with two free cores: {:.2}x",
+            a / b,
+            (b / a - 1.0) * 100.0,
+            2.0 * a / b
+        );
+    }
     println!(
         "  paper's estimator alone, 1 thread       : {tp:7.3} s  (refinement costs {:.1}x)",
         t1 / tp
@@ -136,6 +170,10 @@ fn summary() {
 }
 
 fn main() {
+    if std::env::var_os("LANDMARKS_SUMMARY_ONLY").is_some() {
+        summary();
+        return;
+    }
     let mut c = Criterion::default().configure_from_args();
     benches(&mut c);
     c.final_summary();

@@ -54,10 +54,11 @@ pub const MIN_LIDAR_READINGS: usize = 10;
 /// Fewest readings for the odometer or sonar to take part (same reasoning, three parameters).
 pub const MIN_AUX_READINGS: usize = 10;
 
-/// Least span of commanded distance EM accepts, metres. Separating α1 from α2 needs distinct
-/// distances: over a 5 cm span the quadratic term of the paper's lidar (α2 ≈ 0.06 /m) changes
-/// the reading by under 0.3 mm at 0.5 m (`2 α2 d Δd · Δd/2`), below the XV-11's 1 mm
-/// resolution.
+/// Least span of commanded distance EM accepts, metres: below it the robot has not really
+/// moved (5 cm is 2.5 revolutions at the paper's slowest 0.1 m/s). Separating α1 from α2 needs
+/// the bias's curvature to show: over a span Δ the quadratic term departs from a straight line
+/// by `α2 Δ²/4`, 0.04 mm here for the paper's α2 ≈ 0.06 /m, far below the XV-11's 1 mm
+/// resolution, and the normal equations are numerically singular.
 pub const MIN_SPAN_M: f64 = 0.05;
 
 /// How the E-step treats the state-dependent (heteroscedastic) noise.
@@ -111,7 +112,8 @@ pub struct EmOptions {
     pub use_odometer: bool,
     /// Use the sonar when the recording has one.
     pub use_sonar: bool,
-    /// Iteration cap.
+    /// Iteration cap, in E-steps (default 5000: plain EM with all three sensors needs up to
+    /// ~3,400 to reach the default tolerance; SQUAREM a few hundred at most).
     pub max_iterations: usize,
     /// Convergence: every parameter's relative change (scale floor 1e-4) and the
     /// log-likelihood's relative change below this.
@@ -120,8 +122,9 @@ pub struct EmOptions {
     pub e_step: EStep,
     /// The paper's `σ_d` (eq. 3), assumed known, expressed per metre commanded: the sd of the
     /// distance's deviation from the commanded motion over one step is `q |u_k|`. It models a
-    /// speed-scale actuation error; the default 0.02 is the ±2 % speed error of a typical
-    /// wheeled robot's open-loop drive (e.g. the simulator's `scale_sd = 0.02`).
+    /// speed-scale actuation error; the paper gives no value, so the default 0.02 is the
+    /// reproduction's simulated drive error (`scale_sd = 0.02`); with such an error the result
+    /// hardly depends on it from 0.005 to 0.05 (`docs/reproduce-em.md`, "Process-noise scale").
     pub process_noise_rel: f64,
     /// Estimate `q` in the M-step (Shumway–Stoffer, with the lag-one covariances) instead of
     /// keeping it fixed, as the paper does.

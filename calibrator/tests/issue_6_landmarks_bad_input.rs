@@ -29,12 +29,14 @@ const SPEED: f64 = 0.1;
 /// A noise-free synthetic recording: `stops` stand-still stops 0.3 m apart along x (2 s each,
 /// five 360-reading revolutions per second, the paper's mean reading f(d)), moves between them.
 fn synthetic(stops: usize, cylinders: &[Cylinder]) -> Recording {
-    let mut meta = Meta::default();
-    meta.lidar = Some(LidarMount {
-        x_m: 0.0,
-        y_m: 0.0,
-        yaw_deg: 0.0,
-    });
+    let mut meta = Meta {
+        lidar: Some(LidarMount {
+            x_m: 0.0,
+            y_m: 0.0,
+            yaw_deg: 0.0,
+        }),
+        ..Meta::default()
+    };
     meta.world.landmark_radius_m = Some(RADIUS);
     let mut rec = Recording::new(meta);
     let mut lidar = Vec::new();

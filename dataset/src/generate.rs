@@ -27,7 +27,7 @@ use crate::{Dataset, Error, Shard};
 
 /// The manifest is rewritten at most this often while runs complete (and always at the end): an
 /// interruption loses at most this much of it, and the next call rebuilds it from the run
-/// directories.
+/// directories. A large manifest is rewritten less often: at most a tenth of the time goes to it.
 const MANIFEST_INTERVAL: Duration = Duration::from_millis(500);
 
 /// How to make a dataset: how many threads, and which share of the runs.
@@ -162,6 +162,7 @@ impl Dataset {
         let mut fatal: Option<Error> = None;
         let (mut made_now, mut failed_now) = (0, 0);
         let mut last_write = Instant::now();
+        let mut write_cost = Duration::ZERO;
         let mut dirty = false;
         pool.in_place_scope(|scope| {
             for _ in 0..jobs.min(to_make.len()) {
@@ -208,7 +209,8 @@ impl Dataset {
                 };
                 rows.insert(r, self.row(r, outcome));
                 dirty = true;
-                if last_write.elapsed() >= MANIFEST_INTERVAL {
+                if last_write.elapsed() >= MANIFEST_INTERVAL.max(write_cost * 10) {
+                    let t = Instant::now();
                     match write_manifest(&rows) {
                         Ok(()) => dirty = false,
                         Err(err) => {
@@ -216,6 +218,7 @@ impl Dataset {
                             fatal.get_or_insert(err);
                         }
                     }
+                    write_cost = t.elapsed();
                     last_write = Instant::now();
                 }
                 progress.run_finished(&report);

@@ -32,17 +32,24 @@ pub struct RunReport {
 /// Receives progress. Called on the thread that called `generate`, never concurrently.
 ///
 /// ```
-/// use hilsim_dataset::{Plan, Progress, RunReport};
-/// #[derive(Default)]
-/// struct Count(u64);
-/// impl Progress for Count {
-///     fn run_finished(&mut self, _run: &RunReport) {
-///         self.0 += 1;
+/// use hilsim_dataset::{Progress, RunReport};
+/// /// Collects the runs that failed.
+/// struct Failures(Vec<u64>);
+/// impl Progress for Failures {
+///     fn run_finished(&mut self, run: &RunReport) {
+///         if run.failure.is_some() {
+///             self.0.push(run.run);
+///         }
 ///     }
 /// }
-/// let mut count = Count::default();
-/// count.planned(&Plan { share: 1, skipped: 0, to_make: 1, jobs: 1 });
-/// # let _ = &mut count;
+/// let mut failures = Failures(Vec::new());
+/// failures.run_finished(&RunReport {
+///     run: 3,
+///     seed: 1,
+///     failure: Some("robot.start: inside cylinder 0".into()),
+///     elapsed: std::time::Duration::ZERO,
+/// });
+/// assert_eq!(failures.0, [3]);
 /// ```
 pub trait Progress {
     /// Once, after the directory was checked and scanned, before any run is made.

@@ -52,8 +52,8 @@ use crate::motion::{MotionController, MotorRequest};
 use crate::pty::PtyLink;
 use crate::streamer::{Pacing, StreamStats, Streamer};
 
-/// How long a firmware may go without a request (and, at the start, without reading the
-/// lidar) before it counts as hung.
+/// How long a firmware may go without a request before it counts as hung; also the time it has
+/// to start reading the lidar.
 pub const DEFAULT_WATCHDOG: Duration = Duration::from_secs(5);
 /// How long the firmware has to exit by itself once its ports have closed.
 pub const DEFAULT_FIRMWARE_GRACE: Duration = Duration::from_secs(1);
@@ -711,8 +711,11 @@ impl<'c> Session<'c> {
         Ok(())
     }
 
-    /// The bytes of the lidar stream the firmware took so far.
+    /// The bytes of the lidar stream the firmware took so far. The pty moves what was just
+    /// written to the client side a moment later (a kernel worker does it), and a packet in
+    /// flight is not in the backlog yet: give it a millisecond. Once per run, and at the end.
     fn lidar_bytes_read(&mut self) -> io::Result<u64> {
+        thread::sleep(Duration::from_millis(1));
         let backlog = self.streamer.link().backlog()? as u64;
         let stats = self.streamer.stats();
         Ok(stats

@@ -2,7 +2,7 @@
 //! firmware) drives the simulated robot with `SetMotor` and reads its encoders, sonar and
 //! lidar through the command port, in real time, while the lidar streams on the other port.
 
-use std::io::{ErrorKind, Read, Write};
+use std::io::{ErrorKind, Read};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::thread;

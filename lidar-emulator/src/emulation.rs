@@ -82,9 +82,23 @@ impl Emulation {
         sim: Simulation,
     ) -> Result<Self, ModelError> {
         let s = &scenario.sensors;
-        let lidar = s.lidar.as_ref().map(|c| Lidar::new(c, seed)).transpose()?;
-        let sonar = s.sonar.as_ref().map(|c| Sonar::new(c, seed)).transpose()?;
-        let odometer = s.odometer.as_ref().map(|c| Odometer::new(c, seed));
+        // The scenario's `[effects]` (all off by default) reach every sensor; motor lag is the
+        // simulation's.
+        let e = &scenario.effects;
+        let lidar = s
+            .lidar
+            .as_ref()
+            .map(|c| Lidar::with_effects(c, e, seed))
+            .transpose()?;
+        let sonar = s
+            .sonar
+            .as_ref()
+            .map(|c| Sonar::with_effects(c, e, seed))
+            .transpose()?;
+        let odometer = s
+            .odometer
+            .as_ref()
+            .map(|c| Odometer::with_effects(c, e, seed));
         let meta = meta(scenario, seed, &sim, lidar.as_ref());
         Ok(Self {
             scenario_name: scenario.name.clone(),

@@ -3,6 +3,7 @@
 //! ([`Emulation`]), and the Neato XV-11 serial packet codec.
 #![warn(missing_docs)]
 
+pub mod effects;
 mod emulation;
 pub mod lidar;
 mod mount;

@@ -7,6 +7,7 @@ use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
+use crate::effects::LidarEffects;
 use crate::mount::Mount;
 use crate::range_model::{ModelError, RangeModel};
 
@@ -99,6 +100,12 @@ pub struct Lidar {
     index: u16,
     rev_start_s: f64,
     rev_rpm: f64,
+    effects: LidarEffects,
+    /// `timing = "per_revolution"` without `[effects.lidar_motion_skew]`: every reading of a
+    /// revolution from the lidar's pose at the revolution's start.
+    snapshot: bool,
+    /// The lidar's origin and 0° direction at the current revolution's start (snapshot only).
+    rev_pose: Option<([f64; 2], f64)>,
 }
 
 impl Lidar {
@@ -107,6 +114,21 @@ impl Lidar {
     /// # Errors
     /// A range model that makes no sense.
     pub fn new(config: &scenario::Lidar, seed: u64) -> Result<Self, ModelError> {
+        Self::with_effects(config, &scenario::Effects::default(), seed)
+    }
+
+    /// The lidar of a scenario with the scenario's `[effects]` that concern it (incidence angle,
+    /// reflectivity, mixed pixels, motion skew, warm-up drift), drawing from the run's `lidar`
+    /// stream. The effects draw no random numbers: with all of them off the readings are those
+    /// of [`Lidar::new`], bit for bit.
+    ///
+    /// # Errors
+    /// A range model that makes no sense.
+    pub fn with_effects(
+        config: &scenario::Lidar,
+        effects: &scenario::Effects,
+        seed: u64,
+    ) -> Result<Self, ModelError> {
         let model = RangeModel::builder()
             .bias(&config.bias)
             .noise(&config.noise)
@@ -126,6 +148,10 @@ impl Lidar {
             index: 0,
             rev_start_s: 0.0,
             rev_rpm: 0.0,
+            effects: LidarEffects::from_scenario(effects),
+            snapshot: config.timing == scenario::LidarTiming::PerRevolution
+                && effects.lidar_motion_skew.is_none(),
+            rev_pose: None,
         };
         lidar.rev_rpm = lidar.rpm_of_revolution(0);
         Ok(lidar)
@@ -141,6 +167,26 @@ impl Lidar {
     #[must_use]
     pub fn mount(&self) -> Mount {
         self.mount
+    }
+
+    /// The effects switched on.
+    #[must_use]
+    pub fn effects(&self) -> &LidarEffects {
+        &self.effects
+    }
+
+    /// Whether every reading of a revolution is taken from the pose at the revolution's start
+    /// (`timing = "per_revolution"` without motion skew).
+    #[must_use]
+    pub fn is_snapshot(&self) -> bool {
+        self.snapshot
+    }
+
+    /// How far a beam is cast: past the maximum range, so that a far target is seen as "beyond
+    /// range" rather than "nothing".
+    #[must_use]
+    pub fn cast_limit_m(&self) -> f64 {
+        (self.max_mm / 1000.0 * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0)
     }
 
     /// The motor speed during revolution `rev`, as the packets report it: quantised to the
@@ -162,7 +208,15 @@ impl Lidar {
                 return;
             }
             if t >= step.t0 {
-                let (origin, yaw) = track.at(t);
+                let (origin, yaw) = if self.snapshot {
+                    // The whole revolution from the pose at its start.
+                    if self.index == 0 || self.rev_pose.is_none() {
+                        self.rev_pose = Some(track.at(t));
+                    }
+                    self.rev_pose.unwrap_or_else(|| track.at(t))
+                } else {
+                    track.at(t)
+                };
                 out.push(self.read(world, origin, yaw, t));
             }
             self.index += 1;
@@ -180,8 +234,7 @@ impl Lidar {
     fn read(&mut self, world: &World, origin: [f64; 2], yaw: f64, t: f64) -> LidarReading {
         let angle_noise: f64 = StandardNormal.sample(&mut self.rng);
         let beam = yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
-        // Cast past the maximum so that a far target is seen as "beyond range", not "nothing".
-        let cast_limit = (self.max_mm / 1000.0 * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0);
+        let cast_limit = self.cast_limit_m();
         let mut reading = LidarReading {
             t_s: t,
             rev: self.rev,
@@ -192,15 +245,17 @@ impl Lidar {
             warning: false,
             true_range_m: None,
         };
-        let Some(hit) = world.cast_ray(origin, beam, cast_limit) else {
+        let Some(ret) = self.effects.beam_return(world, origin, beam, cast_limit) else {
             return reading;
         };
+        let hit = ret.hit;
         let d = hit.distance;
         reading.true_range_m = Some(d);
-        let measured_mm = (self.model.sample(d, &mut self.rng) * 1000.0).round();
+        // The range model sees the distance the unit ranges: the true one unless an effect is on.
+        let ranged = self.effects.ranged_m(&ret, t);
+        let measured_mm = (self.model.sample(ranged, &mut self.rng) * 1000.0).round();
         // Diffuse return: proportional to reflectivity and to the cosine of the incidence.
-        let (sin, cos) = beam.sin_cos();
-        let cos_incidence = (hit.normal[0] * cos + hit.normal[1] * sin).abs();
+        let cos_incidence = ret.cos_incidence;
         let speckle: f64 = StandardNormal.sample(&mut self.rng);
         let strength = STRENGTH_AT_1M
             * (hit.reflectivity / REFERENCE_REFLECTIVITY)

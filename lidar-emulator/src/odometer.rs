@@ -3,6 +3,8 @@
 
 use hilsim_recording::OdometrySample;
 use hilsim_sim::{rng, scenario, StepState};
+
+use crate::effects::slip_travel_m;
 use rand_distr::{Distribution, StandardNormal};
 
 /// The emulated encoders.
@@ -13,12 +15,26 @@ pub struct Odometer {
     period_s: f64,
     rng: rng::Rng,
     next: u64,
+    /// `[effects.odometer_wheel_slip]`: slip velocity per unit of acceleration, seconds.
+    slip_gain_s: Option<f64>,
 }
 
 impl Odometer {
     /// The odometer of a scenario, drawing from the run's `odometer` stream.
     #[must_use]
     pub fn new(config: &scenario::Odometer, seed: u64) -> Self {
+        Self::with_effects(config, &scenario::Effects::default(), seed)
+    }
+
+    /// The odometer of a scenario with `[effects.odometer_wheel_slip]` when switched on: each
+    /// wheel's encoder leads its true travel by `gain_s · v`, v the wheel's speed during the
+    /// physics step (see `effects`).
+    #[must_use]
+    pub fn with_effects(
+        config: &scenario::Odometer,
+        effects: &scenario::Effects,
+        seed: u64,
+    ) -> Self {
         Self {
             scale: 1.0 + config.slip,
             noise_m: config.noise_m,
@@ -26,6 +42,7 @@ impl Odometer {
             period_s: 1.0 / config.rate_hz,
             rng: rng::stream(seed, "odometer"),
             next: 0,
+            slip_gain_s: effects.odometer_wheel_slip.map(|e| e.gain_s),
         }
     }
 
@@ -47,7 +64,13 @@ impl Odometer {
             if t < step.t0 {
                 continue;
             }
-            let [left, right] = step.wheels_at(t);
+            let [mut left, mut right] = step.wheels_at(t);
+            if let Some(gain) = self.slip_gain_s {
+                // The wheels' speeds during this step, from their true travel.
+                let dt = step.t1 - step.t0;
+                left += slip_travel_m(gain, (step.wheels1[0] - step.wheels0[0]) / dt);
+                right += slip_travel_m(gain, (step.wheels1[1] - step.wheels0[1]) / dt);
+            }
             out.push(OdometrySample {
                 t_s: t,
                 left_m: self.report(left),

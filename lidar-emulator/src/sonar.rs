@@ -4,6 +4,7 @@
 use hilsim_recording::SonarSample;
 use hilsim_sim::{rng, scenario, StepState, World};
 
+use crate::effects::sonar_range_scale;
 use crate::mount::Mount;
 use crate::range_model::{ModelError, RangeModel};
 
@@ -21,6 +22,8 @@ pub struct Sonar {
     max_range_m: f64,
     rng: rng::Rng,
     next_ping: u64,
+    /// `[effects.sonar_speed_of_sound]`: c(calibrated) / c(air); 1 when off.
+    range_scale: f64,
 }
 
 impl Sonar {
@@ -29,11 +32,28 @@ impl Sonar {
     /// # Errors
     /// A range model that makes no sense.
     pub fn new(config: &scenario::Sonar, seed: u64) -> Result<Self, ModelError> {
+        Self::with_effects(config, &scenario::Effects::default(), seed)
+    }
+
+    /// The sonar of a scenario with the scenario's `[effects]` that concern it: the beam width
+    /// (`sonar_beam_width` replaces the declared cone) and the speed of sound (every range
+    /// scaled by `c(calibrated_at_c) / c(air_temperature_c)`, see `effects`).
+    ///
+    /// # Errors
+    /// A range model that makes no sense.
+    pub fn with_effects(
+        config: &scenario::Sonar,
+        effects: &scenario::Effects,
+        seed: u64,
+    ) -> Result<Self, ModelError> {
         let model = RangeModel::builder()
             .bias(&config.bias)
             .noise(&config.noise)
             .build()?;
-        let half = config.half_angle_deg.to_radians();
+        let half_angle_deg = effects
+            .sonar_beam_width
+            .map_or(config.half_angle_deg, |b| b.half_angle_deg);
+        let half = half_angle_deg.to_radians();
         let per_side = (half / CONE_RAY_SPACING_RAD).ceil() as i64;
         let ray_offsets = if per_side == 0 {
             vec![0.0]
@@ -51,6 +71,9 @@ impl Sonar {
             max_range_m: config.max_range_m,
             rng: rng::stream(seed, "sonar"),
             next_ping: 0,
+            range_scale: effects.sonar_speed_of_sound.map_or(1.0, |e| {
+                sonar_range_scale(e.air_temperature_c, e.calibrated_at_c)
+            }),
         })
     }
 
@@ -67,6 +90,19 @@ impl Sonar {
             .min_by(f64::total_cmp)
     }
 
+    /// The expected reading (noise-free, before millimetre rounding) for a nearest echo at
+    /// `d_m`: the range model's mean of the range the echo's time gives.
+    #[must_use]
+    pub fn mean_reading_m(&self, d_m: f64) -> f64 {
+        self.model.mean(d_m * self.range_scale)
+    }
+
+    /// The range model.
+    #[must_use]
+    pub fn model(&self) -> &RangeModel {
+        &self.model
+    }
+
     /// Pings whose instant falls in `[step.t0, step.t1)`. A ping with no echo within range
     /// yields no sample (the sensor times out).
     pub fn observe(&mut self, world: &World, step: &StepState, out: &mut Vec<SonarSample>) {
@@ -81,7 +117,8 @@ impl Sonar {
             }
             if let Some(d) = self.nearest_echo(world, &step.pose_at(t)) {
                 // Echo timing resolves about a millimetre; report whole millimetres.
-                let range = (self.model.sample(d, &mut self.rng) * 1000.0).round() / 1000.0;
+                let ranged = d * self.range_scale;
+                let range = (self.model.sample(ranged, &mut self.rng) * 1000.0).round() / 1000.0;
                 out.push(SonarSample {
                     t_s: t,
                     range_m: range.max(0.0),

@@ -25,6 +25,7 @@
 
 mod actuation;
 pub mod drive;
+mod motor_lag;
 pub mod pose;
 pub mod rng;
 pub mod scenario;
@@ -32,6 +33,7 @@ mod simulation;
 pub mod world;
 
 pub use drive::{DriveProgram, WheelCommand};
+pub use motor_lag::MotorLag;
 pub use pose::Pose;
 pub use scenario::{Scenario, ScenarioError};
 pub use simulation::{Collision, Simulation, StepState};

@@ -7,6 +7,7 @@ use rapier2d::prelude::*;
 
 use crate::actuation::ActuationError;
 use crate::drive::{DriveProgram, WheelCommand};
+use crate::motor_lag::MotorLag;
 use crate::pose::{wrap_angle, Pose};
 use crate::scenario::Scenario;
 use crate::world::{Obstacle, World};
@@ -88,6 +89,8 @@ pub struct Simulation {
     collisions: Vec<Collision>,
     touching: Vec<ColliderHandle>,
     actuation: ActuationError,
+    /// `[effects.drive_motor_lag]`, when switched on.
+    lag: Option<MotorLag>,
 }
 
 impl Simulation {
@@ -124,6 +127,10 @@ impl Simulation {
             collisions: Vec::new(),
             touching: Vec::new(),
             actuation: ActuationError::new(&scenario.robot.actuation, scenario.seed),
+            lag: scenario
+                .effects
+                .drive_motor_lag
+                .map(|lag| MotorLag::new(lag.time_constant_s)),
         }
     }
 
@@ -213,10 +220,26 @@ impl Simulation {
     /// Differential drive: wheel speeds → body twist, held by setting the body's velocity each
     /// step; the physics then resolves contacts (a wall stops the robot).
     fn apply(&mut self, command: WheelCommand) {
-        // The wheels achieve the command scaled by the actuation error (1 when it is off).
+        // The wheels achieve the command scaled by the actuation error (1 when it is off) …
         let factor = self.actuation.next_factor(self.step_s);
-        let v = factor * (command.left_mps + command.right_mps) / 2.0;
-        let omega = factor * (command.right_mps - command.left_mps) / self.wheel_base_m;
+        let (v, omega) = match &mut self.lag {
+            None => (
+                factor * (command.left_mps + command.right_mps) / 2.0,
+                factor * (command.right_mps - command.left_mps) / self.wheel_base_m,
+            ),
+            // … through a first-order lag when the scenario switches motor lag on.
+            Some(lag) => {
+                let target = WheelCommand {
+                    left_mps: factor * command.left_mps,
+                    right_mps: factor * command.right_mps,
+                };
+                let w = lag.step(target, self.step_s);
+                (
+                    (w.left_mps + w.right_mps) / 2.0,
+                    (w.right_mps - w.left_mps) / self.wheel_base_m,
+                )
+            }
+        };
         let (sin, cos) = self.pose.yaw.sin_cos();
         let body = &mut self.world.physics.bodies[self.world.robot];
         body.set_linvel(Vector::new((v * cos) as f32, (v * sin) as f32), true);

@@ -34,8 +34,8 @@ pub struct HilArgs {
     /// The run's length in seconds, overriding the scenario's `duration_s`.
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
-    /// Seconds the firmware may go without a request (or, at the start, without reading the
-    /// lidar) before it counts as hung.
+    /// Seconds the firmware may go without a request before it counts as hung; also the time
+    /// it has to start reading the lidar.
     #[arg(long, value_name = "S", default_value_t = 5.0)]
     pub watchdog: f64,
     /// Seed of every random stream (default: the scenario's `seed`).
@@ -44,7 +44,10 @@ pub struct HilArgs {
 }
 
 fn seconds(flag: &str, value: f64) -> Result<Duration> {
-    if !(value.is_finite() && value > 0.0 && value <= MAX_SECONDS) {
+    if !value.is_finite() {
+        bail!("{flag} must be a number of seconds in (0, {MAX_SECONDS}], got a non-finite value");
+    }
+    if !(value > 0.0 && value <= MAX_SECONDS) {
         bail!("{flag} must be a number of seconds in (0, {MAX_SECONDS}], got {value}");
     }
     Ok(Duration::from_secs_f64(value))
@@ -97,7 +100,11 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
         out,
         "firmware: pid {} `{}`; {} ({}) for {:.1} s in real time",
         firmware.pid(),
-        args.firmware,
+        // On one line, whatever the command's own line breaks.
+        args.firmware
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" "),
         scenario.name,
         origin,
         duration.as_secs_f64()

@@ -4,6 +4,7 @@
 mod bad_input;
 mod common;
 mod dataset;
+mod hil;
 mod record;
 mod run;
 mod scenario_test;

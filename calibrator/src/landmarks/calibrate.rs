@@ -95,6 +95,12 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             "warning: stop at t = {t:.2} s dropped: the odometry shows motion ({v:.3} m/s)"
         ));
     }
+    if report.too_short > 0 {
+        notes.push(format!(
+            "{} stand-still interval(s) shorter than {} s after the {} s settling time skipped",
+            report.too_short, opts.stops.min_stop_s, opts.stops.settle_s
+        ));
+    }
     if stops.len() < 2 {
         return Err(CalibrationError::TooFewSamples(format!(
             "landmarks: found {} stand-still stop(s) of at least {} s; the bearings of two \
@@ -151,22 +157,31 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         rejected.add(&r);
         dets.extend(d);
     }
+    let reasons = [
+        (rejected.occluded, "occluded"),
+        (rejected.too_long, "too long (walls)"),
+        (rejected.straight, "straight (walls)"),
+        (rejected.short, "too short"),
+        (rejected.edges, "edges misplaced for the radius"),
+        (rejected.radius, "of another radius"),
+        (rejected.intermittent, "intermittent"),
+        (rejected.far, "too far"),
+        (rejected.fit, "failed circle fits"),
+    ];
+    let reasons: Vec<String> = reasons
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, why)| format!("{n} {why}"))
+        .collect();
     notes.push(format!(
-        "{} stops, {} landmark detections; segments rejected: {} walls too long, {} straight, \
-         {} occluded, {} with misplaced edges, {} of another radius, {} too short, {} \
-         intermittent, {} beyond {} m, {} failed fits",
+        "{} stops, {} landmark detections; segments rejected: {}",
         stops.len(),
         dets.len(),
-        rejected.too_long,
-        rejected.straight,
-        rejected.occluded,
-        rejected.edges,
-        rejected.radius,
-        rejected.short,
-        rejected.intermittent,
-        rejected.far,
-        opts.detection.max_range_m,
-        rejected.fit
+        if reasons.is_empty() {
+            "none".to_string()
+        } else {
+            reasons.join(", ")
+        }
     ));
     if dets.is_empty() {
         return Err(CalibrationError::TooFewSamples(format!(

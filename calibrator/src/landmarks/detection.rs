@@ -3,8 +3,13 @@
 //! or clutter does not.
 //!
 //! What a landmark measurement is, precisely:
-//! * its **bearing** ψ is the direction, in the lidar frame, of the centre of the circle of the
-//!   landmark radius R fitted to the segment's averaged points (geometric least squares);
+//! * its **bearing** ψ, in the lidar frame, is the centroid of the beams' hit fractions (the
+//!   share of each beam's samples that returned from the landmark; see `edge_bearing`): the hit
+//!   profile is symmetric about the centre's direction, so this resolves ψ below the 1° beam
+//!   spacing without the range noise. When the background is too close behind the landmark to
+//!   tell hits from misses, ψ is the direction of the centre of the circle of the landmark radius
+//!   R fitted to the segment's averaged points (geometric least squares). On `landmarks-5` the
+//!   first errs by 0.16° rms, the second by 0.46°;
 //! * its **range** r̃ estimates the mean reading of the beam towards that centre, whose true
 //!   value is the distance to the nearest surface point, d = |c − s| − R. It averages, over the
 //!   stop's revolutions, the readings of the central beams (|φ − ψ| within a fraction of the
@@ -334,13 +339,12 @@ fn judge(
         }
     }
     let free_radius_m = free.map(|c| c.radius);
-    let (psi_fit, from_edges) = (psi, true);
+    // The edges' bearing, unless it disagrees with the circle fit by more than the fit's own
+    // uncertainty allows (a degree plus a quarter of the landmark's angular width): then
+    // something else shapes the hit profile.
+    let psi_fit = psi;
     let (psi, from_edges) = match edge_bearing(scan, seg, &angles) {
-        Some(b)
-            if from_edges && (b - psi_fit).abs() < 1f64.to_radians() + half.to_radians() / 2.0 =>
-        {
-            (b, true)
-        }
+        Some(b) if (b - psi_fit).abs() < 1f64.to_radians() + half.to_radians() / 2.0 => (b, true),
         _ => (psi_fit, false),
     };
     // The central beams measure the range (module docs).

@@ -4,7 +4,7 @@
 
 use crate::CalibrationError;
 
-/// Everything [`calibrate`](super::calibrate) can be told.
+/// Everything [`calibrate`](fn@super::calibrate) can be told.
 ///
 /// ```
 /// use hilsim_calibrator::landmarks::{Estimator, Options, OrderSelection};
@@ -61,7 +61,8 @@ impl Default for Options {
 /// How the polynomial order is chosen (the paper's phase #2, Sec. 3.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OrderSelection {
-    /// Akaike's information criterion (as the seed papers [39,40] use).
+    /// Akaike's information criterion (as the seed papers, refs. 39 and 40 of the landmark
+    /// paper, use).
     Aic,
     /// Leave-one-out cross-validation (PRESS).
     CrossValidation,

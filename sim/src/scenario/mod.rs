@@ -21,6 +21,7 @@
 //! assert!(err.to_string().starts_with("bad.toml:1: "));
 //! ```
 
+mod effects;
 mod locate;
 pub mod metrics;
 mod schema;
@@ -29,6 +30,7 @@ mod validate;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+pub use effects::*;
 pub use schema::*;
 
 /// A scenario that could not be loaded: the file, the line where known, and what was wrong.

@@ -40,6 +40,9 @@ pub struct Scenario {
     /// Assertions checked by `hilsim run` and `hilsim scenario test`.
     #[serde(default)]
     pub expect: Vec<Expect>,
+    /// Physics switched on beyond the nominal models (the mismatch catalogue); default: none.
+    #[serde(default)]
+    pub effects: super::effects::Effects,
 }
 
 /// `[physics]`.
@@ -302,6 +305,23 @@ pub struct Lidar {
     /// Mount pose on the robot.
     #[serde(default)]
     pub mount: Mount,
+    /// When each reading's geometry is taken; default: each at its own instant.
+    #[serde(default)]
+    pub timing: LidarTiming,
+}
+
+/// When the lidar's readings are taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LidarTiming {
+    /// Each reading at its own instant as the head turns (the XV-11 as it is).
+    #[default]
+    PerReading,
+    /// A whole revolution at one instant, its start: the robot's pose then for all 360 readings
+    /// (the snapshot many simulators take). The readings keep their per-reading timestamps,
+    /// the slots the unit's packets time them by. `[effects.lidar_motion_skew]` is the physics
+    /// this leaves out.
+    PerRevolution,
 }
 
 fn unbiased() -> Vec<f64> {
@@ -334,8 +354,10 @@ pub struct Sonar {
     /// beta_0.. of eq. (2); the EM paper's sonar noise is constant. Default `[0]`.
     #[serde(default = "noiseless")]
     pub noise: Vec<f64>,
-    /// Half of the beam cone, degrees; 0 is an axis-only sonar. Default 15 (HC-SR04 class).
-    #[serde(default = "default_half_angle")]
+    /// Half of the beam cone, degrees; default 0, an axis-only sonar (a scenario's nominal
+    /// simulation is what it declares: a cone, e.g. 15° for the HC-SR04 class, is declared here,
+    /// or left out and switched on as `[effects.sonar_beam_width]`).
+    #[serde(default)]
     pub half_angle_deg: f64,
     /// Ping rate, Hz; default 10.
     #[serde(default = "default_sonar_rate")]
@@ -346,10 +368,6 @@ pub struct Sonar {
     /// Mount pose on the robot.
     #[serde(default)]
     pub mount: Mount,
-}
-
-fn default_half_angle() -> f64 {
-    15.0
 }
 
 fn default_sonar_rate() -> f64 {

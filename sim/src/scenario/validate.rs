@@ -123,6 +123,10 @@ pub(crate) fn validate(s: &Scenario) -> Check {
     robot(s)?;
     drive(s)?;
     sensors(s)?;
+    super::effects::validate(s).map_err(|e| Invalid {
+        path: e.path,
+        message: e.message,
+    })?;
     for (i, e) in s.expect.iter().enumerate() {
         if !metrics::is_known(&e.metric) {
             return fail(

@@ -1,0 +1,42 @@
+//! `lidar_incidence_angle`: the range error grows as the beam meets a surface obliquely.
+//!
+//! Derivation (beam footprint). A beam of angular half-width γ meeting a plane at incidence θ
+//! (the angle between the beam and the surface normal) at range d lights a footprint whose edges
+//! lie at ranges `d cos γ / cos(θ ± γ) ≈ d (1 ± γ tan θ)`: the footprint spans `2 γ d tan θ` in
+//! depth, nothing at normal incidence and without bound towards grazing. A range finder reports
+//! the centroid of the returned light, and that light is not spread evenly over the footprint
+//! (its near half returns more: Lambert's cosine and 1/r², and the triangulation receiver's spot
+//! image is skewed), so the reported range sits a fixed fraction of the footprint's depth from
+//! its centre: `Δd = κ d tan θ`. κ lumps the divergence and the asymmetry; it is the unit's own,
+//! to be fitted. Measurements of terrestrial scanners show the same growth of the error with
+//! obliquity (Soudarissanane, Lindenbergh, Menenti, Teunissen, "Scanning geometry: influencing
+//! factor on the quality of terrestrial laser scanning points", ISPRS J. Photogramm. Remote
+//! Sens. 66 (2011)).
+
+/// Incidence beyond this is treated as this (tan 80° ≈ 5.7): at grazing incidence the footprint
+/// model breaks down and the return is usually too weak to range anyway.
+pub const MAX_INCIDENCE_DEG: f64 = 80.0;
+
+/// `tan θ` for a beam meeting a surface with `cos θ = cos_incidence`, θ capped at
+/// [`MAX_INCIDENCE_DEG`].
+#[must_use]
+pub fn tan_incidence(cos_incidence: f64) -> f64 {
+    let cap = MAX_INCIDENCE_DEG.to_radians();
+    let theta = cos_incidence.abs().min(1.0).acos().min(cap);
+    theta.tan()
+}
+
+/// The range error `κ d tan θ`, metres, of a beam at range `d_m` meeting a surface with
+/// `cos θ = cos_incidence`.
+///
+/// ```
+/// use hilsim_lidar_emulator::effects::incidence_error_m;
+/// // 45°: tan θ = 1, so 1 % of 2 m.
+/// let e = incidence_error_m(0.01, 2.0, std::f64::consts::FRAC_1_SQRT_2);
+/// assert!((e - 0.02).abs() < 1e-12);
+/// assert_eq!(incidence_error_m(0.01, 2.0, 1.0), 0.0);
+/// ```
+#[must_use]
+pub fn incidence_error_m(coefficient: f64, d_m: f64, cos_incidence: f64) -> f64 {
+    coefficient * d_m * tan_incidence(cos_incidence)
+}

@@ -1,0 +1,294 @@
+//! `[effects]`: physics that a scenario switches on. Every effect of the mismatch catalogue
+//! (`hilsim diagnose`) is off by default, so a scenario's nominal simulation is exactly what it
+//! declares and nothing more; a scenario with an effect switched on is how "real" data with that
+//! effect is produced. Each table holds the effect's parameters; the physics behind each one is
+//! in the sensor model that applies it (`hilsim-lidar-emulator`'s `effects` module for the
+//! sensors, `motor_lag` here for the drive) and in `scenarios/README.md`.
+
+use serde::Deserialize;
+
+use super::locate::{key_path, Key};
+use super::schema::{LidarTiming, Scenario};
+
+/// `[effects]`: each table present switches that effect on.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Effects {
+    /// The lidar's range error grows as its beam meets a surface obliquely.
+    #[serde(default)]
+    pub lidar_incidence_angle: Option<LidarIncidenceAngle>,
+    /// The lidar's range bias depends on the target's reflectivity (range walk).
+    #[serde(default)]
+    pub lidar_reflectivity: Option<LidarReflectivity>,
+    /// The lidar's beam has a width: a beam grazing an edge returns a range between the
+    /// foreground and the background.
+    #[serde(default)]
+    pub lidar_mixed_pixels: Option<LidarMixedPixels>,
+    /// The lidar's head turns while the robot moves: the readings of a revolution are taken at
+    /// their own instants, not at the revolution's start.
+    #[serde(default)]
+    pub lidar_motion_skew: Option<LidarMotionSkew>,
+    /// The lidar's range bias drifts with the time since power-on.
+    #[serde(default)]
+    pub lidar_warmup_drift: Option<LidarWarmupDrift>,
+    /// The sonar returns the nearest echo anywhere in a cone wider than declared.
+    #[serde(default)]
+    pub sonar_beam_width: Option<SonarBeamWidth>,
+    /// The air's temperature scales every sonar range.
+    #[serde(default)]
+    pub sonar_speed_of_sound: Option<SonarSpeedOfSound>,
+    /// The wheels slip in proportion to their acceleration.
+    #[serde(default)]
+    pub odometer_wheel_slip: Option<OdometerWheelSlip>,
+    /// The wheels reach a commanded speed with a first-order lag.
+    #[serde(default)]
+    pub drive_motor_lag: Option<DriveMotorLag>,
+}
+
+impl Effects {
+    /// The catalogue names of the effects switched on, in catalogue order.
+    #[must_use]
+    pub fn active(&self) -> Vec<&'static str> {
+        let on = [
+            (
+                "lidar_incidence_angle",
+                self.lidar_incidence_angle.is_some(),
+            ),
+            ("lidar_reflectivity", self.lidar_reflectivity.is_some()),
+            ("lidar_mixed_pixels", self.lidar_mixed_pixels.is_some()),
+            ("lidar_motion_skew", self.lidar_motion_skew.is_some()),
+            ("lidar_warmup_drift", self.lidar_warmup_drift.is_some()),
+            ("sonar_beam_width", self.sonar_beam_width.is_some()),
+            ("sonar_speed_of_sound", self.sonar_speed_of_sound.is_some()),
+            ("odometer_wheel_slip", self.odometer_wheel_slip.is_some()),
+            ("drive_motor_lag", self.drive_motor_lag.is_some()),
+        ];
+        on.iter().filter(|(_, o)| *o).map(|(n, _)| *n).collect()
+    }
+
+    /// Whether no effect is switched on.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.active().is_empty()
+    }
+}
+
+/// `[effects.lidar_incidence_angle]`: range error `coefficient · d · tan θ`, θ the angle between
+/// the beam and the surface normal.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarIncidenceAngle {
+    /// Dimensionless: the range error per metre of range per unit of `tan θ`; positive reads
+    /// long.
+    pub coefficient: f64,
+}
+
+/// `[effects.lidar_reflectivity]`: range walk `coefficient_m · (reference / ρ − 1)`, ρ the
+/// surface's reflectivity (`world.materials`).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarReflectivity {
+    /// Metres: the range walk per unit of `reference / ρ − 1`; positive: dark surfaces read long.
+    pub coefficient_m: f64,
+    /// The reflectivity at which the unit was calibrated (no walk); default 0.8, the built-in
+    /// material's.
+    #[serde(default = "default_reference_reflectivity")]
+    pub reference: f64,
+}
+
+fn default_reference_reflectivity() -> f64 {
+    0.8
+}
+
+/// `[effects.lidar_mixed_pixels]`: the beam's footprint spans `±half_width_deg`; a footprint on
+/// two surfaces returns their intensity-weighted triangulation centroid.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarMixedPixels {
+    /// Half of the beam's angular width, degrees.
+    pub half_width_deg: f64,
+}
+
+/// `[effects.lidar_motion_skew]`: no parameters; needs `[sensors.lidar] timing =
+/// "per_revolution"` (a lidar that takes a revolution at one instant), whose readings it spreads
+/// over the revolution as the head turns.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarMotionSkew {}
+
+/// `[effects.lidar_warmup_drift]`: range error `coefficient_per_m · d² · exp(−t / τ)`, t the time
+/// since power-on (the recording's start).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarWarmupDrift {
+    /// Per metre: the range error at power-on is this times d².
+    pub coefficient_per_m: f64,
+    /// The thermal time constant τ, seconds.
+    pub time_constant_s: f64,
+}
+
+/// `[effects.sonar_beam_width]`: the sonar's real cone.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SonarBeamWidth {
+    /// Half of the real beam cone, degrees; replaces `[sensors.sonar] half_angle_deg`.
+    pub half_angle_deg: f64,
+}
+
+/// `[effects.sonar_speed_of_sound]`: every range scaled by `c(calibrated_at_c) / c(air)`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SonarSpeedOfSound {
+    /// The air's temperature during the run, °C.
+    pub air_temperature_c: f64,
+    /// The temperature whose speed of sound the sonar converts echo times with, °C; default 20.
+    #[serde(default = "default_calibrated_at")]
+    pub calibrated_at_c: f64,
+}
+
+fn default_calibrated_at() -> f64 {
+    20.0
+}
+
+/// `[effects.odometer_wheel_slip]`: each wheel's slip velocity is `gain_s` times its
+/// acceleration, so the encoders lead the true travel by `gain_s · v_wheel`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OdometerWheelSlip {
+    /// Seconds: slip velocity per unit of wheel acceleration.
+    pub gain_s: f64,
+}
+
+/// `[effects.drive_motor_lag]`: each wheel's speed follows its command through a first-order
+/// lag.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveMotorLag {
+    /// The lag's time constant τ, seconds.
+    pub time_constant_s: f64,
+}
+
+/// A failed check of an effect's table.
+pub(crate) struct EffectInvalid {
+    pub(crate) path: Vec<Key>,
+    pub(crate) message: String,
+}
+
+type Check = Result<(), EffectInvalid>;
+
+fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
+    Err(EffectInvalid {
+        path,
+        message: message.into(),
+    })
+}
+
+/// `v` must be finite and lie in `[lo, hi]`.
+fn within(path: Vec<Key>, v: f64, lo: f64, hi: f64, what: &str) -> Check {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        fail(path, format!("expected {what} in {lo}..={hi}, found {v}"))
+    }
+}
+
+/// `v` must be finite, positive and at most `hi`.
+fn positive_up_to(path: Vec<Key>, v: f64, hi: f64, what: &str) -> Check {
+    if v.is_finite() && v > 0.0 && v <= hi {
+        Ok(())
+    } else {
+        fail(path, format!("expected {what} in (0, {hi}], found {v}"))
+    }
+}
+
+fn needs(path: Vec<Key>, present: bool, sensor: &str) -> Check {
+    if present {
+        Ok(())
+    } else {
+        fail(
+            path,
+            format!("this effect needs a [sensors.{sensor}]: the robot has no {sensor}"),
+        )
+    }
+}
+
+/// Ranges and references of the `[effects]` tables.
+pub(crate) fn validate(s: &Scenario) -> Check {
+    let e = &s.effects;
+    let lidar = s.sensors.lidar.as_ref();
+    let has_sonar = s.sensors.sonar.is_some();
+    if let Some(x) = e.lidar_incidence_angle {
+        let p = |k: &'static str| key_path!["effects", "lidar_incidence_angle", k];
+        needs(p("coefficient"), lidar.is_some(), "lidar")?;
+        within(p("coefficient"), x.coefficient, -0.2, 0.2, "a coefficient")?;
+    }
+    if let Some(x) = e.lidar_reflectivity {
+        let p = |k: &'static str| key_path!["effects", "lidar_reflectivity", k];
+        needs(p("coefficient_m"), lidar.is_some(), "lidar")?;
+        within(p("coefficient_m"), x.coefficient_m, -0.1, 0.1, "metres")?;
+        positive_up_to(p("reference"), x.reference, 1.0, "a reflectivity")?;
+    }
+    if let Some(x) = e.lidar_mixed_pixels {
+        let p = |k: &'static str| key_path!["effects", "lidar_mixed_pixels", k];
+        needs(p("half_width_deg"), lidar.is_some(), "lidar")?;
+        positive_up_to(p("half_width_deg"), x.half_width_deg, 5.0, "degrees")?;
+    }
+    if e.lidar_motion_skew.is_some() {
+        let path = key_path!["effects", "lidar_motion_skew"];
+        needs(path.clone(), lidar.is_some(), "lidar")?;
+        if lidar.is_some_and(|l| l.timing != LidarTiming::PerRevolution) {
+            return fail(
+                path,
+                "this effect needs `[sensors.lidar] timing = \"per_revolution\"`: a per-reading \
+                 lidar already takes each reading at its own instant",
+            );
+        }
+    }
+    if let Some(x) = e.lidar_warmup_drift {
+        let p = |k: &'static str| key_path!["effects", "lidar_warmup_drift", k];
+        needs(p("coefficient_per_m"), lidar.is_some(), "lidar")?;
+        within(
+            p("coefficient_per_m"),
+            x.coefficient_per_m,
+            -0.1,
+            0.1,
+            "a coefficient per metre",
+        )?;
+        positive_up_to(p("time_constant_s"), x.time_constant_s, 3600.0, "seconds")?;
+    }
+    if let Some(x) = e.sonar_beam_width {
+        let p = |k: &'static str| key_path!["effects", "sonar_beam_width", k];
+        needs(p("half_angle_deg"), has_sonar, "sonar")?;
+        if !(x.half_angle_deg.is_finite() && (0.0..90.0).contains(&x.half_angle_deg)) {
+            return fail(
+                p("half_angle_deg"),
+                format!(
+                    "expected 0 ≤ half_angle_deg < 90, found {}",
+                    x.half_angle_deg
+                ),
+            );
+        }
+    }
+    if let Some(x) = e.sonar_speed_of_sound {
+        let p = |k: &'static str| key_path!["effects", "sonar_speed_of_sound", k];
+        needs(p("air_temperature_c"), has_sonar, "sonar")?;
+        within(
+            p("air_temperature_c"),
+            x.air_temperature_c,
+            -50.0,
+            60.0,
+            "°C",
+        )?;
+        within(p("calibrated_at_c"), x.calibrated_at_c, -50.0, 60.0, "°C")?;
+    }
+    if let Some(x) = e.odometer_wheel_slip {
+        let p = |k: &'static str| key_path!["effects", "odometer_wheel_slip", k];
+        needs(p("gain_s"), s.sensors.odometer.is_some(), "odometer")?;
+        within(p("gain_s"), x.gain_s, -1.0, 1.0, "seconds")?;
+    }
+    if let Some(x) = e.drive_motor_lag {
+        let p = |k: &'static str| key_path!["effects", "drive_motor_lag", k];
+        positive_up_to(p("time_constant_s"), x.time_constant_s, 10.0, "seconds")?;
+    }
+    Ok(())
+}

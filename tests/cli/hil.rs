@@ -1,0 +1,379 @@
+//! `hilsim hil`: firmware in the loop, end to end. The example firmwares (Rust and C) drive to
+//! 0.5 m from the board of a short `hil-approach`; faulty firmwares end the run with exit code
+//! 1, the fault on one line, their stderr tail, and none of their processes left.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+use std::thread;
+use std::time::{Duration, Instant};
+
+use hilsim_recording::Recording;
+
+use super::common::*;
+
+/// `scenarios/hil-approach.toml` with the robot 1.5 m from the board instead of 2.5 m, so that
+/// the approach takes about 5 s of real time.
+fn short_approach(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(repo_file("scenarios/hil-approach.toml")).unwrap();
+    let moved = text.replace("start = { x = 2.5,", "start = { x = 1.5,");
+    assert_ne!(
+        moved, text,
+        "the start pose line of hil-approach.toml changed"
+    );
+    let path = dir.join("approach.toml");
+    std::fs::write(&path, moved).unwrap();
+    path
+}
+
+/// The example firmware, built once per test run (the `hilsim` package cannot depend on a
+/// binary-only package, so the test asks cargo for it; a no-op when it is up to date).
+fn example_firmware() -> &'static Path {
+    static BUILT: OnceLock<PathBuf> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let bin_dir = Path::new(env!("CARGO_BIN_EXE_hilsim")).parent().unwrap();
+        let mut cargo = Command::new(env!("CARGO"));
+        cargo
+            .args(["build", "--quiet", "-p", "hilsim-example-firmware"])
+            .current_dir(root());
+        if bin_dir.ends_with("release") {
+            cargo.arg("--release");
+        }
+        let out = cargo.output().expect("cargo runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let path = bin_dir.join("example-firmware");
+        assert!(path.is_file(), "{} was not built", path.display());
+        path
+    })
+}
+
+/// `firmware/c/firmware.c`, compiled with the machine's C compiler into `dir`.
+fn c_firmware(dir: &Path) -> PathBuf {
+    let exe = dir.join("c-firmware");
+    let out = Command::new("cc")
+        .args(["-O2", "-Wall", "-o"])
+        .arg(&exe)
+        .arg(repo_file("firmware/c/firmware.c"))
+        .output()
+        .expect("a C compiler (cc) is installed");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    exe
+}
+
+/// The firmware's pid from the report's `firmware: pid N` line.
+fn firmware_pid(text: &str) -> u32 {
+    text.lines()
+        .find_map(|l| {
+            l.strip_prefix("firmware: pid ")?
+                .split(' ')
+                .next()?
+                .parse()
+                .ok()
+        })
+        .unwrap_or_else(|| panic!("no pid in {text}"))
+}
+
+/// The process no longer runs (gone, or a zombie waiting for init to reap it).
+fn gone(pid: u32) -> bool {
+    let deadline = Instant::now() + Duration::from_secs(2);
+    loop {
+        match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+            Err(_) => return true,
+            Ok(stat)
+                if stat
+                    .rsplit(')')
+                    .next()
+                    .unwrap_or("")
+                    .trim_start()
+                    .starts_with('Z') =>
+            {
+                return true
+            }
+            Ok(_) if Instant::now() > deadline => return false,
+            Ok(_) => thread::sleep(Duration::from_millis(10)),
+        }
+    }
+}
+
+/// Asserts that the firmware (its summary line starts with `name:`) decoded every revolution
+/// hilsim sent: no gap in the packet index sequence, no bad checksum, none dropped, and as many
+/// revolutions as were sent (but the one in progress when it exited).
+fn assert_every_revolution_seen(text: &str, name: &str) {
+    let summary = text
+        .lines()
+        .find(|l| l.starts_with(&format!("{name}: ")))
+        .unwrap_or_else(|| panic!("no summary from {name}: {text}"));
+    assert!(
+        summary.contains(", index gaps 0, bad checksums 0"),
+        "{summary}"
+    );
+    let number_after = |line: &str, key: &str| -> u64 {
+        line.split(key)
+            .nth(1)
+            .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok())
+            .unwrap_or_else(|| panic!("no `{key}` in {line}"))
+    };
+    let seen = number_after(summary, "; revolutions ");
+    let lidar = text
+        .lines()
+        .find(|l| l.starts_with("lidar: ") && l.contains("revolutions sent"))
+        .unwrap();
+    let sent = number_after(lidar, "lidar: ");
+    assert!(lidar.contains(" revolutions sent, 0 dropped;"), "{lidar}");
+    assert!(
+        seen + 1 >= sent && seen <= sent && sent >= 10,
+        "{summary}\n{lidar}"
+    );
+}
+
+/// The robot's final distance to the board's face (x = 0), from the recording's truth.
+fn final_distance(dir: &Path) -> f64 {
+    let rec = Recording::read_dir(dir).unwrap();
+    assert!(rec.lidar.is_some() && rec.sonar.is_some() && rec.odometry.is_some());
+    assert!(rec.commands.iter().any(|c| c.left_mps > 0.0));
+    rec.truth.unwrap().last().unwrap().x_m
+}
+
+#[test]
+fn the_example_firmware_stops_half_a_metre_from_the_board_and_misses_no_revolution() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = short_approach(tmp.path());
+    let firmware = example_firmware().to_str().unwrap().to_string();
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--firmware",
+            &firmware,
+            "--duration",
+            "12",
+            "--out",
+            "rec",
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(text.starts_with("lidar: /dev/pts/"), "{text}");
+    assert!(text.contains("\nrobot: /dev/pts/"), "{text}");
+    // The firmware's own summary (its stdout passes through): every revolution arrived.
+    assert!(
+        text.contains("example-firmware: reached the target"),
+        "{text}"
+    );
+    assert_every_revolution_seen(&text, "example-firmware");
+    assert!(
+        text.contains("ended: the firmware exited with status 0"),
+        "{text}"
+    );
+    assert!(text.contains("; 0 collision(s)"), "{text}");
+    assert!(text.contains(", 0 error(s)"), "{text}");
+    let d = final_distance(&tmp.path().join("rec"));
+    assert!((d - 0.50).abs() <= 0.05, "stopped {d:.3} m from the board");
+    assert!(gone(firmware_pid(&text)));
+}
+
+#[test]
+fn a_firmware_in_c_does_the_same() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = short_approach(tmp.path());
+    let firmware = c_firmware(tmp.path()).to_str().unwrap().to_string();
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--firmware",
+            &firmware,
+            "--duration",
+            "12",
+            "--out",
+            "rec",
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(text.contains("c-firmware: reached the target"), "{text}");
+    assert_every_revolution_seen(&text, "c-firmware");
+    // Its tolerance: ±0.05 m too (a gentler approach, 250 mm/s at most).
+    let d = final_distance(&tmp.path().join("rec"));
+    assert!((d - 0.50).abs() <= 0.05, "stopped {d:.3} m from the board");
+}
+
+/// Runs `sh -c script` as the firmware on a short approach with a 1 s watchdog; expects a
+/// fault: exit code 1, `FAULT … {fault}`, the stderr tail with `last_words`, and the shell
+/// and every `pid N` it printed on stderr gone.
+fn assert_fault(script: &str, fault: &str, last_words: &str) -> String {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = short_approach(tmp.path());
+    let firmware = format!("sh -c '{script}'");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--firmware",
+            &firmware,
+            "--duration",
+            "6",
+            "--watchdog",
+            "1",
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(1), "{text}{}", stderr(&out));
+    let fault_line = text
+        .lines()
+        .find(|l| l.starts_with("FAULT at "))
+        .unwrap_or_else(|| panic!("no FAULT line: {text}"));
+    assert!(fault_line.contains(fault), "{fault_line}");
+    assert!(text.contains("firmware stderr (last "), "{text}");
+    assert!(text.contains(&format!("  | {last_words}")), "{text}");
+    let mut pids = vec![firmware_pid(&text)];
+    pids.extend(
+        text.lines()
+            .filter_map(|l| l.strip_prefix("  | pid ")?.parse::<u32>().ok()),
+    );
+    for pid in pids {
+        assert!(gone(pid), "process {pid} survived: {text}");
+    }
+    text
+}
+
+#[test]
+fn a_crashing_firmware_fails_the_run() {
+    assert_fault(
+        r#"cat "$HILSIM_LIDAR_PORT" >/dev/null & echo "pid $!" >&2; echo "bad config" >&2; exit 3"#,
+        "the firmware crashed: exit status 3",
+        "bad config",
+    );
+    assert_fault(
+        r#"cat "$HILSIM_LIDAR_PORT" >/dev/null & echo "pid $!" >&2; echo "null pointer" >&2; kill -SEGV $$"#,
+        "the firmware crashed: signal 11 (SIGSEGV)",
+        "null pointer",
+    );
+}
+
+#[test]
+fn a_firmware_that_stops_talking_is_caught_by_the_watchdog() {
+    let text = assert_fault(
+        r#"cat "$HILSIM_LIDAR_PORT" >/dev/null & echo "pid $!" >&2
+           printf "TestMode On\n" > "$HILSIM_ROBOT_PORT"; echo "waiting for a semaphore" >&2
+           sleep 60 & echo "pid $!" >&2; wait"#,
+        "the firmware hung: no request on the robot port for 1.0 s (the watchdog)",
+        "waiting for a semaphore",
+    );
+    assert!(text.contains("requests: 1 (TestMode 1,"), "{text}");
+}
+
+#[test]
+fn a_firmware_that_floods_the_port_is_stopped() {
+    assert_fault(
+        r#"cat "$HILSIM_LIDAR_PORT" >/dev/null & echo "pid $!" >&2
+           cat "$HILSIM_ROBOT_PORT" >/dev/null & echo "pid $!" >&2
+           echo "polling in a tight loop" >&2; exec yes GetMotors > "$HILSIM_ROBOT_PORT""#,
+        "the firmware flooded the robot port",
+        "polling in a tight loop",
+    );
+}
+
+#[test]
+fn a_firmware_that_never_reads_the_lidar_fails_the_run() {
+    let text = assert_fault(
+        r#"cat "$HILSIM_ROBOT_PORT" >/dev/null & echo "pid $!" >&2; echo "sonar only" >&2
+           while :; do printf "GetSonar\n"; sleep 0.2; done > "$HILSIM_ROBOT_PORT""#,
+        "the firmware never read the lidar port: it took ",
+        "sonar only",
+    );
+    // It took nothing; a packet still in the pty's hands may count as taken.
+    let took: u64 = text
+        .split("it took ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next()?.parse().ok())
+        .unwrap();
+    assert!(took <= 22, "{text}");
+}
+
+#[test]
+fn bad_hil_input_is_refused_before_anything_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = short_approach(tmp.path());
+    let scenario = scenario.to_str().unwrap();
+    for (args, expected) in [
+        (
+            vec!["--firmware", "true", "--duration", "0"],
+            "--duration must be a number of seconds",
+        ),
+        (
+            vec!["--firmware", "true", "--watchdog", "NaN"],
+            "--watchdog must be a number of seconds",
+        ),
+        (
+            vec!["--firmware", "fw 'unterminated"],
+            "unterminated ' quote",
+        ),
+        (
+            vec!["--firmware", "  "],
+            "the firmware command line is empty",
+        ),
+        (
+            vec!["--firmware", "/nonexistent/firmware --fast"],
+            "cannot start `/nonexistent/firmware`",
+        ),
+    ] {
+        let mut all = vec!["hil", scenario];
+        all.extend(args);
+        let err = assert_bad_input(&hilsim(tmp.path(), &all));
+        assert!(err.contains(expected), "{all:?}: {err}");
+    }
+    // A scenario with its own drive program and no duration_s: the firmware drives, so the
+    // run needs a length.
+    let board = repo_file("scenarios/straight-board.toml");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["hil", board.to_str().unwrap(), "--firmware", "true"],
+    ));
+    assert!(err.contains("set `duration_s` or pass --duration"), "{err}");
+}
+
+#[test]
+fn duration_makes_a_scenario_without_drive_program_or_duration_runnable() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(short_approach(tmp.path())).unwrap();
+    let endless = text.replace("duration_s = 30.0\n", "");
+    assert_ne!(endless, text);
+    std::fs::write(tmp.path().join("endless.toml"), endless).unwrap();
+    // Validation refuses it on its own...
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["hil", "endless.toml", "--firmware", "true"],
+    ));
+    assert!(err.contains("the run would have no end"), "{err}");
+    // ... and --duration supplies the end. A firmware that exits at once with status 0 ends
+    // the run without a fault.
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            "endless.toml",
+            "--firmware",
+            "true",
+            "--duration",
+            "2",
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(
+        text.contains("ended: the firmware exited with status 0"),
+        "{text}"
+    );
+}

@@ -446,16 +446,17 @@ fn estep(seeds: u64) {
          every variant. NMSE mean ± SE; `Δ vs paper` is the mean paired difference of NMSE \
          (variant − paper) ± its SE; `bias err` is the RMS over d ∈ [0.5, 4] m of the fitted \
          lidar bias against the true one (meaningful without actuation error only: with it, \
-         the commands' unknown scale distorts α); `µs/iter` the wall time per EM iteration.\n"
+         the commands' unknown scale distorts α). Time per iteration: `cargo bench -p \
+         hilsim-calibrator --bench em`.\n"
     );
     println!(
-        "| setting | speed | E-step | NMSE | Δ vs paper | bias err mm | iterations | µs/iter |\n\
-         |---|---|---|---|---|---|---|---|"
+        "| setting | speed | E-step | NMSE | Δ vs paper | bias err mm | iterations |\n\
+         |---|---|---|---|---|---|---|"
     );
     let variants = [EStep::Paper, EStep::SecondOrder, EStep::Relinearized];
     for (label, (scale, wander)) in [("no actuation", (0.0, 0.0)), ("actuation", ACTUATION)] {
         for speed in [0.1, 0.3] {
-            let rows: Vec<Vec<[f64; 4]>> = (1..=seeds)
+            let rows: Vec<Vec<[f64; 3]>> = (1..=seeds)
                 .into_par_iter()
                 .map(|seed| {
                     let rec = Run {
@@ -469,7 +470,6 @@ fn estep(seeds: u64) {
                     variants
                         .iter()
                         .map(|&v| {
-                            let t = Instant::now();
                             let o = run_em(
                                 &rec,
                                 &EmOptions {
@@ -477,13 +477,10 @@ fn estep(seeds: u64) {
                                     ..EmOptions::default()
                                 },
                             );
-                            let us = t.elapsed().as_secs_f64() * 1e6;
-                            let it = o.calibration.iterations as f64;
                             [
                                 nmse(&o.calibration),
                                 bias_error(&o.calibration),
-                                it,
-                                us / it,
+                                o.calibration.iterations as f64,
                             ]
                         })
                         .collect()
@@ -494,12 +491,11 @@ fn estep(seeds: u64) {
                 let diff: Vec<f64> = rows.iter().map(|r| r[vi][0] - r[0][0]).collect();
                 let (dm, dse) = mean_se(&diff);
                 println!(
-                    "| {label} | {speed} | {} | {} | {dm:+.2e} ± {dse:.1e} | {:.3} | {:.0} | {:.0} |",
+                    "| {label} | {speed} | {} | {} | {dm:+.2e} ± {dse:.1e} | {:.3} | {:.0} |",
                     v.name(),
                     fmt_mean_se(&col(0)),
                     1e3 * mean_se(&col(1)).0,
                     mean_se(&col(2)).0,
-                    mean_se(&col(3)).0,
                 );
             }
         }

@@ -54,8 +54,9 @@ pub struct SensorModel {
 /// Distance-estimate quality against the truth, when the recording has truth.
 ///
 /// `mse_*` is the mean squared error of the distance estimates (raw: the sensor's readings as
-/// distances; calibrated: the method's estimates), metres²; `nmse_*` normalises by the mean
-/// squared true distance, as the EM paper's Fig. 3 does.
+/// distances; calibrated: the method's estimates), metres²; `nmse_*` is the EM paper's
+/// normalised MSE (Fig. 3): the mean over samples of each squared error divided by that
+/// sample's squared true distance (dimensionless).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Metrics {
     /// MSE of the raw readings.

@@ -54,7 +54,7 @@ def main(directory):
     print(f"largest difference of the smoothed distance: {diff_d:.3e} m")
     print(f"largest relative difference of its variance: {diff_var:.3e}")
     print(f"pykalman smooth: {py_ns:.0f} ns/step (best of 3)")
-    print(f"hilsim RtsSmoother: {rust_ns:.1} ns/step")
+    print(f"hilsim RtsSmoother: {rust_ns:.1f} ns/step")
     print(f"ratio pykalman / hilsim: {py_ns / rust_ns:.0f}")
     # Same model, same algorithm: anything beyond rounding is a bug in one of them.
     if not (diff_d < 1e-6 and diff_var < 1e-6):

@@ -47,8 +47,8 @@ pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
     ("lidar.mse_raw", "MSE of the raw lidar distances against the truth, m²"),
     ("lidar.mse_calibrated", "MSE of the calibrated distance estimates, m²"),
     ("lidar.mse_ratio", "raw over calibrated MSE (the landmark paper's eq. 31)"),
-    ("lidar.nmse_raw", "raw MSE normalised by the mean squared true distance"),
-    ("lidar.nmse_calibrated", "calibrated MSE normalised likewise (the EM paper's Fig. 3)"),
+    ("lidar.nmse_raw", "mean of squared raw errors over squared true distances (EM paper, Fig. 3)"),
+    ("lidar.nmse_calibrated", "the same for the calibrated estimates"),
 ];
 
 /// The calibration methods a calibration metric may be prefixed with.

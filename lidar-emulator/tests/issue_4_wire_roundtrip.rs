@@ -46,7 +46,10 @@ fn a_wobbling_lidar_survives_the_wire_bit_for_bit() {
                 revolutions += 1;
             }
         }
-        sent.extend(readings.iter().map(|r| LidarSample { true_range_m: None, ..r.to_sample() }));
+        sent.extend(readings.iter().map(|r| LidarSample {
+            true_range_m: None,
+            ..r.to_sample()
+        }));
     }
     assert!(revolutions > 20, "{revolutions}");
     // Only whole revolutions cross the wire.
@@ -65,5 +68,8 @@ fn a_wobbling_lidar_survives_the_wire_bit_for_bit() {
         timeline.push(&rev, &mut received);
     }
     assert_eq!(received.len(), sent.len());
-    assert_eq!(received, sent, "timestamps, ranges, flags and strengths all equal");
+    assert_eq!(
+        received, sent,
+        "timestamps, ranges, flags and strengths all equal"
+    );
 }

@@ -42,13 +42,31 @@ pub const METRICS: &[(&str, &str)] = &[
 /// truth).
 pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
     ("iterations", "iterations the method ran"),
-    ("converged", "1 when the method met its convergence criterion, else 0"),
+    (
+        "converged",
+        "1 when the method met its convergence criterion, else 0",
+    ),
     ("order", "the selected polynomial order (landmarks)"),
-    ("lidar.mse_raw", "MSE of the raw lidar distances against the truth, m²"),
-    ("lidar.mse_calibrated", "MSE of the calibrated distance estimates, m²"),
-    ("lidar.mse_ratio", "raw over calibrated MSE (the landmark paper's eq. 31)"),
-    ("lidar.nmse_raw", "mean of squared raw errors over squared true distances (EM paper, Fig. 3)"),
-    ("lidar.nmse_calibrated", "the same for the calibrated estimates"),
+    (
+        "lidar.mse_raw",
+        "MSE of the raw lidar distances against the truth, m²",
+    ),
+    (
+        "lidar.mse_calibrated",
+        "MSE of the calibrated distance estimates, m²",
+    ),
+    (
+        "lidar.mse_ratio",
+        "raw over calibrated MSE (the landmark paper's eq. 31)",
+    ),
+    (
+        "lidar.nmse_raw",
+        "mean of squared raw errors over squared true distances (EM paper, Fig. 3)",
+    ),
+    (
+        "lidar.nmse_calibrated",
+        "the same for the calibrated estimates",
+    ),
 ];
 
 /// The calibration methods a calibration metric may be prefixed with.

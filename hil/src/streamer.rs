@@ -73,6 +73,17 @@ impl StreamStats {
         self.lateness.iter().sum()
     }
 
+    /// `"packet lateness median 0.1 ms, p99 0.4 ms"`, when any packet was paced.
+    #[must_use]
+    pub fn lateness_summary(&self) -> Option<String> {
+        let ms = |q| self.lateness_quantile(q).map(|d| d.as_secs_f64() * 1e3);
+        Some(format!(
+            "packet lateness median {:.1} ms, p99 {:.1} ms",
+            ms(0.5)?,
+            ms(0.99)?
+        ))
+    }
+
     /// The `q`-quantile (0..=1) of packet lateness: how long after its due time each packet was
     /// written, to 0.1 ms. `None` without paced packets.
     #[must_use]

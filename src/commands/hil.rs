@@ -192,13 +192,8 @@ fn summarise(report: &HilReport, out: &mut dyn Write) -> Result<()> {
             "lidar: {} revolutions sent, {} dropped; the firmware read {read} of {} bytes",
             s.revolutions_sent, s.revolutions_dropped, s.bytes_written
         )?;
-        if let (Some(p50), Some(p99)) = (s.lateness_quantile(0.5), s.lateness_quantile(0.99)) {
-            write!(
-                out,
-                "; packet lateness median {:.1} ms, p99 {:.1} ms",
-                p50.as_secs_f64() * 1e3,
-                p99.as_secs_f64() * 1e3
-            )?;
+        if let Some(lateness) = s.lateness_summary() {
+            write!(out, "; {lateness}")?;
         }
         writeln!(out)?;
     }

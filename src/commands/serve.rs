@@ -48,13 +48,8 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         "served {:.1} s: {} revolutions sent, {} dropped (no reader or a stalled one), {} bytes",
         report.simulated_s, s.revolutions_sent, s.revolutions_dropped, s.bytes_written
     )?;
-    if let (Some(p50), Some(p99)) = (s.lateness_quantile(0.5), s.lateness_quantile(0.99)) {
-        write!(
-            out,
-            "; packet lateness median {:.1} ms, p99 {:.1} ms",
-            p50.as_secs_f64() * 1e3,
-            p99.as_secs_f64() * 1e3
-        )?;
+    if let Some(lateness) = s.lateness_summary() {
+        write!(out, "; {lateness}")?;
     }
     writeln!(out)?;
     Ok(())

@@ -232,8 +232,9 @@ pub fn run_samples(
     opts.validate()?;
     let Some(start) = samples.start_distance_m else {
         return Err(CalibrationError::Missing(
-            "no start distance: meta.toml [world] has no target_start_distance_m and none was \
-             given (--start-distance); EM needs it to anchor the distance"
+            "no start distance: none was given (--start-distance), and meta.toml's [world] \
+             target_start_distance_m, when present, is the frontal target's (beam 0°) only; \
+             EM needs it to anchor the distance"
                 .into(),
         ));
     };

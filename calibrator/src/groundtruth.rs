@@ -288,8 +288,9 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
     )?;
     let Some(truth) = samples.truth_m.as_ref() else {
         return Err(CalibrationError::Missing(
-            "no start distance: meta.toml [world] has no target_start_distance_m and none was \
-             given (--start-distance); the true distances are measured from it"
+            "no start distance: none was given (--start-distance), and meta.toml's [world] \
+             target_start_distance_m, when present, is the frontal target's (beam 0°) only; \
+             the true distances are measured from it"
                 .into(),
         ));
     };

@@ -39,7 +39,8 @@ pub struct SampleOptions {
     /// Beam angle in the lidar's frame, degrees (rounded to the nearest whole degree: the XV-11
     /// reads one beam per degree).
     pub beam_deg: f64,
-    /// Lidar-to-target distance at t = 0; overrides `meta.world.target_start_distance_m`.
+    /// Lidar-to-target distance at t = 0; overrides `meta.world.target_start_distance_m`, which
+    /// is used only for the beam straight ahead (it is the frontal target's).
     pub start_distance_m: Option<f64>,
 }
 
@@ -139,10 +140,14 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
         )));
     }
     let beam_index = opts.beam_deg.round().rem_euclid(360.0) as u16;
-    let start = match opts
-        .start_distance_m
-        .or(rec.meta.world.target_start_distance_m)
-    {
+    // meta.toml's start distance is the frontal target's (interfaces.md): it says nothing about
+    // what another beam sees, so another beam needs its own start distance.
+    let meta_start = rec
+        .meta
+        .world
+        .target_start_distance_m
+        .filter(|_| beam_index == 0);
+    let start = match opts.start_distance_m.or(meta_start) {
         Some(d) if d.is_finite() && d > 0.0 => Some(d),
         Some(d) => {
             return Err(CalibrationError::Invalid(format!(
@@ -227,6 +232,17 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
         return Err(CalibrationError::Invalid(format!(
             "the lidar beam at {beam_index}° never returned a valid reading in {} revolutions: \
              it never sees a target (choose another beam with --beam)",
+            t_s.len()
+        )));
+    }
+    // The method follows one target along one beam: a beam that loses it in most revolutions is
+    // looking at something else (or at nothing) and would give a confident wrong model.
+    let valid = lidar_m.iter().flatten().count();
+    if 2 * valid < t_s.len() {
+        return Err(CalibrationError::Invalid(format!(
+            "the lidar beam at {beam_index}° returned a valid reading in only {valid} of {} \
+             revolutions: it does not see one target throughout the run (choose another beam \
+             with --beam)",
             t_s.len()
         )));
     }

@@ -1,0 +1,144 @@
+//! `hilsim calibrate` and `hilsim smooth` on recordings: the JSON of interfaces.md, and bad
+//! recordings refused with one line and exit code 2.
+
+use super::common::*;
+
+fn record(dir: &std::path::Path, scenario: &str, out: &str) {
+    let path = repo_file(&format!("scenarios/{scenario}"));
+    let o = hilsim(dir, &["record", path.to_str().unwrap(), "--out", out]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(out));
+    serde_json::from_str(&stdout(out)).unwrap()
+}
+
+#[test]
+fn em_and_groundtruth_print_the_interface_json() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    for method in ["em", "groundtruth"] {
+        let v = json(&hilsim(
+            tmp.path(),
+            &["calibrate", "rec", "--method", method, "--json"],
+        ));
+        assert_eq!(v["method"], method);
+        assert_eq!(v["sensors"]["lidar"]["alpha"].as_array().unwrap().len(), 3);
+        assert_eq!(v["sensors"]["sonar"]["alpha"].as_array().unwrap().len(), 2);
+        assert_eq!(
+            v["sensors"]["odometer"]["beta"].as_array().unwrap().len(),
+            1
+        );
+        assert!(v["iterations"].as_u64().unwrap() >= 1);
+        assert_eq!(v["converged"], true);
+        let m = &v["metrics"];
+        // The raw lidar's quadratic bias is far from the truth; any calibration beats it.
+        assert!(m["mse_calibrated"].as_f64().unwrap() < m["mse_raw"].as_f64().unwrap() / 3.0);
+    }
+}
+
+#[test]
+fn landmarks_add_order_and_landmarks_and_metrics_need_truth() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "landmarks-5.toml", "rec");
+    let v = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "landmarks", "--json"],
+    ));
+    assert_eq!(v["order"], 2);
+    assert_eq!(v["landmarks"].as_array().unwrap().len(), 5);
+    assert!(v["metrics"].is_object());
+    // Without truth (and true ranges) there is nothing to score against: no metrics.
+    std::fs::remove_file(tmp.path().join("rec/truth.csv")).unwrap();
+    let lidar = std::fs::read_to_string(tmp.path().join("rec/lidar.csv")).unwrap();
+    let stripped: String = lidar
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
+        .collect();
+    std::fs::write(tmp.path().join("rec/lidar.csv"), stripped).unwrap();
+    let v = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "landmarks", "--json"],
+    ));
+    assert!(v.get("metrics").is_none(), "{v}");
+    assert_eq!(v["landmarks"].as_array().unwrap().len(), 5);
+}
+
+#[test]
+fn smooth_applies_a_trained_calibration_to_another_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "train");
+    record(tmp.path(), "straight-board-0.3.toml", "test");
+    let cal = hilsim(
+        tmp.path(),
+        &["calibrate", "train", "--method", "em", "--json"],
+    );
+    std::fs::write(tmp.path().join("cal.json"), &cal.stdout).unwrap();
+    let o = hilsim(
+        tmp.path(),
+        &[
+            "smooth",
+            "test",
+            "--calibration",
+            "cal.json",
+            "--csv",
+            "d.csv",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(tmp.path().join("d.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("t_s,distance_m,sd_m"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // 13.7 s at 5 revolutions per second; the run ends ~4 m from the board.
+    assert!(rows.len() >= 60, "{}", rows.len());
+    let last = rows.last().unwrap();
+    assert!((3.5..4.5).contains(&last[1]), "{last:?}");
+    assert!(last[2] > 0.0 && last[2] < 0.1, "{last:?}");
+}
+
+#[test]
+fn bad_recordings_exit_2_with_one_line_naming_the_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    let run = |args: &[&str]| assert_bad_input(&hilsim(tmp.path(), args));
+    // A missing recording.
+    let err = run(&["calibrate", "nowhere", "--method", "em"]);
+    assert!(err.contains("nowhere"), "{err}");
+    // Time going backwards in the lidar table.
+    let lidar = tmp.path().join("rec/lidar.csv");
+    let text = std::fs::read_to_string(&lidar).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.swap(5, 6);
+    std::fs::write(&lidar, lines.join("\n") + "\n").unwrap();
+    let err = run(&["calibrate", "rec", "--method", "em"]);
+    assert!(err.contains("lidar.csv:7: time goes backwards"), "{err}");
+    // NaN.
+    std::fs::write(&lidar, text.replacen(",0.509,", ",nan,", 1)).unwrap();
+    let err = run(&["calibrate", "rec", "--method", "groundtruth"]);
+    assert!(err.contains("lidar.csv:2:"), "{err}");
+    std::fs::write(&lidar, &text).unwrap();
+    // A beam that does not see the target (backwards: the far wall, mostly beyond range) must
+    // be refused, not fitted into a confident wrong model.
+    let err = run(&[
+        "calibrate",
+        "rec",
+        "--method",
+        "em",
+        "--beam",
+        "180",
+        "--start-distance",
+        "8.5",
+    ]);
+    assert!(err.contains("returned a valid reading in only"), "{err}");
+    // meta.toml's start distance is the frontal target's: another beam needs its own.
+    let err = run(&["calibrate", "rec", "--method", "em", "--beam", "-5"]);
+    assert!(err.starts_with("hilsim: rec: em: "), "{err}");
+    // A calibration file that is not one.
+    std::fs::write(tmp.path().join("cal.json"), "{\"method\": \"magic\"}").unwrap();
+    let err = run(&["smooth", "rec", "--calibration", "cal.json"]);
+    assert!(err.contains("cal.json"), "{err}");
+}

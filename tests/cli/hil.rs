@@ -293,13 +293,15 @@ fn a_firmware_that_never_reads_the_lidar_fails_the_run() {
         "the firmware never read the lidar port: it took ",
         "sonar only",
     );
-    // It took nothing; a packet still in the pty's hands may count as taken.
+    // It took nothing. The harness counts written − discarded − backlog, and the backlog it can
+    // see (FIONREAD) misses bytes still in the kernel's flip buffers, which a loaded machine may
+    // hold for a while: so assert the fault's own threshold, under one revolution (1,980 bytes).
     let took: u64 = text
         .split("it took ")
         .nth(1)
         .and_then(|rest| rest.split(' ').next()?.parse().ok())
         .unwrap();
-    assert!(took <= 22, "{text}");
+    assert!(took < 1980, "{text}");
 }
 
 #[test]

@@ -37,6 +37,10 @@ pub enum Command {
     Dataset(crate::commands::dataset::DatasetArgs),
     /// Run a firmware build in the loop with the lidar and robot command ports.
     Hil(crate::commands::hil::HilArgs),
+    /// Compare a simulation with a real recording: locate the mismatch, name the physics the
+    /// simulation left out, fit it and show the held-out improvement (or prove it blind with
+    /// `--self-test N`).
+    Diagnose(crate::commands::diagnose::DiagnoseArgs),
 }
 
 #[derive(Debug, clap::Args)]

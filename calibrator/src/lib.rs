@@ -13,6 +13,7 @@ pub mod error;
 pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
+pub mod mismatch;
 pub mod smoothing;
 pub mod target_samples;
 

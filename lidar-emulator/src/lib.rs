@@ -9,6 +9,7 @@ pub mod lidar;
 mod mount;
 pub mod neato_packet;
 mod odometer;
+pub mod prediction;
 mod range_model;
 mod sonar;
 pub mod wire;

@@ -97,6 +97,12 @@ impl Sonar {
         self.model.mean(d_m * self.range_scale)
     }
 
+    /// The standard deviation of the reading for a nearest echo at `d_m`.
+    #[must_use]
+    pub fn reading_sd_m(&self, d_m: f64) -> f64 {
+        self.model.std_dev(d_m * self.range_scale)
+    }
+
     /// The range model.
     #[must_use]
     pub fn model(&self) -> &RangeModel {

@@ -27,6 +27,7 @@ mod actuation;
 pub mod drive;
 mod motor_lag;
 pub mod pose;
+pub mod replay;
 pub mod rng;
 pub mod scenario;
 mod simulation;

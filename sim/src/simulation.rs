@@ -8,7 +8,7 @@ use rapier2d::prelude::*;
 use crate::actuation::ActuationError;
 use crate::drive::{DriveProgram, WheelCommand};
 use crate::motor_lag::MotorLag;
-use crate::pose::{wrap_angle, Pose};
+use crate::pose::Pose;
 use crate::scenario::Scenario;
 use crate::world::{Obstacle, World};
 
@@ -250,13 +250,7 @@ impl Simulation {
     /// displacement and turn, split onto the wheels. A robot pushed against a wall stalls its
     /// wheels: they report what the body did, not what was commanded.
     fn wheel_travel(&self, p0: Pose, p1: Pose) -> [f64; 2] {
-        let mid_yaw = p0.yaw + wrap_angle(p1.yaw - p0.yaw) / 2.0;
-        let forward = (p1.x - p0.x) * mid_yaw.cos() + (p1.y - p0.y) * mid_yaw.sin();
-        let turn = wrap_angle(p1.yaw - p0.yaw) * self.wheel_base_m / 2.0;
-        [
-            self.wheels[0] + forward - turn,
-            self.wheels[1] + forward + turn,
-        ]
+        crate::replay::wheel_travel(self.wheels, &p0, &p1, self.wheel_base_m)
     }
 
     fn log_contacts(&mut self, t: f64) {

@@ -2,6 +2,7 @@
 
 pub mod calibrate;
 pub mod dataset;
+pub mod diagnose;
 pub mod hil;
 pub mod record;
 pub mod run;

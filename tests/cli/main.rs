@@ -5,6 +5,7 @@ mod bad_input;
 mod calibrate;
 mod common;
 mod dataset;
+mod diagnose;
 mod hil;
 mod record;
 mod run;

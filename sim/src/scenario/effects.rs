@@ -183,12 +183,26 @@ fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
     })
 }
 
+/// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
+fn shown(v: f64) -> String {
+    if v.is_nan() {
+        "nan".to_string()
+    } else if v.is_infinite() {
+        if v > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        v.to_string()
+    }
+}
+
 /// `v` must be finite and lie in `[lo, hi]`.
 fn within(path: Vec<Key>, v: f64, lo: f64, hi: f64, what: &str) -> Check {
     if v.is_finite() && (lo..=hi).contains(&v) {
         Ok(())
     } else {
-        fail(path, format!("expected {what} in {lo}..={hi}, found {v}"))
+        fail(
+            path,
+            format!("expected {what} in {lo}..={hi}, found {}", shown(v)),
+        )
     }
 }
 
@@ -197,7 +211,10 @@ fn positive_up_to(path: Vec<Key>, v: f64, hi: f64, what: &str) -> Check {
     if v.is_finite() && v > 0.0 && v <= hi {
         Ok(())
     } else {
-        fail(path, format!("expected {what} in (0, {hi}], found {v}"))
+        fail(
+            path,
+            format!("expected {what} in (0, {hi}], found {}", shown(v)),
+        )
     }
 }
 
@@ -264,7 +281,7 @@ pub(crate) fn validate(s: &Scenario) -> Check {
                 p("half_angle_deg"),
                 format!(
                     "expected 0 ≤ half_angle_deg < 90, found {}",
-                    x.half_angle_deg
+                    shown(x.half_angle_deg)
                 ),
             );
         }

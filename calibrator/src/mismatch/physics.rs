@@ -1,0 +1,232 @@
+//! The physics the diagnosis asks about, behind a small trait: what the scenario's sensors
+//! should read from a trajectory, and where its robot goes under recorded commands — nominally,
+//! or with one catalogued effect switched on with given parameters. `hilsim` implements it from
+//! the simulator (`hilsim-sim`, `hilsim-lidar-emulator`); this crate never depends on them (or on
+//! rapier), so the statistics here would work with any simulator that implements the trait.
+
+use hilsim_recording::{CommandSample, TruthSample};
+
+use super::catalogue::Effect;
+use super::trajectory::{Pose2, Trajectory};
+
+/// A model to predict with: the nominal one, or the nominal one with one effect switched on
+/// with `params` (in the order of [`Effect::params`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hypothesis {
+    /// The effect switched on; `None`: the nominal model.
+    pub effect: Option<Effect>,
+    /// Its parameters.
+    pub params: Vec<f64>,
+}
+
+impl Hypothesis {
+    /// The scenario as declared.
+    #[must_use]
+    pub fn nominal() -> Self {
+        Self {
+            effect: None,
+            params: Vec::new(),
+        }
+    }
+
+    /// The scenario with `effect` switched on with `params`.
+    #[must_use]
+    pub fn with(effect: Effect, params: Vec<f64>) -> Self {
+        Self {
+            effect: Some(effect),
+            params,
+        }
+    }
+
+    /// The `i`-th parameter when `effect` is the one switched on.
+    #[must_use]
+    pub fn param_of(&self, effect: Effect, i: usize) -> Option<f64> {
+        (self.effect == Some(effect))
+            .then(|| self.params.get(i).copied())
+            .flatten()
+    }
+}
+
+/// What the scenario declares that the diagnosis needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Declared {
+    /// The scenario's name.
+    pub scenario: String,
+    /// The robot's start pose.
+    pub start: Pose2,
+    /// The distance between the wheels, metres.
+    pub wheel_base_m: f64,
+    /// The lidar, when the robot has one.
+    pub lidar: Option<DeclaredLidar>,
+    /// The sonar's declared cone half-angle (degrees), when the robot has a sonar.
+    pub sonar_half_angle_deg: Option<f64>,
+    /// Whether the robot has wheel encoders.
+    pub odometer: bool,
+    /// The declared actuation error's standard deviation (fixed and wandering scale errors
+    /// combined, √(scale_sd² + wander_sd²)); 0 for an ideal drive.
+    pub actuation_sd: f64,
+}
+
+/// What the scenario declares about the lidar.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeclaredLidar {
+    /// Every reading of a revolution from the pose at its start (`timing = "per_revolution"`).
+    pub snapshot: bool,
+    /// The motor speed, rpm.
+    pub rpm: f64,
+    /// The farthest valid range, metres.
+    pub max_range_m: f64,
+}
+
+/// One Gaussian of a predictive mixture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gaussian {
+    /// Weight (a prediction's weights sum to 1).
+    pub weight: f64,
+    /// Mean, metres.
+    pub mean_m: f64,
+    /// Standard deviation, metres (> 0).
+    pub sd_m: f64,
+}
+
+/// One lidar reading to predict.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LidarQuery {
+    /// Its timestamp, seconds.
+    pub t_s: f64,
+    /// When its revolution started (the timestamp of its reading 0), seconds.
+    pub rev_start_s: f64,
+    /// Its angle in the lidar's frame, degrees.
+    pub angle_deg: f64,
+}
+
+/// The predictive distribution of one lidar reading, with its geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LidarPrediction {
+    /// The mixture a valid reading comes from; empty: no valid reading expected.
+    pub components: Vec<Gaussian>,
+    /// The centre ray's true range, metres.
+    pub true_range_m: Option<f64>,
+    /// The angle between the beam and the surface normal, degrees.
+    pub incidence_deg: f64,
+    /// What the beam hit (an index for [`Physics::object_name`]).
+    pub object: Option<u32>,
+    /// Its reflectivity.
+    pub reflectivity: f64,
+    /// Whether the beam's direction noise or footprint reaches another surface.
+    pub near_edge: bool,
+}
+
+/// The predictive distribution of one sonar ping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SonarPrediction {
+    /// The expected reading; `None`: no echo within range expected.
+    pub reading: Option<Gaussian>,
+    /// The nearest echo's true range in the hypothesis's cone, metres.
+    pub true_range_m: Option<f64>,
+    /// The nearest echo within 30° of the axis, metres (where a wider cone would look).
+    pub wide_cone_m: Option<f64>,
+}
+
+/// The predictive distribution of one odometer reading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OdometryPrediction {
+    /// Left and right wheels.
+    pub wheels: [Gaussian; 2],
+    /// The wheels' speeds then, m/s.
+    pub speed_mps: [f64; 2],
+}
+
+/// The simulator, as the diagnosis sees it.
+///
+/// Every method is a pure function of its arguments: the same question gets the same answer
+/// (the diagnosis asks many times while it fits). A `Hypothesis` whose effect does not concern
+/// the sensor asked about leaves its predictions nominal.
+///
+/// ```
+/// use hilsim_calibrator::mismatch::*;
+/// use hilsim_recording::{CommandSample, TruthSample};
+///
+/// /// A robot that never moves, in front of a wall 2 m ahead of its start.
+/// struct Corridor(Declared);
+/// impl Physics for Corridor {
+///     fn declared(&self) -> &Declared { &self.0 }
+///     fn object_name(&self, _: u32) -> String { "wall 0".into() }
+///     fn drive(&self, _: &[CommandSample], end_s: f64, _: &Hypothesis) -> Vec<TruthSample> {
+///         vec![TruthSample { t_s: 0.0, x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 },
+///              TruthSample { t_s: end_s, x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 }]
+///     }
+///     fn lidar(&self, tr: &Trajectory, q: &[LidarQuery], _: &Hypothesis) -> Vec<LidarPrediction> {
+///         q.iter().map(|q| {
+///             let p = tr.pose_at(q.t_s);
+///             let d = (2.0 - p.x) / (p.yaw + q.angle_deg.to_radians()).cos();
+///             LidarPrediction {
+///                 components: vec![Gaussian { weight: 1.0, mean_m: d, sd_m: 0.01 }],
+///                 true_range_m: Some(d), incidence_deg: q.angle_deg, object: Some(0),
+///                 reflectivity: 0.8, near_edge: false,
+///             }
+///         }).collect()
+///     }
+///     fn sonar(&self, _: &Trajectory, t: &[f64], _: &Hypothesis) -> Vec<SonarPrediction> {
+///         t.iter().map(|_| SonarPrediction { reading: None, true_range_m: None, wide_cone_m: None }).collect()
+///     }
+///     fn odometry(&self, _: &Trajectory, t: &[f64], _: &Hypothesis) -> Vec<OdometryPrediction> {
+///         let g = Gaussian { weight: 1.0, mean_m: 0.0, sd_m: 0.001 };
+///         t.iter().map(|_| OdometryPrediction { wheels: [g, g], speed_mps: [0.0; 2] }).collect()
+///     }
+/// }
+/// let physics = Corridor(Declared {
+///     scenario: "corridor".into(), start: Pose2::default(), wheel_base_m: 0.23,
+///     lidar: Some(DeclaredLidar { snapshot: false, rpm: 300.0, max_range_m: 6.0 }),
+///     sonar_half_angle_deg: None, odometer: false, actuation_sd: 0.0,
+/// });
+/// let still = Trajectory::new(&physics.drive(&[], 1.0, &Hypothesis::nominal()))?;
+/// let ahead = physics.lidar(&still, &[LidarQuery { t_s: 0.5, rev_start_s: 0.4, angle_deg: 0.0 }],
+///                           &Hypothesis::nominal());
+/// assert_eq!(ahead[0].true_range_m, Some(2.0));
+/// # Ok::<(), MismatchError>(())
+/// ```
+pub trait Physics: Sync {
+    /// What the scenario declares.
+    fn declared(&self) -> &Declared;
+
+    /// A name for an object of [`LidarPrediction::object`], e.g. `board 1 (dark)`.
+    fn object_name(&self, object: u32) -> String;
+
+    /// The robot's trajectory from t = 0 to `end_s` when its wheels are commanded by `commands`
+    /// (the recording's `commands.csv`), under `hypothesis` (motor lag; any other effect leaves
+    /// the drive nominal). The declared actuation error is left out: it is noise to the
+    /// diagnosis, not a prediction.
+    fn drive(
+        &self,
+        commands: &[CommandSample],
+        end_s: f64,
+        hypothesis: &Hypothesis,
+    ) -> Vec<TruthSample>;
+
+    /// The lidar readings `queries` from the robot on `trajectory`, under `hypothesis`. When
+    /// each reading's geometry is taken (its timestamp, its revolution's start, or in between
+    /// under motion skew) is the physics' to decide.
+    fn lidar(
+        &self,
+        trajectory: &Trajectory,
+        queries: &[LidarQuery],
+        hypothesis: &Hypothesis,
+    ) -> Vec<LidarPrediction>;
+
+    /// The sonar pings at `times` from the robot on `trajectory`, under `hypothesis`.
+    fn sonar(
+        &self,
+        trajectory: &Trajectory,
+        times: &[f64],
+        hypothesis: &Hypothesis,
+    ) -> Vec<SonarPrediction>;
+
+    /// The odometer readings at `times` from the robot on `trajectory`, under `hypothesis`.
+    fn odometry(
+        &self,
+        trajectory: &Trajectory,
+        times: &[f64],
+        hypothesis: &Hypothesis,
+    ) -> Vec<OdometryPrediction>;
+}

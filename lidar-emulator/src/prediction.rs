@@ -1,0 +1,418 @@
+//! Expected readings: what each sensor of a scenario should report from a given pose, noise-free,
+//! with the spread its declared noise gives — the predictive distribution of one reading. For
+//! estimators that hold the simulation against data (`hilsim diagnose`); the emulator itself
+//! draws from the same models (`lidar.rs`, `sonar.rs`, `odometer.rs`, `effects`).
+//!
+//! The lidar's beam direction is noisy (`angle_noise_deg`, σ_φ): on a surface met obliquely that
+//! turns into range noise (and, at grazing incidence, a skewed one), and near an edge the beam
+//! lands on one side or the other, or (with mixed pixels) anywhere between. On one surface the
+//! prediction integrates over the direction with 7-point Gauss–Hermite quadrature (exact for
+//! polynomials up to degree 13 in the angle error) into one Gaussian with the quadrature's mean
+//! and variance. When those directions reach another surface (or a footprint mixes), the
+//! reading is no smooth function of the direction: it is sampled every σ_φ/2 over ±3.5 σ_φ,
+//! each direction one Gaussian of the mixture, widened by the reading's change to its
+//! neighbours.
+//! Readings are millimetres, so every spread includes the rounding's `1 mm / √12`.
+
+use hilsim_sim::{scenario, Obstacle, Pose, World};
+
+use crate::effects::{BeamReturn, LidarEffects};
+use crate::lidar::MAX_DISTANCE_MM;
+use crate::mount::Mount;
+use crate::range_model::{ModelError, RangeModel};
+use crate::sonar::Sonar;
+
+/// `P(Z ≤ z)` for a standard normal Z (Abramowitz & Stegun 7.1.26 for erf: absolute error
+/// below 1.5e-7, ample for a weight).
+fn normal_cdf(z: f64) -> f64 {
+    let x = z.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.327_591_1 * x);
+    let poly = t
+        * (0.254_829_592
+            + t * (-0.284_496_736
+                + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
+    let erf = 1.0 - poly * (-x * x).exp();
+    if z >= 0.0 {
+        0.5 * (1.0 + erf)
+    } else {
+        0.5 * (1.0 - erf)
+    }
+}
+
+/// Variance of rounding to whole millimetres, m².
+const ROUNDING_VAR_M2: f64 = 1e-6 / 12.0;
+
+/// 7-point Gauss–Hermite nodes `x_k` for `∫ e^{−x²} f(x) dx` (Abramowitz & Stegun, table 25.10),
+/// and the weights divided by √π, so that `E f(σ z) ≈ Σ w_k f(√2 σ x_k)` for z ~ N(0, 1).
+const GH_NODES: [f64; 7] = [
+    -2.651_961_356_835_233,
+    -1.673_551_628_767_471,
+    -0.816_287_882_858_965,
+    0.0,
+    0.816_287_882_858_965,
+    1.673_551_628_767_471,
+    2.651_961_356_835_233,
+];
+const GH_WEIGHTS: [f64; 7] = [
+    0.000_548_268_855_972,
+    0.030_757_123_967_586,
+    0.240_123_178_605_013,
+    0.457_142_857_142_857,
+    0.240_123_178_605_013,
+    0.030_757_123_967_586,
+    0.000_548_268_855_972,
+];
+
+/// Directions sampled across an edge: every half σ over ±3.5 σ of the direction noise (the
+/// Gaussian's mass beyond is 5e-4).
+const DENSE_NODES: usize = 15;
+const DENSE_SPACING: f64 = 0.5;
+
+/// One Gaussian of a predictive mixture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Component {
+    /// Its weight; a prediction's weights sum to 1.
+    pub weight: f64,
+    /// The expected reading, metres.
+    pub mean_m: f64,
+    /// The reading's standard deviation, metres.
+    pub sd_m: f64,
+}
+
+/// The predictive distribution of one lidar reading, and the beam's geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExpectedLidar {
+    /// The mixture a valid reading is drawn from: one Gaussian per surface the beam's direction
+    /// noise can land on; empty when no valid reading is expected (nothing hit, or out of
+    /// range).
+    pub components: Vec<Component>,
+    /// The centre ray's true range, when it hit something.
+    pub true_range_m: Option<f64>,
+    /// `|cos θ|` of the centre ray on its surface.
+    pub cos_incidence: f64,
+    /// What the centre ray hit.
+    pub obstacle: Option<Obstacle>,
+    /// The reflectivity of what it hit.
+    pub reflectivity: f64,
+    /// Whether the beam's direction noise (or its footprint) reaches another surface.
+    pub near_edge: bool,
+}
+
+/// What a beam's quadrature directions see: the geometry of one reading, before any range
+/// error. It depends on the pose, the angle and the beam's footprint (mixed pixels) only, so it
+/// can be computed once and predicted from under many parameters of the other effects.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamNodes {
+    /// (weight, what the direction returned) per quadrature node; one node, weight 1, without
+    /// direction noise. The centre node is `centre`.
+    pub nodes: Vec<(f64, Option<BeamReturn>)>,
+    /// The index of the centre direction in `nodes`.
+    pub centre: usize,
+    /// Whether the nodes sample the direction densely (an edge within reach) rather than by
+    /// Gauss–Hermite quadrature.
+    pub dense: bool,
+}
+
+/// Predicts the readings of a scenario's lidar with given effects.
+#[derive(Debug, Clone)]
+pub struct LidarPredictor {
+    model: RangeModel,
+    mount: Mount,
+    angle_noise_rad: f64,
+    min_m: f64,
+    max_m: f64,
+    cast_limit_m: f64,
+    effects: LidarEffects,
+}
+
+impl LidarPredictor {
+    /// The predictor of `config`'s lidar with `effects` switched on.
+    ///
+    /// # Errors
+    /// A range model that makes no sense.
+    pub fn new(config: &scenario::Lidar, effects: LidarEffects) -> Result<Self, ModelError> {
+        Ok(Self {
+            model: RangeModel::builder()
+                .bias(&config.bias)
+                .noise(&config.noise)
+                .build()?,
+            mount: config.mount.into(),
+            angle_noise_rad: config.angle_noise_deg.to_radians(),
+            min_m: config.min_range_m,
+            max_m: config.max_range_m,
+            cast_limit_m: (config.max_range_m * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0),
+            effects,
+        })
+    }
+
+    /// The effects it predicts with.
+    #[must_use]
+    pub fn effects(&self) -> &LidarEffects {
+        &self.effects
+    }
+
+    /// The lidar's origin and the beam's direction for `angle_deg` when the robot is at `robot`.
+    fn beam(&self, robot: &Pose, angle_deg: f64) -> ([f64; 2], f64) {
+        let sensor = self.mount.in_world(robot);
+        ([sensor.x, sensor.y], sensor.yaw + angle_deg.to_radians())
+    }
+
+    /// The beam's quadrature directions and what each returns (with the footprint of mixed
+    /// pixels when that effect is on).
+    #[must_use]
+    pub fn beam_nodes(&self, world: &World, robot: &Pose, angle_deg: f64) -> BeamNodes {
+        let (origin, heading) = self.beam(robot, angle_deg);
+        let cast = |o: f64| {
+            self.effects
+                .beam_return(world, origin, heading + o, self.cast_limit_m)
+        };
+        if self.angle_noise_rad <= 0.0 {
+            return BeamNodes {
+                nodes: vec![(1.0, cast(0.0))],
+                centre: 0,
+                dense: false,
+            };
+        }
+        let sigma = self.angle_noise_rad;
+        let nodes: Vec<(f64, Option<BeamReturn>)> = GH_NODES
+            .iter()
+            .zip(GH_WEIGHTS)
+            .map(|(x, w)| (w, cast(std::f64::consts::SQRT_2 * sigma * x)))
+            .collect();
+        let centre = nodes[3].1.map(|r| r.hit.obstacle);
+        let uniform = nodes.iter().all(|(_, r)| {
+            r.map(|r| r.hit.obstacle) == centre && r.is_none_or(|r| r.footprint_m == r.hit.distance)
+        });
+        if uniform {
+            return BeamNodes {
+                nodes,
+                centre: 3,
+                dense: false,
+            };
+        }
+        // An edge (or a footprint that mixes) within reach of the direction noise: the reading
+        // is no longer a smooth function of the direction, so sample it densely.
+        let half = DENSE_NODES / 2;
+        let nodes = (0..DENSE_NODES)
+            .map(|k| {
+                let x = (k as f64 - half as f64) * DENSE_SPACING;
+                ((-0.5 * x * x).exp(), cast(x * sigma))
+            })
+            .collect::<Vec<_>>();
+        let total: f64 = nodes.iter().map(|(w, _)| w).sum();
+        BeamNodes {
+            nodes: nodes.into_iter().map(|(w, r)| (w / total, r)).collect(),
+            centre: half,
+            dense: true,
+        }
+    }
+
+    /// Whether no surface but the centre's lies within `margin_rad` (beyond the quadrature's
+    /// reach) of the beam, sampled every 0.25°: then no footprint up to that half-width mixes.
+    #[must_use]
+    pub fn clear_of_edges(
+        &self,
+        world: &World,
+        robot: &Pose,
+        angle_deg: f64,
+        margin_rad: f64,
+    ) -> bool {
+        let (origin, heading) = self.beam(robot, angle_deg);
+        let reach = margin_rad + 3.0 * self.angle_noise_rad;
+        let centre = world
+            .cast_ray(origin, heading, self.cast_limit_m)
+            .map(|h| h.obstacle);
+        let step = 0.25f64.to_radians();
+        let n = (reach / step).ceil() as i64;
+        (-n..=n).filter(|k| *k != 0).all(|k| {
+            world
+                .cast_ray(origin, heading + k as f64 * step, self.cast_limit_m)
+                .map(|h| h.obstacle)
+                == centre
+        })
+    }
+
+    /// The predictive distribution of a reading whose beam saw `beam`, `t_s` seconds after
+    /// power-on. The nodes are grouped by the surface they landed on; each group becomes one
+    /// Gaussian with the group's weight and the quadrature's mean and variance of the reading
+    /// over it (range noise and rounding included), so a surface met obliquely gets the spread
+    /// (and the skew of the mean) its direction noise gives, and an edge a mixture.
+    #[must_use]
+    pub fn predict_nodes(&self, beam: &BeamNodes, t_s: f64) -> ExpectedLidar {
+        let centre = beam.nodes.get(beam.centre).and_then(|(_, r)| *r);
+        let mut out = ExpectedLidar {
+            components: Vec::new(),
+            true_range_m: centre.map(|c| c.hit.distance),
+            cos_incidence: centre.map_or(1.0, |c| c.cos_incidence),
+            obstacle: centre.map(|c| c.hit.obstacle),
+            reflectivity: centre.map_or(0.0, |c| c.hit.reflectivity),
+            near_edge: false,
+        };
+        // (weight, mean, variance, surface) per node whose reading can be valid.
+        let mut nodes: Vec<Option<(f64, f64, f64, Obstacle)>> =
+            Vec::with_capacity(beam.nodes.len());
+        for (w, ret) in &beam.nodes {
+            let Some(ret) = ret else {
+                out.near_edge |= centre.is_some();
+                nodes.push(None);
+                continue;
+            };
+            out.near_edge |= ret.footprint_m != ret.hit.distance;
+            let ranged = self.effects.ranged_m(ret, t_s);
+            let mean = self.model.mean(ranged);
+            let sd = self.model.std_dev(ranged);
+            let var = sd * sd + ROUNDING_VAR_M2;
+            // A reading outside [min, max] is reported invalid: a valid one comes from the part
+            // of each node's distribution inside (its weight the probability of landing there).
+            let valid = normal_cdf((self.max_m - mean) / var.sqrt())
+                - normal_cdf((self.min_m - mean) / var.sqrt());
+            nodes.push((valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle)));
+        }
+        if beam.dense {
+            out.near_edge = true;
+            // One Gaussian per node, widened by the spread of the reading across the node's
+            // share of directions: the slope to its neighbours on the same surface (or across a
+            // mixing footprint, where the reading is continuous) times the spacing, / √12.
+            for k in 0..nodes.len() {
+                let Some((w, mean, var, what)) = nodes[k] else {
+                    continue;
+                };
+                let step = |j: Option<usize>| {
+                    j.and_then(|j| nodes.get(j).copied().flatten())
+                        .filter(|n| n.3 == what || (n.1 - mean).abs() < 10.0 * var.sqrt())
+                        .map(|n| (n.1 - mean).abs())
+                };
+                let steps: Vec<f64> = [step(k.checked_sub(1)), step(Some(k + 1))]
+                    .into_iter()
+                    .flatten()
+                    .collect();
+                let spread = if steps.is_empty() {
+                    0.0
+                } else {
+                    steps.iter().sum::<f64>() / steps.len() as f64
+                };
+                out.components.push(Component {
+                    weight: w,
+                    mean_m: mean,
+                    sd_m: (var + spread * spread / 12.0).sqrt(),
+                });
+            }
+        } else {
+            // One surface: the quadrature's mean and variance of the reading over the direction
+            // noise, one Gaussian per surface (a single one unless a node fell off the range).
+            let mut groups: Vec<(Obstacle, f64, f64, f64)> = Vec::with_capacity(1);
+            for (w, mean, var, what) in nodes.into_iter().flatten() {
+                match groups.iter_mut().find(|g| g.0 == what) {
+                    Some(g) => {
+                        g.1 += w;
+                        g.2 += w * mean;
+                        g.3 += w * (var + mean * mean);
+                    }
+                    None => groups.push((what, w, w * mean, w * (var + mean * mean))),
+                }
+            }
+            out.near_edge |= groups.len() > 1;
+            for (_, w, sm, ss) in groups {
+                let mean = sm / w;
+                let var = (ss / w - mean * mean).max(ROUNDING_VAR_M2);
+                out.components.push(Component {
+                    weight: w,
+                    mean_m: mean,
+                    sd_m: var.sqrt(),
+                });
+            }
+        }
+        let total: f64 = out.components.iter().map(|c| c.weight).sum();
+        if total > 0.0 {
+            for c in &mut out.components {
+                c.weight /= total;
+            }
+        }
+        out
+    }
+
+    /// The reading at `angle_deg` (lidar frame) when the robot is at `robot`, `t_s` seconds
+    /// after power-on.
+    #[must_use]
+    pub fn predict(&self, world: &World, robot: &Pose, angle_deg: f64, t_s: f64) -> ExpectedLidar {
+        self.predict_nodes(&self.beam_nodes(world, robot, angle_deg), t_s)
+    }
+}
+
+/// The expected reading of a sonar ping, and the echo's true range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExpectedSonar {
+    /// The expected reading and its spread.
+    pub reading: Component,
+    /// The nearest echo's true range, metres.
+    pub true_range_m: f64,
+}
+
+/// Predicts the pings of a scenario's sonar with given effects.
+pub struct SonarPredictor {
+    sonar: Sonar,
+}
+
+impl SonarPredictor {
+    /// The predictor of `config`'s sonar with the `[effects]` that concern it (beam width,
+    /// speed of sound).
+    ///
+    /// # Errors
+    /// A range model that makes no sense.
+    pub fn new(config: &scenario::Sonar, effects: &scenario::Effects) -> Result<Self, ModelError> {
+        Ok(Self {
+            sonar: Sonar::with_effects(config, effects, 0)?,
+        })
+    }
+
+    /// The ping when the robot is at `robot`; `None`: no echo within range (no sample).
+    #[must_use]
+    pub fn predict(&self, world: &World, robot: &Pose) -> Option<ExpectedSonar> {
+        let d = self.sonar.nearest_echo(world, robot)?;
+        let mean = self.sonar.mean_reading_m(d);
+        let sd = self.sonar.reading_sd_m(d);
+        Some(ExpectedSonar {
+            reading: Component {
+                weight: 1.0,
+                mean_m: mean,
+                sd_m: (sd * sd + ROUNDING_VAR_M2).sqrt(),
+            },
+            true_range_m: d,
+        })
+    }
+}
+
+/// Predicts the encoders' readings from the wheels' true travel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OdometerPredictor {
+    scale: f64,
+    sd_m: f64,
+    slip_gain_s: Option<f64>,
+}
+
+impl OdometerPredictor {
+    /// The predictor of `config`'s encoders with `[effects.odometer_wheel_slip]` when on.
+    #[must_use]
+    pub fn new(config: &scenario::Odometer, effects: &scenario::Effects) -> Self {
+        let tick_var = config.tick_m * config.tick_m / 12.0;
+        Self {
+            scale: 1.0 + config.slip,
+            sd_m: (config.noise_m * config.noise_m + tick_var).sqrt(),
+            slip_gain_s: effects.odometer_wheel_slip.map(|e| e.gain_s),
+        }
+    }
+
+    /// The expected reading of one wheel whose true cumulative travel is `travel_m` while it
+    /// turns at `speed_mps` (its speed during the physics step), and the reading's spread.
+    #[must_use]
+    pub fn predict(&self, travel_m: f64, speed_mps: f64) -> Component {
+        let slip = self
+            .slip_gain_s
+            .map_or(0.0, |g| crate::effects::slip_travel_m(g, speed_mps));
+        Component {
+            weight: 1.0,
+            mean_m: (travel_m + slip) * self.scale,
+            sd_m: self.sd_m,
+        }
+    }
+}

@@ -1,0 +1,178 @@
+//! `hilsim diagnose --sim SCENARIO --real RECORDING [--json] [--report DIR]` and
+//! `hilsim diagnose --self-test N [--seed S] [--sim SCENARIO] [--json]`.
+//!
+//! Exit codes: 0 when a verdict is reached (`none`, an effect, or `unexplained`: each is an
+//! answer); 2 on bad input, including a recording the diagnosis refuses (too short, no sensor in
+//! common, not a run of the scenario), with one line naming the file and the reason. The
+//! self-test exits 1 when it misses one of its goals.
+
+mod physics;
+mod self_test;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use hilsim_calibrator::mismatch::{self, show, Options};
+use hilsim_recording::{write_file_atomically, Recording};
+
+pub use physics::SimPhysics;
+
+/// Compare a simulation with a real recording: locate the mismatch, name the physics left out,
+/// fit it, show the held-out improvement. Or prove it blind with `--self-test N`.
+#[derive(Debug, clap::Args)]
+pub struct DiagnoseArgs {
+    /// The scenario the recording is a run of (for `--self-test`: the nominal scenario, default
+    /// the built-in `scenarios/diagnose-room.toml`).
+    #[arg(long, value_name = "SCENARIO")]
+    pub sim: Option<PathBuf>,
+    /// The real recording (a directory in the recording format).
+    #[arg(long, value_name = "RECORDING", conflicts_with = "self_test")]
+    pub real: Option<PathBuf>,
+    /// Print the result as one JSON object (`interfaces.md`).
+    #[arg(long)]
+    pub json: bool,
+    /// Write the evidence as SVG plots and an HTML page (`index.html`) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Run N blind trials: each draws an effect (or none) and its parameters, records a "real"
+    /// run with it, diagnoses it against the nominal scenario and scores the answer.
+    #[arg(long, value_name = "N")]
+    pub self_test: Option<usize>,
+    /// Seed of the self-test's draws (default 1).
+    #[arg(long, value_name = "S", requires = "self_test")]
+    pub seed: Option<u64>,
+    /// Self-test: strength of the drawn effects, a factor on the documented moderate ranges.
+    #[arg(long, value_name = "X", requires = "self_test", default_value_t = 1.0)]
+    pub strength: f64,
+    /// Self-test: conceal only this effect in every trial (a catalogue name, or `none`), to
+    /// study one class.
+    #[arg(long, value_name = "EFFECT", requires = "self_test")]
+    pub only: Option<String>,
+    /// Self-test: run only trial I (of the N), print its whole diagnosis and, with `--report`,
+    /// write its report and its "real" recording (`DIR/recording`).
+    #[arg(long, value_name = "I", requires = "self_test")]
+    pub trial: Option<u64>,
+}
+
+/// The built-in scenario of the self-test.
+const SELF_TEST_SCENARIO: &str = include_str!("../../scenarios/diagnose-room.toml");
+
+pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
+    if let Some(n) = args.self_test {
+        if n == 0 {
+            bail!("--self-test: expected at least one trial");
+        }
+        if !(args.strength.is_finite() && args.strength > 0.0 && args.strength <= 5.0) {
+            bail!("--strength: expected a factor in (0, 5]");
+        }
+        let scenario = match &args.sim {
+            Some(path) => hilsim_sim::Scenario::load(path)?,
+            None => hilsim_sim::Scenario::from_toml(
+                SELF_TEST_SCENARIO,
+                Path::new("<built-in diagnose-room>"),
+            )?,
+        };
+        let seed = args.seed.unwrap_or(1);
+        let only = match args.only.as_deref() {
+            None => None,
+            Some("none") => Some(0),
+            Some(name) => match mismatch::Effect::from_name(name) {
+                Some(e) => Some(
+                    1 + mismatch::Effect::ALL
+                        .iter()
+                        .position(|x| *x == e)
+                        .unwrap_or(0),
+                ),
+                None => bail!("--only: expected `none` or a catalogued effect, found `{name}`"),
+            },
+        };
+        if let Some(i) = args.trial {
+            if i >= n as u64 {
+                bail!("--trial: expected a trial below --self-test {n}, found {i}");
+            }
+            return self_test::one(
+                &scenario,
+                seed,
+                i,
+                args.strength,
+                only,
+                args.json,
+                args.report.as_deref(),
+                out,
+            );
+        }
+        // The command that reproduces this self-test.
+        let mut command = format!("hilsim diagnose --self-test {n} --seed {seed}");
+        if let Some(sim) = &args.sim {
+            command += &format!(" --sim {}", sim.display());
+        }
+        if let Some(only) = &args.only {
+            command += &format!(" --only {only}");
+        }
+        if args.strength != 1.0 {
+            command += &format!(" --strength {}", args.strength);
+        }
+        return self_test::run(
+            &scenario,
+            n,
+            seed,
+            args.strength,
+            only,
+            args.json,
+            &command,
+            out,
+        );
+    }
+    let (Some(sim), Some(real)) = (&args.sim, &args.real) else {
+        bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
+    };
+    let scenario = super::load_scenario(Some(sim), None)?;
+    let recording = Recording::read_dir(real)?;
+    let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
+    let diagnosis = mismatch::diagnose(&physics, &recording, &Options::default())
+        .with_context(|| real.display().to_string())?;
+    if let Some(dir) = &args.report {
+        write_report(dir, &diagnosis, sim, real)?;
+    }
+    if args.json {
+        writeln!(out, "{}", show::to_json(&diagnosis))?;
+    } else {
+        out.write_all(show::summary(&diagnosis).as_bytes())?;
+        if let Some(dir) = &args.report {
+            writeln!(out, "report: {}", dir.join("index.html").display())?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `index.html` and its plots into `dir` (created if needed), each file atomically.
+pub(crate) fn write_report(
+    dir: &Path,
+    d: &mismatch::Diagnosis,
+    sim: &Path,
+    real: &Path,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let mut files = Vec::new();
+    for (i, p) in d.plots.iter().enumerate() {
+        let name = format!(
+            "residuals-{}-{}.svg",
+            i + 1,
+            p.variable.name().replace(' ', "-")
+        );
+        write_file_atomically(&dir.join(&name), show::svg(p).as_bytes())?;
+        files.push(name);
+    }
+    let title = format!(
+        "hilsim diagnose: {} against {}",
+        real.display(),
+        sim.display()
+    );
+    write_file_atomically(
+        &dir.join("index.html"),
+        show::html(d, &title, &files).as_bytes(),
+    )?;
+    Ok(())
+}

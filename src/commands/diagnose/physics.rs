@@ -1,0 +1,413 @@
+//! The diagnosis's physics (`hilsim_calibrator::mismatch::Physics`) from the simulator: the
+//! scenario's world and sensor models, with a catalogued effect switched on as the
+//! `[effects]` table of a scenario would. Glue only: every model lives in `hilsim-sim` and
+//! `hilsim-lidar-emulator` (`effects`, `prediction`, `replay`).
+
+use anyhow::{Context, Result};
+use hilsim_calibrator::mismatch::{
+    Declared, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
+    OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
+};
+use hilsim_lidar_emulator::effects::LidarEffects;
+use hilsim_lidar_emulator::prediction::{
+    BeamNodes, Component, LidarPredictor, OdometerPredictor, SonarPredictor,
+};
+use hilsim_recording::{CommandSample, TruthSample};
+use hilsim_sim::scenario::{self, Effects, LidarTiming};
+use hilsim_sim::{replay, Obstacle, Pose, Scenario, World};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::{Arc, RwLock};
+
+/// Readings predicted per parallel task.
+const CHUNK: usize = 2048;
+/// The widest beam the mixed-pixel fit tries (its catalogue range), radians.
+const MAX_HALF_WIDTH_RAD: f64 = 3.0 * std::f64::consts::PI / 180.0;
+
+/// A lidar reading's place: the robot's pose (x, y, yaw) and the beam's angle, bit for bit.
+type BeamKey = [u64; 4];
+/// Beams the caches hold at most (~1 KB each): a 60 s recording has 108,000 readings; beyond
+/// this (e.g. the many trial poses of a scan matcher) beams are cast again instead.
+const CACHE_CAPACITY: usize = 250_000;
+
+/// A scenario's simulation, answering the diagnosis's questions.
+pub struct SimPhysics {
+    scenario: Scenario,
+    world: World,
+    declared: Declared,
+    names: Vec<String>,
+    /// What each beam's quadrature directions see, without a footprint: the same under every
+    /// hypothesis but motion skew (another pose) and mixed pixels (another footprint), so the
+    /// fits of the other lidar effects cast no ray twice.
+    beams: RwLock<HashMap<BeamKey, Arc<BeamNodes>>>,
+    /// Whether no other surface lies within the widest footprint of a beam.
+    clear: RwLock<HashMap<BeamKey, bool>>,
+}
+
+fn gaussian(c: Component) -> Gaussian {
+    Gaussian {
+        weight: c.weight,
+        mean_m: c.mean_m,
+        sd_m: c.sd_m,
+    }
+}
+
+fn pose(p: Pose2) -> Pose {
+    Pose::new(p.x, p.y, p.yaw)
+}
+
+impl SimPhysics {
+    /// The physics of `scenario` as declared (its own `[effects]` included: they are part of
+    /// what it declares).
+    pub fn new(scenario: &Scenario) -> Result<Self> {
+        // Check the sensor models once, so that predicting cannot fail later.
+        if let Some(l) = &scenario.sensors.lidar {
+            LidarPredictor::new(l, LidarEffects::default()).context("lidar model")?;
+        }
+        if let Some(s) = &scenario.sensors.sonar {
+            SonarPredictor::new(s, &scenario.effects).context("sonar model")?;
+        }
+        let s = &scenario;
+        let a = s.robot.actuation;
+        let material = |m: &Option<String>| m.clone().unwrap_or_else(|| "default".into());
+        let mut names = Vec::new();
+        for (i, w) in s.world.walls.iter().enumerate() {
+            names.push(format!("wall {i} ({})", material(&w.material)));
+        }
+        for (i, c) in s.world.cylinders.iter().enumerate() {
+            names.push(format!("cylinder {i} ({})", material(&c.material)));
+        }
+        for (i, b) in s.world.boards.iter().enumerate() {
+            names.push(format!("board {i} ({})", material(&b.material)));
+        }
+        Ok(Self {
+            world: World::new(scenario),
+            declared: Declared {
+                scenario: s.name.clone(),
+                start: Pose2 {
+                    x: s.robot.start.x,
+                    y: s.robot.start.y,
+                    yaw: hilsim_sim::pose::wrap_angle(s.robot.start.yaw_deg.to_radians()),
+                },
+                wheel_base_m: s.robot.wheel_base_m,
+                lidar: s.sensors.lidar.as_ref().map(|l| DeclaredLidar {
+                    snapshot: l.timing == LidarTiming::PerRevolution
+                        && s.effects.lidar_motion_skew.is_none(),
+                    rpm: l.rpm,
+                    max_range_m: l.max_range_m,
+                }),
+                sonar_half_angle_deg: s.sensors.sonar.as_ref().map(|u| {
+                    s.effects
+                        .sonar_beam_width
+                        .map_or(u.half_angle_deg, |b| b.half_angle_deg)
+                }),
+                odometer: s.sensors.odometer.is_some(),
+                actuation_sd: a.scale_sd.hypot(a.wander_sd),
+            },
+            scenario: scenario.clone(),
+            names,
+            beams: RwLock::default(),
+            clear: RwLock::default(),
+        })
+    }
+
+    /// The beam's quadrature directions from the cache, cast on a miss (without a footprint).
+    fn cached_beam(
+        &self,
+        geometry: &LidarPredictor,
+        key: BeamKey,
+        robot: &Pose,
+        angle: f64,
+    ) -> Arc<BeamNodes> {
+        if let Some(b) = self.beams.read().ok().and_then(|m| m.get(&key).cloned()) {
+            return b;
+        }
+        let b = Arc::new(geometry.beam_nodes(&self.world, robot, angle));
+        if let Ok(mut m) = self.beams.write() {
+            if m.len() < CACHE_CAPACITY {
+                m.insert(key, b.clone());
+            }
+        }
+        b
+    }
+
+    fn cached_clear(
+        &self,
+        geometry: &LidarPredictor,
+        key: BeamKey,
+        robot: &Pose,
+        angle: f64,
+    ) -> bool {
+        if let Some(c) = self.clear.read().ok().and_then(|m| m.get(&key).copied()) {
+            return c;
+        }
+        let c = geometry.clear_of_edges(&self.world, robot, angle, MAX_HALF_WIDTH_RAD);
+        if let Ok(mut m) = self.clear.write() {
+            if m.len() < CACHE_CAPACITY {
+                m.insert(key, c);
+            }
+        }
+        c
+    }
+
+    fn object_id(&self, o: Obstacle) -> u32 {
+        let w = &self.scenario.world;
+        (match o {
+            Obstacle::Wall(i) => i,
+            Obstacle::Cylinder(i) => w.walls.len() + i,
+            Obstacle::Board(i) => w.walls.len() + w.cylinders.len() + i,
+        }) as u32
+    }
+
+    /// The scenario's effects with the hypothesis's switched on over them.
+    fn effects(&self, h: &Hypothesis) -> Effects {
+        let mut e = self.scenario.effects.clone();
+        let p = |i: usize| h.params.get(i).copied().unwrap_or(0.0);
+        match h.effect {
+            None => {}
+            Some(Effect::LidarIncidenceAngle) => {
+                e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: p(0) });
+            }
+            Some(Effect::LidarReflectivity) => {
+                e.lidar_reflectivity = Some(scenario::LidarReflectivity {
+                    coefficient_m: p(0),
+                    reference: 0.8,
+                });
+            }
+            Some(Effect::LidarMixedPixels) => {
+                e.lidar_mixed_pixels = (p(0) > 0.0).then_some(scenario::LidarMixedPixels {
+                    half_width_deg: p(0),
+                });
+            }
+            Some(Effect::LidarWarmupDrift) => {
+                e.lidar_warmup_drift = Some(scenario::LidarWarmupDrift {
+                    coefficient_per_m: p(0),
+                    time_constant_s: p(1).max(1e-3),
+                });
+            }
+            Some(Effect::SonarBeamWidth) => {
+                e.sonar_beam_width = Some(scenario::SonarBeamWidth {
+                    half_angle_deg: p(0).clamp(0.0, 89.0),
+                });
+            }
+            Some(Effect::SonarSpeedOfSound) => {
+                e.sonar_speed_of_sound = Some(scenario::SonarSpeedOfSound {
+                    air_temperature_c: p(0),
+                    calibrated_at_c: 20.0,
+                });
+            }
+            Some(Effect::OdometerWheelSlip) => {
+                e.odometer_wheel_slip = Some(scenario::OdometerWheelSlip { gain_s: p(0) });
+            }
+            Some(Effect::DriveMotorLag) => {
+                e.drive_motor_lag = (p(0) > 1e-6).then_some(scenario::DriveMotorLag {
+                    time_constant_s: p(0),
+                });
+            }
+            // Timing, not a sensor table: see `lidar`.
+            Some(Effect::LidarMotionSkew) => {}
+        }
+        e
+    }
+}
+
+impl Physics for SimPhysics {
+    fn declared(&self) -> &Declared {
+        &self.declared
+    }
+
+    fn object_name(&self, object: u32) -> String {
+        self.names
+            .get(object as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("object {object}"))
+    }
+
+    fn drive(
+        &self,
+        commands: &[CommandSample],
+        end_s: f64,
+        hypothesis: &Hypothesis,
+    ) -> Vec<TruthSample> {
+        let mut s = self.scenario.clone();
+        s.effects = self.effects(hypothesis);
+        // The declared actuation error is noise to the diagnosis, not a prediction.
+        s.robot.actuation.scale_sd = 0.0;
+        s.robot.actuation.wander_sd = 0.0;
+        replay::replay_commands(&s, commands, end_s)
+    }
+
+    fn lidar(
+        &self,
+        trajectory: &Trajectory,
+        queries: &[LidarQuery],
+        hypothesis: &Hypothesis,
+    ) -> Vec<LidarPrediction> {
+        let Some(config) = &self.scenario.sensors.lidar else {
+            return queries.iter().map(|_| empty_lidar()).collect();
+        };
+        let effects = LidarEffects::from_scenario(&self.effects(hypothesis));
+        let (Ok(predictor), Ok(geometry)) = (
+            LidarPredictor::new(config, effects),
+            LidarPredictor::new(
+                config,
+                LidarEffects {
+                    mixed_half_width_rad: None,
+                    ..effects
+                },
+            ),
+        ) else {
+            return queries.iter().map(|_| empty_lidar()).collect();
+        };
+        let mixed = effects.mixed_half_width_rad.is_some();
+        // Only a whole run's trajectory is asked about again and again; the short pieces a
+        // scan matcher tries are not worth keeping.
+        let span = trajectory.end_s() - trajectory.times()[0];
+        let cacheable = span > 2.0;
+        let snapshot = self.declared.lidar.is_some_and(|l| l.snapshot);
+        let skew = hypothesis.param_of(Effect::LidarMotionSkew, 0);
+        // When each reading's geometry is taken.
+        let instant = |q: &LidarQuery| match (snapshot, skew) {
+            (true, Some(revolution_s)) => q.rev_start_s + q.angle_deg / 360.0 * revolution_s,
+            (true, None) => q.rev_start_s,
+            (false, _) => q.t_s,
+        };
+        queries
+            .par_chunks(CHUNK)
+            .flat_map_iter(|chunk| {
+                chunk.iter().map(|q| {
+                    let p = trajectory.pose_at(instant(q));
+                    let robot = pose(p);
+                    let e = if skew.is_some() || !cacheable {
+                        // Another pose for every reading: nothing to reuse.
+                        predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
+                    } else {
+                        let key = [p.x, p.y, p.yaw, q.angle_deg].map(f64::to_bits);
+                        if mixed && !self.cached_clear(&geometry, key, &robot, q.angle_deg) {
+                            predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
+                        } else {
+                            let beam = self.cached_beam(&geometry, key, &robot, q.angle_deg);
+                            predictor.predict_nodes(&beam, q.t_s)
+                        }
+                    };
+                    LidarPrediction {
+                        components: e.components.into_iter().map(gaussian).collect(),
+                        true_range_m: e.true_range_m,
+                        incidence_deg: e.cos_incidence.clamp(0.0, 1.0).acos().to_degrees(),
+                        object: e.obstacle.map(|o| self.object_id(o)),
+                        reflectivity: e.reflectivity,
+                        near_edge: e.near_edge,
+                    }
+                })
+            })
+            .collect()
+    }
+
+    fn sonar(
+        &self,
+        trajectory: &Trajectory,
+        times: &[f64],
+        hypothesis: &Hypothesis,
+    ) -> Vec<SonarPrediction> {
+        let none = SonarPrediction {
+            reading: None,
+            true_range_m: None,
+            wide_cone_m: None,
+        };
+        let Some(config) = &self.scenario.sensors.sonar else {
+            return times.iter().map(|_| none).collect();
+        };
+        let effects = self.effects(hypothesis);
+        let Ok(predictor) = SonarPredictor::new(config, &effects) else {
+            return times.iter().map(|_| none).collect();
+        };
+        // Where a wider cone would look (asked only with the nominal model: a covariate).
+        let wide = hypothesis.effect.is_none().then(|| {
+            let mut e = effects.clone();
+            e.sonar_beam_width = Some(scenario::SonarBeamWidth {
+                half_angle_deg: 30.0,
+            });
+            SonarPredictor::new(config, &e)
+        });
+        times
+            .par_iter()
+            .map(|&t| {
+                let robot = pose(trajectory.pose_at(t));
+                let p = predictor.predict(&self.world, &robot);
+                SonarPrediction {
+                    reading: p.map(|p| gaussian(p.reading)),
+                    true_range_m: p.map(|p| p.true_range_m),
+                    wide_cone_m: wide
+                        .as_ref()
+                        .and_then(|w| w.as_ref().ok())
+                        .and_then(|w| w.predict(&self.world, &robot))
+                        .map(|p| p.true_range_m),
+                }
+            })
+            .collect()
+    }
+
+    fn odometry(
+        &self,
+        trajectory: &Trajectory,
+        times: &[f64],
+        hypothesis: &Hypothesis,
+    ) -> Vec<OdometryPrediction> {
+        let flat = Gaussian {
+            weight: 1.0,
+            mean_m: 0.0,
+            sd_m: 1.0,
+        };
+        let Some(config) = &self.scenario.sensors.odometer else {
+            return times
+                .iter()
+                .map(|_| OdometryPrediction {
+                    wheels: [flat; 2],
+                    speed_mps: [0.0; 2],
+                })
+                .collect();
+        };
+        let predictor = OdometerPredictor::new(config, &self.effects(hypothesis));
+        // The wheels' true travel along the trajectory, as the simulator defines it.
+        let (ts, ps) = (trajectory.times(), trajectory.poses());
+        let mut travel = Vec::with_capacity(ts.len());
+        travel.push([0.0; 2]);
+        for k in 1..ts.len() {
+            let prev = travel[k - 1];
+            travel.push(replay::wheel_travel(
+                prev,
+                &pose(ps[k - 1]),
+                &pose(ps[k]),
+                self.scenario.robot.wheel_base_m,
+            ));
+        }
+        times
+            .iter()
+            .map(|&t| {
+                let at = trajectory.interpolate(&travel, t);
+                let k = trajectory.interval(t);
+                let speed = match ts.get(k + 1) {
+                    Some(&t1) if t1 > ts[k] => {
+                        [0, 1].map(|w| (travel[k + 1][w] - travel[k][w]) / (t1 - ts[k]))
+                    }
+                    _ => [0.0; 2],
+                };
+                OdometryPrediction {
+                    wheels: [0, 1].map(|w| gaussian(predictor.predict(at[w], speed[w]))),
+                    speed_mps: speed,
+                }
+            })
+            .collect()
+    }
+}
+
+fn empty_lidar() -> LidarPrediction {
+    LidarPrediction {
+        components: Vec::new(),
+        true_range_m: None,
+        incidence_deg: 0.0,
+        object: None,
+        reflectivity: 0.0,
+        near_edge: false,
+    }
+}

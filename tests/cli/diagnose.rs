@@ -1,0 +1,279 @@
+//! `hilsim diagnose`: the verdict as JSON (`interfaces.md`), the report page, the self-test,
+//! and bad input refused with one line naming the file.
+
+use std::path::Path;
+
+use super::common::*;
+
+/// A small room and a short drive (12 s: starts, a stop, a turn), every sensor; the lidar takes
+/// each revolution at one instant and the sonar looks along its axis. Small so that the tests,
+/// which run the unoptimised binary, stay quick.
+const ROOM: &str = r#"name = "diagnose-small"
+seed = 5
+[world]
+walls = [
+    { from = [0.0, 0.0], to = [4.0, 0.0] },
+    { from = [4.0, 0.0], to = [4.0, 3.0] },
+    { from = [4.0, 3.0], to = [0.0, 3.0] },
+    { from = [0.0, 3.0], to = [0.0, 0.0] },
+]
+cylinders = [{ center = [2.6, 1.3], radius = 0.1 }]
+[robot]
+start = { x = 0.8, y = 0.8, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+turn_rate_deg_s = 60.0
+[[drive]]
+stop_s = 1.0
+[[drive]]
+speed_mps = 0.3
+distance_m = 1.8
+[[drive]]
+turn_deg = 90.0
+[[drive]]
+speed_mps = 0.2
+distance_m = 1.0
+[[drive]]
+stop_s = 3.5
+[sensors.lidar]
+bias = [0.0525, 0.8838, 0.0584]
+noise = [0.003, 0.0, 0.002]
+angle_noise_deg = 0.3
+timing = "per_revolution"
+[sensors.sonar]
+bias = [0.021, 1.028]
+noise = [0.008]
+[sensors.odometer]
+noise_m = 0.002
+"#;
+
+/// Writes the room with `effects` appended (and `seed`) as `name` in `dir`.
+fn scenario(dir: &Path, name: &str, seed: u64, effects: &str) -> String {
+    let text = ROOM.replace("seed = 5", &format!("seed = {seed}")) + effects;
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn record(dir: &Path, scenario: &str, out: &str) {
+    let o = hilsim(dir, &["record", scenario, "--out", out]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(out));
+    serde_json::from_str(stdout(out).trim()).expect("one JSON object")
+}
+
+#[test]
+fn a_concealed_effect_is_named_in_the_interface_json() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    // The real air at 0 °C: every sonar range 3.6 % long (derivation in docs/diagnose.md).
+    let cold = scenario(
+        tmp.path(),
+        "cold.toml",
+        9,
+        "[effects.sonar_speed_of_sound]\nair_temperature_c = 0.0\n",
+    );
+    record(tmp.path(), &cold, "real");
+    let out = hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", &nominal, "--real", "real", "--json"],
+    );
+    let j = json(&out);
+    for key in [
+        "mismatch",
+        "located",
+        "effect",
+        "explanation",
+        "params",
+        "fit",
+        "candidates",
+    ] {
+        assert!(j.get(key).is_some(), "{key} missing: {j}");
+    }
+    assert_eq!(j["mismatch"], true);
+    assert_eq!(j["effect"], "sonar_speed_of_sound", "{j}");
+    assert_eq!(j["located"]["sensor"], "sonar");
+    assert!(j["located"]["where"].is_string() && j["located"]["evidence"].is_string());
+    assert_eq!(j["fit"]["metric"], "heldout_rmse_m");
+    let (before, after) = (
+        j["fit"]["before"].as_f64().unwrap(),
+        j["fit"]["after"].as_f64().unwrap(),
+    );
+    assert!(after < before / 3.0, "{before} → {after}");
+    // ~55 held-out pings of 8 mm noise: the fitted temperature's standard error is a fraction
+    // of a degree (0.08 °C on the 56 s room); 2 °C is a generous bound for 12 s.
+    let t = j["params"]["air_temperature_c"].as_f64().unwrap();
+    assert!(t.abs() < 2.0, "{t}");
+    let c = j["candidates"].as_array().unwrap();
+    assert_eq!(c[0]["effect"], "sonar_speed_of_sound");
+    assert!(c
+        .iter()
+        .all(|c| c["effect"].is_string() && c["score"].is_number()));
+    assert!(c.iter().any(|c| c["effect"] == "none"));
+}
+
+#[test]
+fn the_nominal_run_is_none_and_the_report_renders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    // The same scenario with other noise: what a faithful simulation of a real run gives.
+    let again = scenario(tmp.path(), "again.toml", 6, "");
+    record(tmp.path(), &again, "real");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "diagnose", "--sim", &nominal, "--real", "real", "--json", "--report", "rep",
+        ],
+    );
+    let j = json(&out);
+    assert_eq!(j["effect"], "none", "{j}");
+    assert_eq!(j["mismatch"], false);
+    assert!(j["located"].is_null());
+    let page = std::fs::read_to_string(tmp.path().join("rep/index.html")).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>"));
+    assert!(page.contains("<b>none</b>"), "{page}");
+}
+
+#[test]
+fn without_truth_the_trajectory_is_estimated() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    let again = scenario(tmp.path(), "again.toml", 7, "");
+    record(tmp.path(), &again, "real");
+    std::fs::remove_file(tmp.path().join("real/truth.csv")).unwrap();
+    let out = hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", &nominal, "--real", "real", "--json"],
+    );
+    let j = json(&out);
+    assert_eq!(
+        j["alignment"],
+        "estimated (replayed commands + scan-to-map matching)"
+    );
+    assert_eq!(j["effect"], "none", "{j}");
+    let notes = j["notes"].as_array().unwrap();
+    assert!(notes
+        .iter()
+        .any(|n| n.as_str().unwrap().contains("no truth.csv")));
+}
+
+#[test]
+fn the_report_holds_plots_of_the_fix() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    let slipping = scenario(
+        tmp.path(),
+        "slip.toml",
+        8,
+        "[effects.odometer_wheel_slip]\ngain_s = 0.08\n",
+    );
+    record(tmp.path(), &slipping, "real");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "diagnose", "--sim", &nominal, "--real", "real", "--report", "rep",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.starts_with("verdict: odometer_wheel_slip"), "{text}");
+    assert!(text.contains("report: rep/index.html"), "{text}");
+    let page = std::fs::read_to_string(tmp.path().join("rep/index.html")).unwrap();
+    let svgs: Vec<String> = std::fs::read_dir(tmp.path().join("rep"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    assert!(!svgs.is_empty());
+    for svg in &svgs {
+        assert!(page.contains(svg.as_str()), "{svg} not on the page");
+        let body = std::fs::read_to_string(tmp.path().join("rep").join(svg)).unwrap();
+        assert!(body.starts_with("<svg") && body.trim_end().ends_with("</svg>"));
+        assert!(body.contains("after (effect fitted)"));
+        assert!(!body.contains("NaN"));
+    }
+}
+
+#[test]
+fn bad_input_is_refused_with_one_line_naming_the_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    // No such recording.
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", &nominal, "--real", "missing"],
+    ));
+    assert!(err.contains("missing"), "{err}");
+    // Too short a recording: 5 s.
+    std::fs::write(
+        tmp.path().join("short.toml"),
+        ROOM.replace("seed = 5", "seed = 5\nduration_s = 5.0"),
+    )
+    .unwrap();
+    record(tmp.path(), "short.toml", "short");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", &nominal, "--real", "short"],
+    ));
+    assert!(err.contains("short") && err.contains("too short"), "{err}");
+    // A run of another scenario: it starts elsewhere.
+    let elsewhere = ROOM.replace("x = 0.8, y = 0.8", "x = 2.0, y = 2.2");
+    std::fs::write(tmp.path().join("elsewhere.toml"), elsewhere).unwrap();
+    record(tmp.path(), "elsewhere.toml", "other");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", &nominal, "--real", "other"],
+    ));
+    assert!(
+        err.contains("other") && err.contains("not a run of this scenario"),
+        "{err}"
+    );
+    // A bad scenario names its file and line.
+    std::fs::write(tmp.path().join("bad.toml"), "name = 1\n").unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", "bad.toml", "--real", "other"],
+    ));
+    assert!(err.contains("bad.toml:1"), "{err}");
+    // Usage.
+    let err = assert_bad_input(&hilsim(tmp.path(), &["diagnose", "--sim", &nominal]));
+    assert!(err.contains("--real"), "{err}");
+    let err = assert_bad_input(&hilsim(tmp.path(), &["diagnose", "--self-test", "0"]));
+    assert!(err.contains("--self-test"), "{err}");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--self-test", "2", "--only", "lidar_fog"],
+    ));
+    assert!(err.contains("lidar_fog"), "{err}");
+}
+
+#[test]
+fn the_self_test_prints_its_confusion_matrix_and_goals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "diagnose",
+            "--self-test",
+            "2",
+            "--seed",
+            "3",
+            "--sim",
+            &nominal,
+            "--only",
+            "odometer_wheel_slip",
+        ],
+    );
+    // Two slip trials on the small room: both named (exit 0 = every goal met).
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(text.contains("confusion (rows: concealed effect; columns: verdict)"));
+    assert!(text.contains("named correctly: 2/2"), "{text}");
+    assert!(
+        text.contains("reproduce: hilsim diagnose --self-test 2 --seed 3 --sim "),
+        "{text}"
+    );
+}

@@ -67,7 +67,7 @@ impl Corridor {
                 }),
                 sonar_half_angle_deg: None,
                 odometer: false,
-                actuation_sd: 0.0,
+                actuation: Default::default(),
             },
         }
     }
@@ -101,11 +101,7 @@ impl Physics for Corridor {
                 let p = tr.pose_at(q.t_s);
                 let (mean, cos) = Corridor::mean(p, q.angle_deg, kappa, 0.0);
                 LidarPrediction {
-                    components: vec![Gaussian {
-                        weight: 1.0,
-                        mean_m: mean,
-                        sd_m: SD,
-                    }],
+                    components: vec![Gaussian::new(1.0, mean, SD)],
                     true_range_m: Some(cast(p, p.yaw + q.angle_deg.to_radians()).0),
                     incidence_deg: cos.acos().to_degrees(),
                     object: Some(0),
@@ -125,11 +121,7 @@ impl Physics for Corridor {
             .collect()
     }
     fn odometry(&self, _: &Trajectory, t: &[f64], _: &Hypothesis) -> Vec<OdometryPrediction> {
-        let g = Gaussian {
-            weight: 1.0,
-            mean_m: 0.0,
-            sd_m: 1.0,
-        };
+        let g = Gaussian::new(1.0, 0.0, 1.0);
         t.iter()
             .map(|_| OdometryPrediction {
                 wheels: [g, g],

@@ -96,6 +96,9 @@ pub struct ExpectedLidar {
     pub reflectivity: f64,
     /// Whether the beam's direction noise (or its footprint) reaches another surface.
     pub near_edge: bool,
+    /// The readings reported valid, `[min, max]` metres: each component is the part of its
+    /// Gaussian inside (a reading beyond a limit is reported invalid instead).
+    pub valid_range_m: (f64, f64),
 }
 
 /// What a beam's quadrature directions see: the geometry of one reading, before any range
@@ -138,8 +141,10 @@ impl LidarPredictor {
                 .build()?,
             mount: config.mount.into(),
             angle_noise_rad: config.angle_noise_deg.to_radians(),
-            min_m: config.min_range_m,
-            max_m: config.max_range_m,
+            // The unit rounds to millimetres first, then compares with its limits (`lidar.rs`):
+            // a valid reading is one whose unrounded value lies within these.
+            min_m: ((config.min_range_m * 1000.0).ceil() - 0.5) / 1000.0,
+            max_m: ((config.max_range_m * 1000.0).floor() + 0.5) / 1000.0,
             cast_limit_m: (config.max_range_m * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0),
             effects,
         })
@@ -247,10 +252,12 @@ impl LidarPredictor {
             obstacle: centre.map(|c| c.hit.obstacle),
             reflectivity: centre.map_or(0.0, |c| c.hit.reflectivity),
             near_edge: false,
+            valid_range_m: (self.min_m, self.max_m),
         };
-        // (weight, mean, variance, surface) per node whose reading can be valid.
-        let mut nodes: Vec<Option<(f64, f64, f64, Obstacle)>> =
-            Vec::with_capacity(beam.nodes.len());
+        // (weight × chance of a valid reading, mean, variance, surface, weight) per node whose
+        // reading can be valid.
+        type Node = (f64, f64, f64, Obstacle, f64);
+        let mut nodes: Vec<Option<Node>> = Vec::with_capacity(beam.nodes.len());
         for (w, ret) in &beam.nodes {
             let Some(ret) = ret else {
                 out.near_edge |= centre.is_some();
@@ -266,7 +273,7 @@ impl LidarPredictor {
             // of each node's distribution inside (its weight the probability of landing there).
             let valid = normal_cdf((self.max_m - mean) / var.sqrt())
                 - normal_cdf((self.min_m - mean) / var.sqrt());
-            nodes.push((valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle)));
+            nodes.push((valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle, *w)));
         }
         if beam.dense {
             out.near_edge = true;
@@ -274,7 +281,7 @@ impl LidarPredictor {
             // share of directions: the slope to its neighbours on the same surface (or across a
             // mixing footprint, where the reading is continuous) times the spacing, / √12.
             for k in 0..nodes.len() {
-                let Some((w, mean, var, what)) = nodes[k] else {
+                let Some((w, mean, var, what, _)) = nodes[k] else {
                     continue;
                 };
                 let step = |j: Option<usize>| {
@@ -300,23 +307,28 @@ impl LidarPredictor {
         } else {
             // One surface: the quadrature's mean and variance of the reading over the direction
             // noise, one Gaussian per surface (a single one unless a node fell off the range).
-            let mut groups: Vec<(Obstacle, f64, f64, f64)> = Vec::with_capacity(1);
-            for (w, mean, var, what) in nodes.into_iter().flatten() {
+            // The moments are of the reading before the range limits (weights: the directions'
+            // own), so that the limits, applied once to the surface's Gaussian
+            // (`valid_range_m`), are not applied twice; its weight is its chance of a valid
+            // reading.
+            let mut groups: Vec<(Obstacle, f64, f64, f64, f64)> = Vec::with_capacity(1);
+            for (wv, mean, var, what, w) in nodes.into_iter().flatten() {
                 match groups.iter_mut().find(|g| g.0 == what) {
                     Some(g) => {
-                        g.1 += w;
+                        g.1 += wv;
                         g.2 += w * mean;
                         g.3 += w * (var + mean * mean);
+                        g.4 += w;
                     }
-                    None => groups.push((what, w, w * mean, w * (var + mean * mean))),
+                    None => groups.push((what, wv, w * mean, w * (var + mean * mean), w)),
                 }
             }
             out.near_edge |= groups.len() > 1;
-            for (_, w, sm, ss) in groups {
+            for (_, wv, sm, ss, w) in groups {
                 let mean = sm / w;
                 let var = (ss / w - mean * mean).max(ROUNDING_VAR_M2);
                 out.components.push(Component {
-                    weight: w,
+                    weight: wv,
                     mean_m: mean,
                     sd_m: var.sqrt(),
                 });

@@ -153,6 +153,18 @@ fn moments(z: &[f64]) -> (f64, f64) {
     (mean, var)
 }
 
+/// `Σ_c (Σ_{k ∈ c} dev(k))²` over the clusters `c` that share errors (`cluster[k]`): the
+/// cluster-robust ("sandwich") variance of the sum of `dev` over `ks` (Liang & Zeger,
+/// Biometrika 1986). Deviations are taken from the null's value, so a bin inside one cluster
+/// can never count as more than one observation.
+fn clustered_sum_var(ks: &[usize], dev: impl Fn(usize) -> f64, cluster: &[u32]) -> f64 {
+    let mut sums: BTreeMap<u32, f64> = BTreeMap::new();
+    for &k in ks {
+        *sums.entry(cluster[k]).or_default() += dev(k);
+    }
+    sums.values().map(|s| s * s).sum()
+}
+
 /// Every test of one sensor's residuals. `fits[k]` is the fit of row `rows[k]` of `data`.
 /// `whiteness`: whether to test the residuals' correlation in time (not against an estimated
 /// trajectory, whose errors a revolution's readings share).
@@ -175,6 +187,16 @@ pub(crate) fn locate(
         pos[i] = k;
     }
     let z: Vec<f64> = fits.iter().map(|f| f.z).collect();
+    // Readings that share an error (of an estimated trajectory) are not independent: the tests'
+    // variances are then the larger of the independent and the cluster-robust one.
+    let cluster: Option<Vec<u32>> = data
+        .clusters
+        .as_ref()
+        .map(|c| rows.iter().map(|&i| c[i]).collect());
+    let robust = |ks: &[usize], dev: &dyn Fn(usize) -> f64, independent: f64| match &cluster {
+        Some(c) => independent.max(clustered_sum_var(ks, dev, c)),
+        None => independent,
+    };
     let (mean, sample_var) = moments(&z);
     // Normal scores have variance 1 when the prediction is right. Every test below measures
     // departures on that scale, or on the sample's when it is wider: residuals far smaller than
@@ -196,7 +218,7 @@ pub(crate) fn locate(
     };
     let all: Vec<usize> = (0..n).collect();
     // Overall bias: a t statistic of the scores.
-    let t = mean / (var / n as f64).sqrt();
+    let t = mean * n as f64 / robust(&all, &|k| z[k], var * n as f64).sqrt();
     out.push(Evidence {
         sensor,
         test: TestKind::Bias,
@@ -215,7 +237,7 @@ pub(crate) fn locate(
         sensor,
         test: TestKind::Spread,
         covariate: None,
-        score: (ss - n as f64) / (2.0 * n as f64).sqrt(),
+        score: (ss - n as f64) / robust(&all, &|k| z[k] * z[k] - 1.0, 2.0 * n as f64).sqrt(),
         // (the mean square is tested against the declared 1, upwards only)
         place: format!("all {sensor} readings"),
         detail: format!(
@@ -242,9 +264,15 @@ pub(crate) fn locate(
             let nb = ks.len() as f64;
             let mb = ks.iter().map(|&k| z[k]).sum::<f64>() / nb;
             let vb = ks.iter().map(|&k| z[k] * z[k]).sum::<f64>() / nb;
-            let zb = (mb - mean) / (var / nb).sqrt();
+            let zb = (mb - mean) * nb / robust(&ks, &|k| z[k] - mean, var * nb).sqrt();
             // The mean square of a bin of normal scores has variance 2 msq² / n_b.
-            let sb = (vb - msq_all) / (2.0 * msq_all * msq_all / nb).sqrt();
+            let sb = (vb - msq_all) * nb
+                / robust(
+                    &ks,
+                    &|k| z[k] * z[k] - msq_all,
+                    2.0 * msq_all * msq_all * nb,
+                )
+                .sqrt();
             chi_bias += zb * zb;
             // Only an excess counts (a mismatch adds spread), so the sum is stochastically
             // below its χ²_{B−1} reference: conservative.

@@ -37,8 +37,8 @@ pub use catalogue::{Effect, ParamSpec, Sensor};
 pub use explain::CandidateFit;
 pub use locate::{Evidence, TestKind};
 pub use physics::{
-    Declared, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery, OdometryPrediction,
-    Physics, SonarPrediction,
+    Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
+    OdometryPrediction, Physics, SonarPrediction,
 };
 pub use residuals::Covariate;
 pub use show::PlotData;
@@ -249,6 +249,10 @@ pub fn diagnose(
     .flatten()
     {
         if d.len() >= 60 {
+            let mut d = d;
+            if ctx.estimated {
+                d.clusters = Some(residuals::shared_error_clusters(ctx.trajectory, &d.t));
+            }
             data.push(d);
         } else if !d.y.is_empty() {
             notes.push(format!(

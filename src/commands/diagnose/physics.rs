@@ -5,8 +5,8 @@
 
 use anyhow::{Context, Result};
 use hilsim_calibrator::mismatch::{
-    Declared, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
-    OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
+    Declared, DeclaredActuation, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
+    LidarQuery, OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
 };
 use hilsim_lidar_emulator::effects::LidarEffects;
 use hilsim_lidar_emulator::prediction::{
@@ -45,11 +45,7 @@ pub struct SimPhysics {
 }
 
 fn gaussian(c: Component) -> Gaussian {
-    Gaussian {
-        weight: c.weight,
-        mean_m: c.mean_m,
-        sd_m: c.sd_m,
-    }
+    Gaussian::new(c.weight, c.mean_m, c.sd_m)
 }
 
 fn pose(p: Pose2) -> Pose {
@@ -102,7 +98,11 @@ impl SimPhysics {
                         .map_or(u.half_angle_deg, |b| b.half_angle_deg)
                 }),
                 odometer: s.sensors.odometer.is_some(),
-                actuation_sd: a.scale_sd.hypot(a.wander_sd),
+                actuation: DeclaredActuation {
+                    scale_sd: a.scale_sd,
+                    wander_sd: a.wander_sd,
+                    wander_tau_s: a.wander_tau_s,
+                },
             },
             scenario: scenario.clone(),
             names,
@@ -291,7 +291,11 @@ impl Physics for SimPhysics {
                         }
                     };
                     LidarPrediction {
-                        components: e.components.into_iter().map(gaussian).collect(),
+                        components: e
+                            .components
+                            .into_iter()
+                            .map(|c| gaussian(c).truncated(e.valid_range_m.0, e.valid_range_m.1))
+                            .collect(),
                         true_range_m: e.true_range_m,
                         incidence_deg: e.cos_incidence.clamp(0.0, 1.0).acos().to_degrees(),
                         object: e.obstacle.map(|o| self.object_id(o)),
@@ -353,11 +357,7 @@ impl Physics for SimPhysics {
         times: &[f64],
         hypothesis: &Hypothesis,
     ) -> Vec<OdometryPrediction> {
-        let flat = Gaussian {
-            weight: 1.0,
-            mean_m: 0.0,
-            sd_m: 1.0,
-        };
+        let flat = Gaussian::new(1.0, 0.0, 1.0);
         let Some(config) = &self.scenario.sensors.odometer else {
             return times
                 .iter()

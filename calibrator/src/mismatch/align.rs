@@ -6,7 +6,7 @@
 use hilsim_recording::Recording;
 
 use super::estimate::estimate_trajectory;
-use super::physics::Physics;
+use super::physics::{Hypothesis, Physics};
 use super::trajectory::{wrap, Trajectory};
 use super::MismatchError;
 
@@ -117,7 +117,8 @@ pub(crate) fn align(
                         .into(),
                 ));
             }
-            let (trajectory, sd) = estimate_trajectory(physics, recording, end_s)?;
+            let (trajectory, sd) =
+                estimate_trajectory(physics, recording, end_s, &Hypothesis::nominal())?;
             notes.push(format!(
                 "no truth.csv: the trajectory is estimated by matching the lidar to the \
                  scenario's world (position s.d. {:.1} mm, heading {:.2} mrad), so only the \
@@ -153,5 +154,27 @@ pub(crate) fn align(
         position_sd_m,
         yaw_sd_rad,
         notes,
+    })
+}
+
+/// `aligned` (an estimated trajectory) estimated again with the lidar predicted under
+/// `hypothesis`: a lidar effect that the nominal model cannot take is partly absorbed into the
+/// scan matching's corrections, so an effect's fit is refined against the trajectory its own
+/// model gives (one step of alternating the alignment and the fit).
+///
+/// # Errors
+/// As [`align`].
+pub(crate) fn realign(
+    physics: &dyn Physics,
+    recording: &Recording,
+    aligned: &Aligned,
+    hypothesis: &Hypothesis,
+) -> Result<Aligned, MismatchError> {
+    let (trajectory, sd) = estimate_trajectory(physics, recording, aligned.end_s, hypothesis)?;
+    Ok(Aligned {
+        trajectory,
+        position_sd_m: sd.position_m,
+        yaw_sd_rad: sd.yaw_rad,
+        ..aligned.clone()
     })
 }

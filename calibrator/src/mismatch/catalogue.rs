@@ -197,22 +197,55 @@ impl Effect {
 
     /// The parameter values at which the effect is absent (what the nominal model assumes),
     /// given the declared sonar cone for the beam width and the declared calibration
-    /// temperature (20 °C) for the speed of sound.
+    /// temperature (20 °C) for the speed of sound. The warm-up drift is absent at k = 0 for
+    /// any τ.
     #[must_use]
     pub fn absent(self, declared_half_angle_deg: f64) -> Vec<f64> {
         match self {
             Effect::LidarWarmupDrift => vec![0.0, 10.0],
-            Effect::LidarMixedPixels => vec![0.0],
             Effect::SonarBeamWidth => vec![declared_half_angle_deg],
             Effect::SonarSpeedOfSound => vec![20.0],
-            Effect::DriveMotorLag => vec![0.0],
             _ => vec![0.0],
         }
     }
 
-    /// What physics the simulation left out, in one sentence; `params` are the fitted ones.
+    /// The smallest departure of the scored parameter (the first) from its absence that names
+    /// the effect: below it the fitted model is the nominal one to within what the sensors
+    /// resolve, so what it "explains" is noise the fit chased. Each is about one millimetre of
+    /// range where the effect acts (or the model's own resolution):
+    /// - incidence κ: 0.001 is 1 mm per metre at 45°;
+    /// - reflectivity c: 1 mm on a surface of half the reference's reflectivity;
+    /// - mixed pixels: a beam half-width of 0.1°, a third of a typical 0.3° direction noise;
+    /// - motion skew: a revolution of 0.02 s, a tenth of the XV-11's 0.2 s;
+    /// - warm-up k: 0.00025 /m, 1 mm at 2 m at power-on;
+    /// - sonar cone: 1°, four of the emulator's 0.25° rays;
+    /// - speed of sound: 0.6 °C, 0.1 % of range (1 mm at 1 m);
+    /// - wheel slip g: 0.005 s, 1 mm of travel at 0.2 m/s;
+    /// - motor lag τ: 0.02 s, two physics steps (the drive's resolution is 0.01 s).
     #[must_use]
-    pub fn explanation(self, params: &[f64]) -> String {
+    pub fn departs(self, params: &[f64], declared_half_angle_deg: f64) -> bool {
+        let Some(&value) = params.first() else {
+            return false;
+        };
+        let absent = self.absent(declared_half_angle_deg)[0];
+        let least = match self {
+            Effect::LidarIncidenceAngle => 0.001,
+            Effect::LidarReflectivity => 0.001,
+            Effect::LidarMixedPixels => 0.1,
+            Effect::LidarMotionSkew => 0.02,
+            Effect::LidarWarmupDrift => 0.000_25,
+            Effect::SonarBeamWidth => 1.0,
+            Effect::SonarSpeedOfSound => 0.6,
+            Effect::OdometerWheelSlip => 0.005,
+            Effect::DriveMotorLag => 0.02,
+        };
+        (value - absent).abs() >= least
+    }
+
+    /// One sentence: the physics the simulation left out, with the fitted parameters (and the
+    /// declared sonar cone the beam width replaces).
+    #[must_use]
+    pub fn explanation(self, params: &[f64], declared_half_angle_deg: f64) -> String {
         let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
         match self {
             Effect::LidarIncidenceAngle => format!(
@@ -241,6 +274,11 @@ impl Effect {
                 p(0) * 4.0 * 1000.0,
                 p(1)
             ),
+            Effect::SonarBeamWidth if declared_half_angle_deg > 0.0 => format!(
+                "The simulated sonar's cone is ±{declared_half_angle_deg:.1}°; the real one \
+                 returns the nearest echo anywhere in a cone of ±{:.1}°.",
+                p(0)
+            ),
             Effect::SonarBeamWidth => format!(
                 "The simulated sonar sees along its axis only; the real one returns the nearest \
                  echo anywhere in a cone of ±{:.1}°.",
@@ -268,5 +306,27 @@ impl Effect {
 impl fmt::Display for Effect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Effect;
+
+    /// An effect fitted to its own absence names nothing: the sonar cone against the declared
+    /// one (not against zero), the speed of sound against the calibration temperature.
+    #[test]
+    fn an_effect_departs_only_beyond_what_the_sensors_resolve() {
+        assert!(!Effect::SonarBeamWidth.departs(&[15.004], 15.0));
+        assert!(Effect::SonarBeamWidth.departs(&[15.004], 0.0));
+        assert!(Effect::SonarBeamWidth.departs(&[12.0], 15.0));
+        assert!(!Effect::SonarSpeedOfSound.departs(&[20.3], 0.0));
+        assert!(Effect::SonarSpeedOfSound.departs(&[5.0], 0.0));
+        assert!(!Effect::DriveMotorLag.departs(&[0.005], 0.0));
+        assert!(Effect::DriveMotorLag.departs(&[0.1], 0.0));
+        assert!(!Effect::LidarIncidenceAngle.departs(&[], 0.0));
+        for e in Effect::ALL {
+            assert!(!e.departs(&e.absent(10.0), 10.0), "{e:?}");
+        }
     }
 }

@@ -7,8 +7,9 @@
 //! found by Gauss–Newton on the readings' normalised residuals against the nominal prediction,
 //! with Huber weights (k = 2) so that readings the world does not explain (people, a mixed pixel)
 //! do not pull it; the Jacobian by central differences (1 mm, 1 mrad) through the physics. It
-//! starts from the previous revolution's correction. Between revolutions the correction is
-//! interpolated linearly.
+//! starts from the previous revolution's correction. The revolutions' corrections are then
+//! smoothed over time (a random walk whose steps grow with the motion, RTS smoother), and
+//! interpolated linearly between revolutions.
 //!
 //! An effect that biases the lidar is partly absorbed into these corrections; effects with a
 //! shape a rigid shift cannot take (incidence, reflectivity, mixed pixels, skew while turning)
@@ -110,16 +111,21 @@ fn residuals(
     trajectory: &Trajectory,
     queries: &[LidarQuery],
     readings: &[f64],
+    hypothesis: &Hypothesis,
 ) -> Vec<Option<f64>> {
     physics
-        .lidar(trajectory, queries, &Hypothesis::nominal())
+        .lidar(trajectory, queries, hypothesis)
         .iter()
         .zip(readings)
         .map(|(p, &y)| {
-            // The component nearest the reading, in its own standard deviations.
+            // The component nearest the reading, in its own standard deviations (the moments
+            // of what is reported valid: near a range limit, of the truncated distribution).
             p.components
                 .iter()
-                .map(|g| (y - g.mean_m) / g.sd_m)
+                .map(|g| {
+                    let (mean, sd) = g.moments();
+                    (y - mean) / sd
+                })
                 .min_by(|a, b| a.abs().total_cmp(&b.abs()))
         })
         .collect()
@@ -134,7 +140,8 @@ pub(crate) struct Uncertainty {
     pub yaw_rad: f64,
 }
 
-/// The trajectory estimated from `recording`, and its uncertainty.
+/// The trajectory estimated from `recording`, and its uncertainty, with the lidar predicted
+/// under `hypothesis` (the nominal model first; a fitted effect when re-aligning).
 ///
 /// # Errors
 /// [`MismatchError::Refused`] without lidar readings to match.
@@ -142,6 +149,7 @@ pub(crate) fn estimate_trajectory(
     physics: &dyn Physics,
     recording: &Recording,
     end_s: f64,
+    hypothesis: &Hypothesis,
 ) -> Result<(Trajectory, Uncertainty), MismatchError> {
     let Some(lidar) = recording.lidar.as_ref().filter(|l| !l.is_empty()) else {
         return Err(MismatchError::Refused(
@@ -194,7 +202,13 @@ pub(crate) fn estimate_trajectory(
         let steps = [0.001, 0.001, 0.001];
         let mut info = [[0.0; 3]; 3];
         for _ in 0..ITERATIONS {
-            let r0 = residuals(physics, &shifted(&base, t0, t1, correction), &queries, &y);
+            let r0 = residuals(
+                physics,
+                &shifted(&base, t0, t1, correction),
+                &queries,
+                &y,
+                hypothesis,
+            );
             // Central differences of the residuals along each coordinate.
             let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; y.len()];
             let mut usable = vec![true; y.len()];
@@ -203,8 +217,20 @@ pub(crate) fn estimate_trajectory(
                 let mut down = correction;
                 up[k] += steps[k];
                 down[k] -= steps[k];
-                let ru = residuals(physics, &shifted(&base, t0, t1, up), &queries, &y);
-                let rd = residuals(physics, &shifted(&base, t0, t1, down), &queries, &y);
+                let ru = residuals(
+                    physics,
+                    &shifted(&base, t0, t1, up),
+                    &queries,
+                    &y,
+                    hypothesis,
+                );
+                let rd = residuals(
+                    physics,
+                    &shifted(&base, t0, t1, down),
+                    &queries,
+                    &y,
+                    hypothesis,
+                );
                 for i in 0..y.len() {
                     match (ru[i], rd[i]) {
                         (Some(a), Some(b)) => jac[i][k] = (a - b) / (2.0 * steps[k]),
@@ -246,9 +272,6 @@ pub(crate) fn estimate_trajectory(
                 break;
             }
         }
-        if let Some(inv) = invert3(info) {
-            variances.push(((inv[0][0] + inv[1][1]) / 2.0, inv[2][2]));
-        }
         // The correction holds where the readings' geometry was taken: at the revolution's
         // start for a lidar that takes it at one instant, else around its middle.
         let knot = if snapshot {
@@ -256,8 +279,15 @@ pub(crate) fn estimate_trajectory(
         } else {
             start + 0.5 * 360.0 * period
         };
+        // A revolution whose geometry pins no coordinate (a corridor's length) is left to the
+        // others.
+        let Some(inv) = invert3(info) else {
+            continue;
+        };
         knots.push((knot, correction));
+        variances.push([inv[0][0], inv[1][1], inv[2][2]]);
     }
+    let (knots, variances) = smooth_corrections(&base, &knots, &variances);
     if knots.is_empty() {
         return Err(MismatchError::Refused(
             "the recording has no truth.csv and too few valid lidar readings to estimate its \
@@ -292,19 +322,96 @@ pub(crate) fn estimate_trajectory(
             }
         })
         .collect();
-    // The median revolution's standard errors, doubled (and floored at 3 mm and 1 mrad): the
-    // curvature of one revolution's fit leaves out the interpolation between revolutions.
+    // The median revolution's smoothed standard errors, doubled (and floored at 3 mm and
+    // 1 mrad): the curvature of the fits leaves out the interpolation between revolutions.
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
-    let pos = median(variances.iter().map(|v| v.0).collect());
-    let yaw = median(variances.iter().map(|v| v.1).collect());
+    let pos = median(variances.iter().map(|v| (v[0] + v[1]) / 2.0).collect());
+    let yaw = median(variances.iter().map(|v| v[2]).collect());
     let sd = Uncertainty {
         position_m: (2.0 * pos.max(0.0).sqrt()).max(0.003),
         yaw_rad: (2.0 * yaw.max(0.0).sqrt()).max(0.001),
     };
     Ok((Trajectory::new(&samples)?, sd))
+}
+
+/// A revolution's time and its correction `(dx, dy, dθ)`.
+type Knot = (f64, [f64; 3]);
+
+/// Drift of the dead reckoning the corrections follow, per metre travelled and per radian
+/// turned: generous (5 % of the travel, 0.02 rad per metre and 5 % of the turn) so that a
+/// drive that departs from its commands (a concealed motor lag, slip) is followed, not
+/// smoothed over. Standing still, the correction may wander by 1 mm and 0.5 mrad per
+/// revolution.
+const DRIFT_PER_M: f64 = 0.05;
+const YAW_DRIFT_PER_M: f64 = 0.02;
+const YAW_DRIFT_PER_RAD: f64 = 0.05;
+const STILL_DRIFT_M: f64 = 0.001;
+const STILL_DRIFT_RAD: f64 = 0.0005;
+
+/// The revolutions' corrections smoothed over time, with their variances: each coordinate a
+/// random walk whose steps grow with the distance and the turn the dead reckoning covers
+/// between two revolutions, observed by each revolution's scan match with the variance its fit
+/// gives (Rauch–Tung–Striebel smoother; Shumway & Stoffer, §6.2). One revolution's match uses
+/// a few dozen readings and errs by centimetres in a sparse world; while the robot stands, the
+/// smoother averages every revolution of the stop.
+fn smooth_corrections(
+    base: &Trajectory,
+    knots: &[Knot],
+    variances: &[[f64; 3]],
+) -> (Vec<Knot>, Vec<[f64; 3]>) {
+    let n = knots.len();
+    if n < 2 {
+        return (knots.to_vec(), variances.to_vec());
+    }
+    // Process variance between knot k − 1 and k, per coordinate.
+    let q: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            if k == 0 {
+                return [0.0; 3];
+            }
+            let (a, b) = (base.pose_at(knots[k - 1].0), base.pose_at(knots[k].0));
+            let (dist, turn) = ((b.x - a.x).hypot(b.y - a.y), wrap(b.yaw - a.yaw).abs());
+            let pos = STILL_DRIFT_M.powi(2) + (DRIFT_PER_M * dist).powi(2);
+            let yaw = STILL_DRIFT_RAD.powi(2)
+                + (YAW_DRIFT_PER_M * dist + YAW_DRIFT_PER_RAD * turn).powi(2);
+            [pos, pos, yaw]
+        })
+        .collect();
+    let mut out = knots.to_vec();
+    let mut out_var = variances.to_vec();
+    for c in 0..3 {
+        // Forward filter: predicted (m⁻, p⁻) and filtered (m, p) at each knot.
+        let mut pred = Vec::with_capacity(n);
+        let mut filt: Vec<(f64, f64)> = Vec::with_capacity(n);
+        for k in 0..n {
+            let (mp, pp) = match filt.last() {
+                Some(&(m, p)) => (m, p + q[k][c]),
+                // The first revolution: a diffuse prior.
+                None => (0.0, 1e6),
+            };
+            pred.push((mp, pp));
+            let (y, r) = (knots[k].1[c], variances[k][c].max(1e-12));
+            let gain = pp / (pp + r);
+            filt.push((mp + gain * (y - mp), (1.0 - gain) * pp));
+        }
+        // Backward pass.
+        let mut smooth = filt.clone();
+        for k in (0..n - 1).rev() {
+            let g = filt[k].1 / pred[k + 1].1;
+            smooth[k] = (
+                filt[k].0 + g * (smooth[k + 1].0 - pred[k + 1].0),
+                filt[k].1 + g * g * (smooth[k + 1].1 - pred[k + 1].1),
+            );
+        }
+        for k in 0..n {
+            out[k].1[c] = smooth[k].0;
+            out_var[k][c] = smooth[k].1.max(0.0);
+        }
+    }
+    (out, out_var)
 }
 
 /// Solves the 3×3 system `a x = b` (Cramer's rule); `None` when singular.

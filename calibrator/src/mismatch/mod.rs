@@ -46,6 +46,12 @@ pub use trajectory::{wrap, Pose2, Trajectory};
 
 use residuals::{Context, SensorData};
 
+/// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
+/// it (against an estimated trajectory only); they stop once the parameter moves by less than
+/// [`REALIGN_SETTLED`] of its value.
+const REALIGN_ROUNDS: usize = 4;
+const REALIGN_SETTLED: f64 = 0.02;
+
 /// A diagnosis that could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -334,10 +340,70 @@ pub fn diagnose(
             .find(|x| x.sensor == s)
             .map_or(0.0, |x| x.strongest)
     };
-    let best = candidates
+    // An effect fitted to (next to) its own absence is the nominal model: what it gains is
+    // noise the fit chased, not physics.
+    let declared_cone = physics.declared().sonar_half_angle_deg.unwrap_or(0.0);
+    let mut best = candidates
         .iter()
-        .find(|c| c.heldout_gain > options.min_gain && c.bic_gain > 0.0)
+        .find(|c| {
+            c.heldout_gain > options.min_gain
+                && c.bic_gain > 0.0
+                && c.effect.departs(&c.params, declared_cone)
+        })
         .cloned();
+    // Against an estimated trajectory a lidar effect was partly absorbed into the scan
+    // matching (fitted with the nominal model): the trajectory is estimated again under the
+    // effect's fitted model and the effect refitted against it.
+    let mut realigned: Option<align::Aligned> = None;
+    if let Some(mut current) = best
+        .clone()
+        .filter(|b| ctx.estimated && b.effect.sensor() == Sensor::Lidar)
+    {
+        for _ in 0..REALIGN_ROUNDS {
+            let hypothesis = Hypothesis::with(current.effect, current.params.clone());
+            let again = align::realign(physics, recording, &aligned, &hypothesis)?;
+            let ctx2 = Context {
+                trajectory: &again.trajectory,
+                position_sd_m: again.position_sd_m,
+                yaw_sd_rad: again.yaw_sd_rad,
+                ..ctx
+            };
+            let Some(mut lidar) = residuals::lidar(&ctx2)? else {
+                break;
+            };
+            lidar.clusters = Some(residuals::shared_error_clusters(ctx2.trajectory, &lidar.t));
+            let refit =
+                explain::fit_candidate(&ctx2, &lidar, current.effect, options.max_fit_rows, &names);
+            if !(refit.heldout_gain > options.min_gain
+                && refit.effect.departs(&refit.params, declared_cone))
+            {
+                break;
+            }
+            let (before, after) = (current.params[0], refit.params[0]);
+            current = refit;
+            // The plots show the data against the trajectory the verdict rests on.
+            if let Some(d) = data.iter_mut().find(|d| d.sensor == Sensor::Lidar) {
+                *d = lidar;
+            }
+            realigned = Some(again);
+            if (after - before).abs() <= REALIGN_SETTLED * after.abs() {
+                break;
+            }
+        }
+        if realigned.is_some() {
+            if let Some(c) = candidates.iter_mut().find(|c| c.effect == current.effect) {
+                *c = current.clone();
+            }
+            best = Some(current);
+        }
+    }
+    let realigned_ctx = realigned.as_ref().map(|a| Context {
+        trajectory: &a.trajectory,
+        position_sd_m: a.position_sd_m,
+        yaw_sd_rad: a.yaw_sd_rad,
+        ..ctx
+    });
+    let plot_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
     let (verdict, located, fitted, explanation) = match (best, misaligned) {
         (Some(best), _) => {
             let sensor = best.effect.sensor();
@@ -352,7 +418,7 @@ pub fn diagnose(
             let allowed = (threshold + 2.0).max(share * strongest_of(sensor));
             let located = place_of(&evidence, Some(sensor), threshold);
             if left <= allowed {
-                let explanation = best.effect.explanation(&best.params);
+                let explanation = best.effect.explanation(&best.params, declared_cone);
                 (
                     Verdict::Effect(best.effect),
                     located,
@@ -409,7 +475,7 @@ pub fn diagnose(
             ));
         }
     }
-    let plots = show::plots(&ctx, &data, located.as_ref(), fitted.as_ref());
+    let plots = show::plots(plot_ctx, &data, located.as_ref(), fitted.as_ref());
     Ok(Diagnosis {
         verdict,
         located,

@@ -55,11 +55,6 @@ impl fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            ErrorKind::Io(err) => Some(err),
-            ErrorKind::Format(_) => None,
-        }
-    }
-}
+/// The I/O error's text is part of the message (one line naming the file), so it is not also
+/// the source: a report that prints the chain would say it twice.
+impl std::error::Error for Error {}

@@ -17,9 +17,12 @@
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
+
+mod support;
 use hilsim_calibrator::mismatch::{diagnose, Options, Verdict};
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
+use support::cpu_time;
 
 #[allow(dead_code)]
 #[path = "../../src/commands/diagnose/physics.rs"]
@@ -59,16 +62,6 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .num_threads(threads)
         .build()
         .expect("a thread pool")
-}
-
-/// This process's CPU time (user + system), seconds, from `/proc/self/stat` (Linux, 100 ticks
-/// per second); `None` elsewhere.
-fn cpu_time() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
 }
 
 /// Wall and CPU time of one call.

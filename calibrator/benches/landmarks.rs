@@ -21,6 +21,9 @@ use hilsim_calibrator::landmarks::estimate::EstimatorConfig;
 use hilsim_calibrator::landmarks::monte_carlo::{monte_carlo, Setup};
 use hilsim_calibrator::landmarks::{calibrate, Options};
 
+mod support;
+use support::cpu_time;
+
 /// Runs of one Monte Carlo point, as in the paper ("each point is the average of 1000
 /// simulations").
 const RUNS: usize = 1000;
@@ -80,17 +83,6 @@ fn benches(c: &mut Criterion) {
         b.iter(|| black_box(calibrate(&rec, &Options::default()).expect("calibrates")))
     });
     g.finish();
-}
-
-/// This process's CPU time (user + system), seconds, from `/proc/self/stat` (Linux, 100 ticks
-/// per second); `None` elsewhere.
-fn cpu_time() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which is in parentheses and may hold spaces).
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
 }
 
 /// Median wall time of `reps` repetitions, and the mean CPU time of one (user + system, all

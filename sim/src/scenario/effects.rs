@@ -9,6 +9,7 @@ use serde::Deserialize;
 
 use super::locate::{key_path, Key};
 use super::schema::{LidarTiming, Scenario};
+use super::validate::toml_number;
 
 /// `[effects]`: each table present switches that effect on.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
@@ -183,17 +184,6 @@ fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
     })
 }
 
-/// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
-fn shown(v: f64) -> String {
-    if v.is_nan() {
-        "nan".to_string()
-    } else if v.is_infinite() {
-        if v > 0.0 { "inf" } else { "-inf" }.to_string()
-    } else {
-        v.to_string()
-    }
-}
-
 /// `v` must be finite and lie in `[lo, hi]`.
 fn within(path: Vec<Key>, v: f64, lo: f64, hi: f64, what: &str) -> Check {
     if v.is_finite() && (lo..=hi).contains(&v) {
@@ -201,7 +191,7 @@ fn within(path: Vec<Key>, v: f64, lo: f64, hi: f64, what: &str) -> Check {
     } else {
         fail(
             path,
-            format!("expected {what} in {lo}..={hi}, found {}", shown(v)),
+            format!("expected {what} in {lo}..={hi}, found {}", toml_number(v)),
         )
     }
 }
@@ -213,7 +203,7 @@ fn positive_up_to(path: Vec<Key>, v: f64, hi: f64, what: &str) -> Check {
     } else {
         fail(
             path,
-            format!("expected {what} in (0, {hi}], found {}", shown(v)),
+            format!("expected {what} in (0, {hi}], found {}", toml_number(v)),
         )
     }
 }
@@ -281,7 +271,7 @@ pub(crate) fn validate(s: &Scenario) -> Check {
                 p("half_angle_deg"),
                 format!(
                     "expected 0 ≤ half_angle_deg < 90, found {}",
-                    shown(x.half_angle_deg)
+                    toml_number(x.half_angle_deg)
                 ),
             );
         }

@@ -21,7 +21,7 @@ fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
 }
 
 /// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
-fn toml_number(v: f64) -> String {
+pub(super) fn toml_number(v: f64) -> String {
     if v.is_nan() {
         "nan".to_string()
     } else if v.is_infinite() {

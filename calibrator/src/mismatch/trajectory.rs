@@ -1,8 +1,6 @@
 //! The robot's trajectory: poses at increasing times, interpolated linearly between them (the
 //! heading along the shorter arc), as the simulator interpolates within a physics step.
 
-use std::f64::consts::{PI, TAU};
-
 use hilsim_recording::TruthSample;
 
 use super::MismatchError;
@@ -18,16 +16,8 @@ pub struct Pose2 {
     pub yaw: f64,
 }
 
-/// Wraps an angle into (−π, π].
-#[must_use]
-pub fn wrap(a: f64) -> f64 {
-    let w = (a + PI).rem_euclid(TAU) - PI;
-    if w <= -PI {
-        w + TAU
-    } else {
-        w
-    }
-}
+/// Wraps an angle into (−π, π] (the landmark calibrator's, shared).
+pub use crate::landmarks::pose::wrap;
 
 /// Poses at increasing times.
 ///

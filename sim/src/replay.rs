@@ -50,6 +50,43 @@ pub fn replay_commands(
     commands: &[CommandSample],
     end_s: f64,
 ) -> Vec<TruthSample> {
+    replay(scenario, commands, end_s).0
+}
+
+/// The intervals `(from, to)` of [`replay_commands`]'s run during which the robot touches an
+/// obstacle: where the wheels' travel is the contact's doing, not the drive's.
+///
+/// ```
+/// use hilsim_recording::CommandSample;
+/// use hilsim_sim::{replay::replay_contacts, Scenario};
+/// let s = Scenario::from_toml(
+///     "name = \"r\"\nduration_s = 3.0\n[world]\nwalls = [{ from = [1.0, -1.0], to = [1.0, 1.0] }]\n\
+///      [robot]\nstart = { x = 0.0, y = 0.0 }\nwheel_base_m = 0.2\n",
+///     "inline.toml".as_ref(),
+/// )?;
+/// let into_the_wall = [CommandSample { t_s: 0.0, left_mps: 0.5, right_mps: 0.5 }];
+/// let touching = replay_contacts(&s, &into_the_wall, 3.0);
+/// assert_eq!(touching.len(), 1);
+/// assert!(touching[0].0 > 1.0 && touching[0].0 < 2.0 && touching[0].1 > 2.9, "{touching:?}");
+/// let away = [CommandSample { t_s: 0.0, left_mps: -0.5, right_mps: -0.5 }];
+/// assert!(replay_contacts(&s, &away, 3.0).is_empty());
+/// # Ok::<(), hilsim_sim::ScenarioError>(())
+/// ```
+#[must_use]
+pub fn replay_contacts(
+    scenario: &Scenario,
+    commands: &[CommandSample],
+    end_s: f64,
+) -> Vec<(f64, f64)> {
+    replay(scenario, commands, end_s).1
+}
+
+fn replay(
+    scenario: &Scenario,
+    commands: &[CommandSample],
+    end_s: f64,
+) -> (Vec<TruthSample>, Vec<(f64, f64)>) {
+    let mut contacts: Vec<(f64, f64)> = Vec::new();
     let mut sim = Simulation::externally_driven(scenario);
     let dt = sim.step_s();
     let steps = (end_s / dt).round().max(0.0) as u64;
@@ -65,9 +102,15 @@ pub fn replay_commands(
             });
             next += 1;
         }
-        if sim.step().is_none() {
+        let Some(step) = sim.step() else {
             break;
+        };
+        if sim.in_contact() {
+            match contacts.last_mut() {
+                Some(last) if last.1 >= step.t0 => last.1 = step.t1,
+                _ => contacts.push((step.t0, step.t1)),
+            }
         }
     }
-    sim.truth().to_vec()
+    (sim.truth().to_vec(), contacts)
 }

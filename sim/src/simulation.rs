@@ -282,6 +282,12 @@ impl Simulation {
         self.touching = now;
     }
 
+    /// Whether the robot touches an obstacle at the end of the last step.
+    #[must_use]
+    pub fn in_contact(&self) -> bool {
+        !self.touching.is_empty()
+    }
+
     /// Commands as issued so far, one row per change.
     #[must_use]
     pub fn commands(&self) -> &[CommandSample] {

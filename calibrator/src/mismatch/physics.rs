@@ -315,6 +315,13 @@ pub trait Physics: Sync {
     /// A name for an object of [`LidarPrediction::object`], e.g. `board 1 (dark)`.
     fn object_name(&self, object: u32) -> String;
 
+    /// The intervals `(from, to)`, seconds, in which the robot replaying `commands` under the
+    /// nominal model touches an obstacle (its wheels' travel there is the contact's doing, not
+    /// the drive's). Default: none (a physics without contacts).
+    fn drive_contacts(&self, _commands: &[CommandSample], _end_s: f64) -> Vec<(f64, f64)> {
+        Vec::new()
+    }
+
     /// The robot's trajectory from t = 0 to `end_s` when its wheels are commanded by `commands`
     /// (the recording's `commands.csv`), under `hypothesis` (motor lag; any other effect leaves
     /// the drive nominal). The declared actuation error is left out: it is noise to the

@@ -20,6 +20,8 @@ use super::MismatchError;
 pub const SPLIT_BLOCK_S: f64 = 2.0;
 /// Window of the drive's residuals (wheel travel increments), seconds.
 pub const DRIVE_WINDOW_S: f64 = 0.1;
+/// Margin around a contact of the replayed robot in which the drive is not compared, seconds.
+const CONTACT_MARGIN_S: f64 = 0.5;
 /// Normal scores are clipped here, so one wild reading cannot dominate a test.
 pub const Z_CLIP: f64 = 6.0;
 
@@ -234,9 +236,11 @@ impl Context<'_> {
                     .collect();
                 // Two differences of the trajectory's positions per window.
                 let noise_var = 2.0 * self.position_sd_m * self.position_sd_m;
+                let starts: Vec<f64> = windows.iter().map(|w| w.0).collect();
                 let all = drive_predictions(
                     &increments,
                     &data.y,
+                    &starts,
                     self.physics.declared().actuation,
                     noise_var,
                 );
@@ -261,17 +265,19 @@ impl Context<'_> {
 fn drive_predictions(
     increments: &[f64],
     y: &[f64],
+    starts: &[f64],
     actuation: DeclaredActuation,
     noise_var: f64,
 ) -> Vec<Gaussian> {
     let noise_var = noise_var.max(1e-12);
-    // Discrete OU over one window: w' = a w + √(1 − a²) σ_w e.
-    let a = if actuation.wander_tau_s > 0.0 {
-        (-DRIVE_WINDOW_S / actuation.wander_tau_s).exp()
-    } else {
-        0.0
+    // Discrete OU from one window to the next (`dt` apart): w' = a w + √(1 − a²) σ_w e.
+    let decay = |dt: f64| {
+        if actuation.wander_tau_s > 0.0 {
+            (-dt / actuation.wander_tau_s).exp()
+        } else {
+            0.0
+        }
     };
-    let q = actuation.wander_sd.powi(2) * (1.0 - a * a);
     // State (f, w) and its covariance [[pff, pfw], [pfw, pww]].
     let (mut f, mut w) = (0.0, 0.0);
     let (mut pff, mut pfw, mut pww) =
@@ -279,9 +285,10 @@ fn drive_predictions(
     let mut out = Vec::with_capacity(increments.len());
     for (i, (&inc, &real)) in increments.iter().zip(y).enumerate() {
         if i % 2 == 0 && i > 0 {
+            let a = decay(starts[i / 2] - starts[i / 2 - 1]);
             w *= a;
             pfw *= a;
-            pww = a * a * pww + q;
+            pww = a * a * pww + actuation.wander_sd.powi(2) * (1.0 - a * a);
         }
         // Observation: real = inc (1 + f + w) + noise.
         let mean = inc * (1.0 + f + w);
@@ -623,8 +630,20 @@ pub(crate) fn drive(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
     .map(|c| (c, Vec::new()))
     .collect();
     let half_base = ctx.physics.declared().wheel_base_m / 2.0;
+    // Where the robot touches an obstacle its wheels' travel is the contact's doing (and the
+    // real run meets it a little earlier or later, or another simulator resolves it otherwise):
+    // those windows, with a margin, are not the drive's evidence.
+    let contacts = ctx.physics.drive_contacts(commands, ctx.end_s);
+    let touching = |a: f64, b: f64| {
+        contacts
+            .iter()
+            .any(|&(from, to)| a < to + CONTACT_MARGIN_S && b > from - CONTACT_MARGIN_S)
+    };
     for k in 0..n {
         let (a, b) = (k as f64 * DRIVE_WINDOW_S, (k + 1) as f64 * DRIVE_WINDOW_S);
+        if touching(a, b) {
+            continue;
+        }
         windows.push((a, b));
         let (wa, wb) = (tr.interpolate(&travel, a), tr.interpolate(&travel, b));
         // The command in force at the window's start, and how long it has been.
@@ -747,13 +766,15 @@ mod tests {
             )
         };
         let var = noise_sd * noise_sd;
-        let (mean, msq) = scores(&drive_predictions(&increments, &y, actuation, var));
+        let starts: Vec<f64> = (0..2000).map(|k| f64::from(k) * DRIVE_WINDOW_S).collect();
+        let (mean, msq) = scores(&drive_predictions(&increments, &y, &starts, actuation, var));
         assert!(mean.abs() < 0.08, "mean score {mean}");
         assert!((msq - 1.0).abs() < 0.15, "mean square {msq}");
         // The same data against the commands alone (an ideal drive declared): far from noise.
         let (mean, _) = scores(&drive_predictions(
             &increments,
             &y,
+            &starts,
             DeclaredActuation::default(),
             var,
         ));

@@ -53,6 +53,16 @@ fn pose(p: Pose2) -> Pose {
 }
 
 impl SimPhysics {
+    /// The scenario whose drive replays commands under `hypothesis`. The declared actuation
+    /// error is noise to the diagnosis, not a prediction, so it is left out.
+    fn drive_scenario(&self, hypothesis: &Hypothesis) -> Scenario {
+        let mut s = self.scenario.clone();
+        s.effects = self.effects(hypothesis);
+        s.robot.actuation.scale_sd = 0.0;
+        s.robot.actuation.wander_sd = 0.0;
+        s
+    }
+
     /// The physics of `scenario` as declared (its own `[effects]` included: they are part of
     /// what it declares).
     pub fn new(scenario: &Scenario) -> Result<Self> {
@@ -229,12 +239,15 @@ impl Physics for SimPhysics {
         end_s: f64,
         hypothesis: &Hypothesis,
     ) -> Vec<TruthSample> {
-        let mut s = self.scenario.clone();
-        s.effects = self.effects(hypothesis);
-        // The declared actuation error is noise to the diagnosis, not a prediction.
-        s.robot.actuation.scale_sd = 0.0;
-        s.robot.actuation.wander_sd = 0.0;
-        replay::replay_commands(&s, commands, end_s)
+        replay::replay_commands(&self.drive_scenario(hypothesis), commands, end_s)
+    }
+
+    fn drive_contacts(&self, commands: &[CommandSample], end_s: f64) -> Vec<(f64, f64)> {
+        replay::replay_contacts(
+            &self.drive_scenario(&Hypothesis::nominal()),
+            commands,
+            end_s,
+        )
     }
 
     fn lidar(

@@ -173,8 +173,10 @@ pub(crate) fn realign(
     let (trajectory, sd) = estimate_trajectory(physics, recording, aligned.end_s, hypothesis)?;
     Ok(Aligned {
         trajectory,
+        alignment: aligned.alignment,
+        end_s: aligned.end_s,
         position_sd_m: sd.position_m,
         yaw_sd_rad: sd.yaw_rad,
-        ..aligned.clone()
+        notes: aligned.notes.clone(),
     })
 }

@@ -13,7 +13,6 @@ pub mod error;
 pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
-pub mod mismatch;
 pub mod smoothing;
 pub mod target_samples;
 

@@ -6,18 +6,14 @@
 //! common, not a run of the scenario), with one line naming the file and the reason. The
 //! self-test exits 1 when it misses one of its goals.
 
-mod physics;
-mod self_test;
-
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use hilsim_calibrator::mismatch::{self, show, Options};
+use hilsim_diagnose::self_test::{self, Plan};
+use hilsim_diagnose::{show, Effect, Options, SimPhysics};
 use hilsim_recording::{write_file_atomically, Recording};
-
-pub use physics::SimPhysics;
 
 /// Compare a simulation with a real recording: locate the mismatch, name the physics left out,
 /// fit it, show the held-out improvement. Or prove it blind with `--self-test N`.
@@ -78,9 +74,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         let only = match args.only.as_deref() {
             None => None,
             Some("none") => Some(0),
-            Some(name) => match mismatch::Effect::from_name(name) {
+            Some(name) => match Effect::from_name(name) {
                 Some(e) => Some(
-                    1 + mismatch::Effect::ALL
+                    1 + Effect::ALL
                         .iter()
                         .position(|x| *x == e)
                         .unwrap_or(0),
@@ -88,20 +84,29 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
                 None => bail!("--only: expected `none` or a catalogued effect, found `{name}`"),
             },
         };
+        let plan = Plan {
+            trials: n as u64,
+            seed,
+            strength: args.strength,
+            only,
+        };
         if let Some(i) = args.trial {
             if i >= n as u64 {
                 bail!("--trial: expected a trial below --self-test {n}, found {i}");
             }
-            return self_test::one(
-                &scenario,
-                seed,
-                i,
-                args.strength,
-                only,
-                args.json,
-                args.report.as_deref(),
-                out,
-            );
+            let run = self_test::one(&scenario, plan, i)?;
+            if let Some(dir) = args.report.as_deref() {
+                let rec_dir = dir.join("recording");
+                run.recording.write_dir(&rec_dir)?;
+                let origin = format!("<built-in {}>", scenario.name);
+                write_report(dir, &run.diagnosis, Path::new(&origin), &rec_dir)?;
+            }
+            if args.json {
+                writeln!(out, "{}", run.to_json())?;
+            } else {
+                out.write_all(run.to_text().as_bytes())?;
+            }
+            return Ok(ExitCode::SUCCESS);
         }
         // The command that reproduces this self-test.
         let mut command = format!("hilsim diagnose --self-test {n} --seed {seed}");
@@ -114,16 +119,19 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         if args.strength != 1.0 {
             command += &format!(" --strength {}", args.strength);
         }
-        return self_test::run(
-            &scenario,
-            n,
-            seed,
-            args.strength,
-            only,
-            args.json,
-            &command,
-            out,
-        );
+        let started = std::time::Instant::now();
+        let result = self_test::run(&scenario, plan)?;
+        let wall_s = started.elapsed().as_secs_f64();
+        if args.json {
+            writeln!(out, "{}", result.to_json(&command, wall_s))?;
+        } else {
+            out.write_all(result.to_text(&command, wall_s).as_bytes())?;
+        }
+        return Ok(if result.passed() {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::from(1)
+        });
     }
     let (Some(sim), Some(real)) = (&args.sim, &args.real) else {
         bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
@@ -131,7 +139,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let scenario = super::load_scenario(Some(sim), None)?;
     let recording = Recording::read_dir(real)?;
     let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
-    let diagnosis = mismatch::diagnose(&physics, &recording, &Options::default())
+    let diagnosis = hilsim_diagnose::diagnose(&physics, &recording, &Options::default())
         .with_context(|| real.display().to_string())?;
     if let Some(dir) = &args.report {
         write_report(dir, &diagnosis, sim, real)?;
@@ -148,9 +156,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
 }
 
 /// Writes `index.html` and its plots into `dir` (created if needed), each file atomically.
-pub(crate) fn write_report(
+fn write_report(
     dir: &Path,
-    d: &mismatch::Diagnosis,
+    d: &hilsim_diagnose::Diagnosis,
     sim: &Path,
     real: &Path,
 ) -> Result<()> {

@@ -1,12 +1,11 @@
-//! The diagnosis's physics (`hilsim_calibrator::mismatch::Physics`) from the simulator: the
+//! The diagnosis's physics ([`crate::Physics`]) from the simulator: the
 //! scenario's world and sensor models, with a catalogued effect switched on as the
 //! `[effects]` table of a scenario would. Glue only: every model lives in `hilsim-sim` and
 //! `hilsim-lidar-emulator` (`effects`, `prediction`, `replay`).
 
-use anyhow::{Context, Result};
-use hilsim_calibrator::mismatch::{
+use crate::{
     Declared, DeclaredActuation, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
-    LidarQuery, OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
+    LidarQuery, MismatchError, OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
 };
 use hilsim_lidar_emulator::effects::LidarEffects;
 use hilsim_lidar_emulator::prediction::{
@@ -65,13 +64,15 @@ impl SimPhysics {
 
     /// The physics of `scenario` as declared (its own `[effects]` included: they are part of
     /// what it declares).
-    pub fn new(scenario: &Scenario) -> Result<Self> {
+    pub fn new(scenario: &Scenario) -> Result<Self, MismatchError> {
         // Check the sensor models once, so that predicting cannot fail later.
         if let Some(l) = &scenario.sensors.lidar {
-            LidarPredictor::new(l, LidarEffects::default()).context("lidar model")?;
+            LidarPredictor::new(l, LidarEffects::default())
+                .map_err(|e| MismatchError::Input(format!("lidar model: {e}")))?;
         }
         if let Some(s) = &scenario.sensors.sonar {
-            SonarPredictor::new(s, &scenario.effects).context("sonar model")?;
+            SonarPredictor::new(s, &scenario.effects)
+                .map_err(|e| MismatchError::Input(format!("sonar model: {e}")))?;
         }
         let s = &scenario;
         let a = s.robot.actuation;

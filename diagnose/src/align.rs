@@ -1,0 +1,182 @@
+//! Align: put the real recording on the simulation's clock and in its world. With `truth.csv`
+//! (a simulator's, or a motion-capture system's) the real trajectory is known; without it, it is
+//! estimated from the recording (`estimate.rs`). Either way the recording must be a run of the
+//! scenario: long enough, with a sensor in common, starting where the scenario starts.
+
+use hilsim_recording::Recording;
+
+use crate::diagnosis::MismatchError;
+use crate::estimate::estimate_trajectory;
+use crate::physics::{Hypothesis, Physics};
+use crate::trajectory::{wrap, Trajectory};
+
+/// The shortest recording diagnosed, seconds: two training and two held-out blocks.
+pub const MIN_DURATION_S: f64 = 8.0;
+/// How far the recorded start may lie from the scenario's, metres.
+pub const START_TOLERANCE_M: f64 = 0.3;
+/// How far the recorded start heading may lie from the scenario's, degrees.
+pub const START_TOLERANCE_DEG: f64 = 15.0;
+/// Position noise assumed for a recorded trajectory (a motion-capture system's ~1 mm), metres.
+pub const TRUTH_POSITION_SD_M: f64 = 0.001;
+
+/// Where the real trajectory came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Alignment {
+    /// The recording's `truth.csv`.
+    Truth,
+    /// Estimated from the recording: the replayed commands (or the encoders), corrected by
+    /// matching the lidar's scans to the scenario's world.
+    Estimated,
+}
+
+impl Alignment {
+    /// The name used in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Alignment::Truth => "truth.csv",
+            Alignment::Estimated => "estimated (replayed commands + scan-to-map matching)",
+        }
+    }
+}
+
+/// The aligned run.
+#[derive(Debug, Clone)]
+pub(crate) struct Aligned {
+    pub trajectory: Trajectory,
+    pub alignment: Alignment,
+    /// The recording's end, seconds.
+    pub end_s: f64,
+    /// The standard deviation of the trajectory's positions, metres: a motion-capture system's
+    /// ~1 mm for `truth.csv`, the scan matching's own for an estimate.
+    pub position_sd_m: f64,
+    /// The standard deviation of its headings, radians (0 for `truth.csv`).
+    pub yaw_sd_rad: f64,
+    /// What the user should know (sensors missing on one side).
+    pub notes: Vec<String>,
+}
+
+/// Aligns `recording` with the scenario behind `physics`.
+///
+/// # Errors
+/// [`MismatchError::Refused`] when the recording cannot be a run of the scenario (too short,
+/// no sensor in common, a different start) or its trajectory cannot be had.
+pub(crate) fn align(
+    physics: &dyn Physics,
+    recording: &Recording,
+) -> Result<Aligned, MismatchError> {
+    let declared = physics.declared();
+    let end_s = recording.duration_s();
+    if end_s < MIN_DURATION_S {
+        return Err(MismatchError::Refused(format!(
+            "the recording lasts {end_s:.1} s: too short to diagnose (at least {MIN_DURATION_S} s, \
+             so that both the training and the held-out half hold two blocks)"
+        )));
+    }
+    let mut notes = Vec::new();
+    let mut common = Vec::new();
+    for (name, sim, real) in [
+        ("lidar", declared.lidar.is_some(), recording.lidar.is_some()),
+        (
+            "sonar",
+            declared.sonar_half_angle_deg.is_some(),
+            recording.sonar.is_some(),
+        ),
+        ("odometer", declared.odometer, recording.odometry.is_some()),
+    ] {
+        match (sim, real) {
+            (true, true) => common.push(name),
+            (true, false) => notes.push(format!(
+                "the scenario has a {name} but the recording has none: not diagnosed"
+            )),
+            (false, true) => notes.push(format!(
+                "the recording has a {name} the scenario lacks: not diagnosed"
+            )),
+            (false, false) => {}
+        }
+    }
+    if common.is_empty() && recording.truth.is_none() {
+        return Err(MismatchError::Refused(
+            "the recording and the scenario have no sensor in common and the recording has no \
+             truth.csv: nothing to compare"
+                .into(),
+        ));
+    }
+    let (trajectory, alignment, position_sd_m, yaw_sd_rad) = match &recording.truth {
+        Some(truth) if !truth.is_empty() => (
+            Trajectory::new(truth)?,
+            Alignment::Truth,
+            TRUTH_POSITION_SD_M,
+            0.0,
+        ),
+        _ => {
+            if declared.lidar.is_none() || recording.lidar.is_none() {
+                return Err(MismatchError::Refused(
+                    "the recording has no truth.csv, and without a lidar its trajectory cannot \
+                     be estimated against the scenario's world"
+                        .into(),
+                ));
+            }
+            let (trajectory, sd) =
+                estimate_trajectory(physics, recording, end_s, &Hypothesis::nominal())?;
+            notes.push(format!(
+                "no truth.csv: the trajectory is estimated by matching the lidar to the \
+                 scenario's world (position s.d. {:.1} mm, heading {:.2} mrad), so only the \
+                 lidar and the sonar are diagnosed, with that uncertainty in their noise and no \
+                 whiteness test (the estimate's errors are shared by a revolution's readings); \
+                 an effect that shifts every range alike is partly absorbed into the estimate",
+                sd.position_m * 1000.0,
+                sd.yaw_rad * 1000.0
+            ));
+            (trajectory, Alignment::Estimated, sd.position_m, sd.yaw_rad)
+        }
+    };
+    let start = trajectory.pose_at(0.0);
+    let off = (start.x - declared.start.x).hypot(start.y - declared.start.y);
+    let turned = wrap(start.yaw - declared.start.yaw).abs().to_degrees();
+    if off > START_TOLERANCE_M || turned > START_TOLERANCE_DEG {
+        return Err(MismatchError::Refused(format!(
+            "the recording starts at ({:.2}, {:.2}) m heading {:.0}° but the scenario `{}` at \
+             ({:.2}, {:.2}) m heading {:.0}°: not a run of this scenario",
+            start.x,
+            start.y,
+            start.yaw.to_degrees(),
+            declared.scenario,
+            declared.start.x,
+            declared.start.y,
+            declared.start.yaw.to_degrees()
+        )));
+    }
+    Ok(Aligned {
+        trajectory,
+        alignment,
+        end_s,
+        position_sd_m,
+        yaw_sd_rad,
+        notes,
+    })
+}
+
+/// `aligned` (an estimated trajectory) estimated again with the lidar predicted under
+/// `hypothesis`: a lidar effect that the nominal model cannot take is partly absorbed into the
+/// scan matching's corrections, so an effect's fit is refined against the trajectory its own
+/// model gives (one step of alternating the alignment and the fit).
+///
+/// # Errors
+/// As [`align`].
+pub(crate) fn realign(
+    physics: &dyn Physics,
+    recording: &Recording,
+    aligned: &Aligned,
+    hypothesis: &Hypothesis,
+) -> Result<Aligned, MismatchError> {
+    let (trajectory, sd) = estimate_trajectory(physics, recording, aligned.end_s, hypothesis)?;
+    Ok(Aligned {
+        trajectory,
+        alignment: aligned.alignment,
+        end_s: aligned.end_s,
+        position_sd_m: sd.position_m,
+        yaw_sd_rad: sd.yaw_rad,
+        notes: aligned.notes.clone(),
+    })
+}

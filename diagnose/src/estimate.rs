@@ -1,0 +1,451 @@
+//! Estimating the real trajectory when the recording has no `truth.csv`: the commands replayed
+//! through the nominal drive (or, without commands, dead reckoning from the encoders), corrected
+//! revolution by revolution by matching the lidar's readings to the scenario's world.
+//!
+//! Each revolution's correction `(dx, dy, dθ)` is added to the dead-reckoned poses within it
+//! (over 0.2 s the difference between adding and composing it is far below a millimetre) and
+//! found by Gauss–Newton on the readings' normalised residuals against the nominal prediction,
+//! with Huber weights (k = 2) so that readings the world does not explain (people, a mixed pixel)
+//! do not pull it; the Jacobian by central differences (1 mm, 1 mrad) through the physics. It
+//! starts from the previous revolution's correction. The revolutions' corrections are then
+//! smoothed over time (a random walk whose steps grow with the motion, RTS smoother), and
+//! interpolated linearly between revolutions.
+//!
+//! An effect that biases the lidar is partly absorbed into these corrections; effects with a
+//! shape a rigid shift cannot take (incidence, reflectivity, mixed pixels, skew while turning)
+//! still show. The estimate's own uncertainty is reported, and the drive's and the encoders'
+//! residuals are widened by it.
+
+use hilsim_recording::{LidarSample, Recording, TruthSample};
+
+use crate::diagnosis::MismatchError;
+use crate::physics::{Hypothesis, LidarQuery, Physics};
+use crate::trajectory::{wrap, Trajectory};
+
+/// Gauss–Newton iterations per revolution.
+const ITERATIONS: usize = 6;
+/// Readings of a revolution used (evenly thinned).
+const READINGS_PER_REV: usize = 90;
+/// Huber's k, in normalised residuals.
+const HUBER_K: f64 = 2.0;
+
+/// The trajectory to correct: the commands through the nominal drive, or the encoders' travel
+/// integrated from the declared start.
+fn dead_reckoning(
+    physics: &dyn Physics,
+    recording: &Recording,
+    end_s: f64,
+) -> Result<Trajectory, MismatchError> {
+    let d = physics.declared();
+    // The commands through the nominal drive give a smooth path; the encoders' readings carry
+    // their noise into every pose (2 mm per reading is ~10 mrad of heading between readings),
+    // so they are the fallback.
+    if !recording.commands.is_empty() {
+        let replay = physics.drive(&recording.commands, end_s, &Hypothesis::nominal());
+        if replay.len() >= 2 {
+            return Trajectory::new(&replay);
+        }
+    }
+    let Some(odometry) = recording.odometry.as_ref().filter(|o| o.len() >= 2) else {
+        return Err(MismatchError::Refused(
+            "the recording has no truth.csv, no commands and no odometry to follow the robot by"
+                .into(),
+        ));
+    };
+    let mut pose = d.start;
+    let mut out = vec![TruthSample {
+        t_s: 0.0,
+        x_m: pose.x,
+        y_m: pose.y,
+        yaw_rad: pose.yaw,
+    }];
+    let mut last = odometry[0];
+    for o in &odometry[1..] {
+        let (dl, dr) = (o.left_m - last.left_m, o.right_m - last.right_m);
+        let forward = (dl + dr) / 2.0;
+        let turn = (dr - dl) / d.wheel_base_m;
+        let mid = pose.yaw + turn / 2.0;
+        pose.x += forward * mid.cos();
+        pose.y += forward * mid.sin();
+        pose.yaw = wrap(pose.yaw + turn);
+        if o.t_s > out[out.len() - 1].t_s {
+            out.push(TruthSample {
+                t_s: o.t_s,
+                x_m: pose.x,
+                y_m: pose.y,
+                yaw_rad: pose.yaw,
+            });
+        }
+        last = *o;
+    }
+    Trajectory::new(&out)
+}
+
+/// `base` between `t0` and `t1` (its samples there and the interpolated ends) with
+/// `correction` added to every pose.
+fn shifted(base: &Trajectory, t0: f64, t1: f64, correction: [f64; 3]) -> Trajectory {
+    let inside = base
+        .times()
+        .iter()
+        .zip(base.poses())
+        .filter(|(&t, _)| t > t0 && t < t1)
+        .map(|(&t, &p)| (t, p));
+    let samples: Vec<TruthSample> = std::iter::once((t0, base.pose_at(t0)))
+        .chain(inside)
+        .chain(std::iter::once((t1, base.pose_at(t1))))
+        .map(|(t, p)| TruthSample {
+            t_s: t,
+            x_m: p.x + correction[0],
+            y_m: p.y + correction[1],
+            yaw_rad: wrap(p.yaw + correction[2]),
+        })
+        .collect();
+    // The base trajectory is valid, so is its shifted piece.
+    Trajectory::new(&samples).unwrap_or_else(|_| base.clone())
+}
+
+/// The normalised residuals of `readings` under the nominal prediction from `trajectory`
+/// (`None` where nothing valid is predicted).
+fn residuals(
+    physics: &dyn Physics,
+    trajectory: &Trajectory,
+    queries: &[LidarQuery],
+    readings: &[f64],
+    hypothesis: &Hypothesis,
+) -> Vec<Option<f64>> {
+    physics
+        .lidar(trajectory, queries, hypothesis)
+        .iter()
+        .zip(readings)
+        .map(|(p, &y)| {
+            // The component nearest the reading, in its own standard deviations (the moments
+            // of what is reported valid: near a range limit, of the truncated distribution).
+            p.components
+                .iter()
+                .map(|g| {
+                    let (mean, sd) = g.moments();
+                    (y - mean) / sd
+                })
+                .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+        })
+        .collect()
+}
+
+/// How uncertain an estimated trajectory is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Uncertainty {
+    /// Standard deviation of a position, metres.
+    pub position_m: f64,
+    /// Standard deviation of a heading, radians.
+    pub yaw_rad: f64,
+}
+
+/// The trajectory estimated from `recording`, and its uncertainty, with the lidar predicted
+/// under `hypothesis` (the nominal model first; a fitted effect when re-aligning).
+///
+/// # Errors
+/// [`MismatchError::Refused`] without lidar readings to match.
+pub(crate) fn estimate_trajectory(
+    physics: &dyn Physics,
+    recording: &Recording,
+    end_s: f64,
+    hypothesis: &Hypothesis,
+) -> Result<(Trajectory, Uncertainty), MismatchError> {
+    let Some(lidar) = recording.lidar.as_ref().filter(|l| !l.is_empty()) else {
+        return Err(MismatchError::Refused(
+            "the recording has no truth.csv and no lidar readings to estimate its trajectory with"
+                .into(),
+        ));
+    };
+    let base = dead_reckoning(physics, recording, end_s)?;
+    let period = physics
+        .declared()
+        .lidar
+        .map_or(1.0 / 1800.0, |l| 60.0 / (l.rpm * 360.0));
+    let snapshot = physics.declared().lidar.is_some_and(|l| l.snapshot);
+    // The revolutions, in order.
+    let mut revs: Vec<(u64, Vec<&LidarSample>)> = Vec::new();
+    for s in lidar {
+        match revs.last_mut() {
+            Some((rev, rows)) if *rev == s.rev => rows.push(s),
+            _ => revs.push((s.rev, vec![s])),
+        }
+    }
+    let mut knots: Vec<(f64, [f64; 3])> = Vec::with_capacity(revs.len());
+    let mut variances = Vec::new();
+    let mut correction = [0.0; 3];
+    for (_, rows) in &revs {
+        let start = rows[0].t_s - f64::from(rows[0].angle_deg) * period;
+        let valid: Vec<&&LidarSample> = rows
+            .iter()
+            .filter(|s| !s.invalid && s.range_m > 0.0)
+            .collect();
+        if valid.len() < 12 {
+            continue;
+        }
+        let stride = valid.len().div_ceil(READINGS_PER_REV).max(1);
+        let used: Vec<&&LidarSample> = valid.into_iter().step_by(stride).collect();
+        let queries: Vec<LidarQuery> = used
+            .iter()
+            .map(|s| LidarQuery {
+                t_s: s.t_s,
+                rev_start_s: start,
+                angle_deg: f64::from(s.angle_deg),
+            })
+            .collect();
+        let y: Vec<f64> = used.iter().map(|s| s.range_m).collect();
+        // The piece of trajectory the revolution's readings need (timestamps or its start).
+        let (t0, t1) = (
+            start.min(used[0].t_s) - 0.01,
+            used[used.len() - 1].t_s + 0.01,
+        );
+        let steps = [0.001, 0.001, 0.001];
+        let mut info = [[0.0; 3]; 3];
+        for _ in 0..ITERATIONS {
+            let r0 = residuals(
+                physics,
+                &shifted(&base, t0, t1, correction),
+                &queries,
+                &y,
+                hypothesis,
+            );
+            // Central differences of the residuals along each coordinate.
+            let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; y.len()];
+            let mut usable = vec![true; y.len()];
+            for k in 0..3 {
+                let mut up = correction;
+                let mut down = correction;
+                up[k] += steps[k];
+                down[k] -= steps[k];
+                let ru = residuals(
+                    physics,
+                    &shifted(&base, t0, t1, up),
+                    &queries,
+                    &y,
+                    hypothesis,
+                );
+                let rd = residuals(
+                    physics,
+                    &shifted(&base, t0, t1, down),
+                    &queries,
+                    &y,
+                    hypothesis,
+                );
+                for i in 0..y.len() {
+                    match (ru[i], rd[i]) {
+                        (Some(a), Some(b)) => jac[i][k] = (a - b) / (2.0 * steps[k]),
+                        _ => usable[i] = false,
+                    }
+                }
+            }
+            // Weighted normal equations J'WJ δ = −J'W r.
+            let mut a = [[0.0; 3]; 3];
+            let mut g = [0.0; 3];
+            for i in 0..y.len() {
+                let Some(r) = r0[i].filter(|_| usable[i]) else {
+                    continue;
+                };
+                let w = if r.abs() <= HUBER_K {
+                    1.0
+                } else {
+                    HUBER_K / r.abs()
+                };
+                for p in 0..3 {
+                    g[p] -= w * jac[i][p] * r;
+                    for q in 0..3 {
+                        a[p][q] += w * jac[i][p] * jac[i][q];
+                    }
+                }
+            }
+            info = a;
+            let Some(delta) = solve3(a, g) else {
+                break;
+            };
+            // Trust region: at most 5 cm and 3° per step.
+            let scale = (delta[0].hypot(delta[1]) / 0.05)
+                .max(delta[2].abs() / 0.05)
+                .max(1.0);
+            for k in 0..3 {
+                correction[k] += delta[k] / scale;
+            }
+            if delta[0].hypot(delta[1]) < 1e-5 && delta[2].abs() < 1e-5 {
+                break;
+            }
+        }
+        // The correction holds where the readings' geometry was taken: at the revolution's
+        // start for a lidar that takes it at one instant, else around its middle.
+        let knot = if snapshot {
+            start
+        } else {
+            start + 0.5 * 360.0 * period
+        };
+        // A revolution whose geometry pins no coordinate (a corridor's length) is left to the
+        // others.
+        let Some(inv) = invert3(info) else {
+            continue;
+        };
+        knots.push((knot, correction));
+        variances.push([inv[0][0], inv[1][1], inv[2][2]]);
+    }
+    let (knots, variances) = smooth_corrections(&base, &knots, &variances);
+    if knots.is_empty() {
+        return Err(MismatchError::Refused(
+            "the recording has no truth.csv and too few valid lidar readings to estimate its \
+             trajectory"
+                .into(),
+        ));
+    }
+    // Dead reckoning plus the correction, interpolated between revolutions.
+    let at = |t: f64| -> [f64; 3] {
+        let i = knots.partition_point(|k| k.0 <= t);
+        match (i.checked_sub(1).map(|j| knots[j]), knots.get(i)) {
+            (Some(a), Some(b)) => {
+                let u = (t - a.0) / (b.0 - a.0);
+                [0, 1, 2].map(|k| a.1[k] + (b.1[k] - a.1[k]) * u)
+            }
+            (Some(a), None) => a.1,
+            (None, Some(b)) => b.1,
+            (None, None) => [0.0; 3],
+        }
+    };
+    let samples: Vec<TruthSample> = base
+        .times()
+        .iter()
+        .zip(base.poses())
+        .map(|(&t, p)| {
+            let c = at(t);
+            TruthSample {
+                t_s: t,
+                x_m: p.x + c[0],
+                y_m: p.y + c[1],
+                yaw_rad: wrap(p.yaw + c[2]),
+            }
+        })
+        .collect();
+    // The median revolution's smoothed standard errors, doubled (and floored at 3 mm and
+    // 1 mrad): the curvature of the fits leaves out the interpolation between revolutions.
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    let pos = median(variances.iter().map(|v| (v[0] + v[1]) / 2.0).collect());
+    let yaw = median(variances.iter().map(|v| v[2]).collect());
+    let sd = Uncertainty {
+        position_m: (2.0 * pos.max(0.0).sqrt()).max(0.003),
+        yaw_rad: (2.0 * yaw.max(0.0).sqrt()).max(0.001),
+    };
+    Ok((Trajectory::new(&samples)?, sd))
+}
+
+/// A revolution's time and its correction `(dx, dy, dθ)`.
+type Knot = (f64, [f64; 3]);
+
+/// Drift of the dead reckoning the corrections follow, per metre travelled and per radian
+/// turned: generous (5 % of the travel, 0.02 rad per metre and 5 % of the turn) so that a
+/// drive that departs from its commands (a concealed motor lag, slip) is followed, not
+/// smoothed over. Standing still, the correction may wander by 1 mm and 0.5 mrad per
+/// revolution.
+const DRIFT_PER_M: f64 = 0.05;
+const YAW_DRIFT_PER_M: f64 = 0.02;
+const YAW_DRIFT_PER_RAD: f64 = 0.05;
+const STILL_DRIFT_M: f64 = 0.001;
+const STILL_DRIFT_RAD: f64 = 0.0005;
+
+/// The revolutions' corrections smoothed over time, with their variances: each coordinate a
+/// random walk whose steps grow with the distance and the turn the dead reckoning covers
+/// between two revolutions, observed by each revolution's scan match with the variance its fit
+/// gives (Rauch–Tung–Striebel smoother; Shumway & Stoffer, §6.2). One revolution's match uses
+/// a few dozen readings and errs by centimetres in a sparse world; while the robot stands, the
+/// smoother averages every revolution of the stop.
+fn smooth_corrections(
+    base: &Trajectory,
+    knots: &[Knot],
+    variances: &[[f64; 3]],
+) -> (Vec<Knot>, Vec<[f64; 3]>) {
+    let n = knots.len();
+    if n < 2 {
+        return (knots.to_vec(), variances.to_vec());
+    }
+    // Process variance between knot k − 1 and k, per coordinate.
+    let q: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            if k == 0 {
+                return [0.0; 3];
+            }
+            let (a, b) = (base.pose_at(knots[k - 1].0), base.pose_at(knots[k].0));
+            let (dist, turn) = ((b.x - a.x).hypot(b.y - a.y), wrap(b.yaw - a.yaw).abs());
+            let pos = STILL_DRIFT_M.powi(2) + (DRIFT_PER_M * dist).powi(2);
+            let yaw = STILL_DRIFT_RAD.powi(2)
+                + (YAW_DRIFT_PER_M * dist + YAW_DRIFT_PER_RAD * turn).powi(2);
+            [pos, pos, yaw]
+        })
+        .collect();
+    let mut out = knots.to_vec();
+    let mut out_var = variances.to_vec();
+    for c in 0..3 {
+        // Forward filter: predicted (m⁻, p⁻) and filtered (m, p) at each knot.
+        let mut pred = Vec::with_capacity(n);
+        let mut filt: Vec<(f64, f64)> = Vec::with_capacity(n);
+        for k in 0..n {
+            let (mp, pp) = match filt.last() {
+                Some(&(m, p)) => (m, p + q[k][c]),
+                // The first revolution: a diffuse prior.
+                None => (0.0, 1e6),
+            };
+            pred.push((mp, pp));
+            let (y, r) = (knots[k].1[c], variances[k][c].max(1e-12));
+            let gain = pp / (pp + r);
+            filt.push((mp + gain * (y - mp), (1.0 - gain) * pp));
+        }
+        // Backward pass.
+        let mut smooth = filt.clone();
+        for k in (0..n - 1).rev() {
+            let g = filt[k].1 / pred[k + 1].1;
+            smooth[k] = (
+                filt[k].0 + g * (smooth[k + 1].0 - pred[k + 1].0),
+                filt[k].1 + g * g * (smooth[k + 1].1 - pred[k + 1].1),
+            );
+        }
+        for k in 0..n {
+            out[k].1[c] = smooth[k].0;
+            out_var[k][c] = smooth[k].1.max(0.0);
+        }
+    }
+    (out, out_var)
+}
+
+/// Solves the 3×3 system `a x = b` (Cramer's rule); `None` when singular.
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
+    let inv = invert3(a)?;
+    Some([0, 1, 2].map(|i| (0..3).map(|j| inv[i][j] * b[j]).sum()))
+}
+
+/// The inverse of a 3×3 matrix; `None` when singular.
+fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    let scale = m.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+    if !det.is_finite() || det.abs() <= 1e-12 * scale.powi(3) {
+        return None;
+    }
+    let c =
+        |r0: usize, r1: usize, c0: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+    Some([
+        [
+            c(1, 2, 1, 2) / det,
+            -c(0, 2, 1, 2) / det,
+            c(0, 1, 1, 2) / det,
+        ],
+        [
+            -c(1, 2, 0, 2) / det,
+            c(0, 2, 0, 2) / det,
+            -c(0, 1, 0, 2) / det,
+        ],
+        [
+            c(1, 2, 0, 1) / det,
+            -c(0, 2, 0, 1) / det,
+            c(0, 1, 0, 1) / det,
+        ],
+    ])
+}

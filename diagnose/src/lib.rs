@@ -1,0 +1,46 @@
+//! Mismatch discovery (`hilsim diagnose`): hold a real recording against the simulation of the
+//! scenario it is a run of, locate where the two disagree beyond the sensors' noise, name the
+//! physics the simulation left out from a catalogue of effects, fit it, and show the fit improve
+//! on held-out data.
+//!
+//! One module per stage:
+//! 1. [`align`]: the real trajectory, from `truth.csv` or estimated; the recording must be
+//!    a run of the scenario.
+//! 2. `residuals`: every reading against its prediction under the declared noise model.
+//! 3. [`locate`]: tests of bias, spread and whiteness against range, bearing, incidence
+//!    angle, object, time, speed, acceleration, turn rate…; the strongest is the location.
+//! 4. [`explain`]: each catalogued effect fitted by maximum likelihood on the training
+//!    half and scored on the held-out half against "none" and each other.
+//! 5. [`show`]: the verdict as JSON and text, the held-out fit before and after, plots.
+//!
+//! The physics is behind the [`Physics`] trait, which `hilsim` implements from the simulator:
+//! this crate never depends on it. Design and figures: `docs/diagnose.md`.
+
+pub mod align;
+mod catalogue;
+mod diagnosis;
+mod estimate;
+pub mod explain;
+pub mod locate;
+mod optimize;
+mod physics;
+mod residuals;
+pub mod self_test;
+pub mod show;
+mod sim_physics;
+pub mod stats;
+mod trajectory;
+
+pub use align::Alignment;
+pub use catalogue::{Effect, ParamSpec, Sensor};
+pub use diagnosis::{diagnose, Diagnosis, MismatchError, Options, SensorSummary, Verdict};
+pub use explain::CandidateFit;
+pub use locate::{Evidence, TestKind};
+pub use physics::{
+    Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
+    OdometryPrediction, Physics, SonarPrediction,
+};
+pub use residuals::Covariate;
+pub use show::PlotData;
+pub use sim_physics::SimPhysics;
+pub use trajectory::{wrap, Pose2, Trajectory};

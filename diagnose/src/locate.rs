@@ -1,0 +1,350 @@
+//! Locate: where the residuals stop being noise. Each sensor's normal scores are tested for a
+//! bias and an excess spread overall, for a bias and a spread that change with each variable
+//! (range, bearing, incidence angle, object, time, speed, acceleration, turn rate…: readings
+//! binned by the variable, the bins' means and mean squares compared), and for whiteness in time
+//! (Ljung–Box). Every outcome is a normal score ("σ") with the same meaning: how far into the
+//! tail of its null distribution the statistic lies. The strongest is the located mismatch.
+
+use std::collections::BTreeMap;
+
+use crate::catalogue::Sensor;
+use crate::residuals::{Covariate, Fit, SensorData};
+use crate::stats::{chi2_score, ljung_box, normal_quantile, normal_sf};
+
+/// Readings a bin needs to be tested.
+const MIN_BIN: usize = 30;
+/// Bins a continuous variable is cut into (at most).
+const BINS: usize = 8;
+/// Lags of the whiteness test.
+const LAGS: usize = 10;
+
+/// What kind of departure from noise a test looks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TestKind {
+    /// The residuals' mean is not zero.
+    Bias,
+    /// The residuals spread more than the noise model says.
+    Spread,
+    /// The residuals' mean changes with a variable.
+    BiasAgainst,
+    /// The residuals' spread changes with a variable.
+    SpreadAgainst,
+    /// The residuals are correlated in time.
+    Whiteness,
+}
+
+/// The outcome of one test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evidence {
+    /// The sensor tested.
+    pub sensor: Sensor,
+    /// The test.
+    pub test: TestKind,
+    /// The variable the residuals were tested against.
+    pub covariate: Option<Covariate>,
+    /// Normal score: the statistic's upper-tail probability as a standard normal quantile.
+    pub score: f64,
+    /// Where the departure is strongest, in words ("incidence angle 52–80 deg").
+    pub place: String,
+    /// The numbers behind it, in words.
+    pub detail: String,
+    /// The strongest bin's limits (continuous variables), for plots.
+    pub range: Option<(f64, f64)>,
+}
+
+/// A two-sided normal statistic as a one-sided score (the same tail probability).
+fn two_sided(t: f64) -> f64 {
+    let p = 2.0 * normal_sf(t.abs());
+    if p < 1e-300 {
+        t.abs()
+    } else {
+        -normal_quantile(p.min(1.0))
+    }
+}
+
+/// Bins of `rows` by `values`: categories, or up to [`BINS`] groups of near-equal count that
+/// never split equal values. Returns (label value or range, rows).
+fn bins(values: &[f64], rows: &[usize], categorical: bool) -> Vec<((f64, f64), Vec<usize>)> {
+    let mut rows: Vec<usize> = rows
+        .iter()
+        .copied()
+        .filter(|&i| values[i].is_finite())
+        .collect();
+    if categorical {
+        let mut groups: BTreeMap<i64, Vec<usize>> = BTreeMap::new();
+        for i in rows {
+            groups.entry(values[i] as i64).or_default().push(i);
+        }
+        return groups
+            .into_iter()
+            .filter(|(_, g)| g.len() >= MIN_BIN)
+            .map(|(k, g)| ((k as f64, k as f64), g))
+            .collect();
+    }
+    rows.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    let n = rows.len();
+    if n < 2 * MIN_BIN {
+        return Vec::new();
+    }
+    let target = (n / BINS).max(MIN_BIN);
+    let mut out: Vec<((f64, f64), Vec<usize>)> = Vec::new();
+    let mut start = 0;
+    while start < n {
+        let mut end = (start + target).min(n);
+        while end < n && values[rows[end]] == values[rows[end - 1]] {
+            end += 1;
+        }
+        // A short tail joins the last bin.
+        if n - end < MIN_BIN {
+            end = n;
+        }
+        let chunk = rows[start..end].to_vec();
+        out.push(((values[chunk[0]], values[chunk[chunk.len() - 1]]), chunk));
+        start = end;
+    }
+    out
+}
+
+fn fmt_value(v: f64) -> String {
+    if v == 0.0 {
+        "0".to_string()
+    } else if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// The bin's description.
+fn place(c: Covariate, lim: (f64, f64), names: &dyn Fn(u32) -> String) -> String {
+    match c {
+        Covariate::Object => names(lim.0 as u32),
+        Covariate::Edge => {
+            if lim.0 > 0.5 {
+                "beams near an edge".to_string()
+            } else {
+                "beams away from edges".to_string()
+            }
+        }
+        _ if fmt_value(lim.0) == fmt_value(lim.1) => {
+            format!("{} {} {}", c.name(), fmt_value(lim.0), c.unit())
+                .trim_end()
+                .to_string()
+        }
+        _ => format!(
+            "{} {}–{} {}",
+            c.name(),
+            fmt_value(lim.0),
+            fmt_value(lim.1),
+            c.unit()
+        )
+        .trim_end()
+        .to_string(),
+    }
+}
+
+/// Mean and variance of the scores of `rows` (`fits` indexed by row position `pos[i]`).
+fn moments(z: &[f64]) -> (f64, f64) {
+    let n = z.len() as f64;
+    let mean = z.iter().sum::<f64>() / n;
+    let var = z.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0).max(1.0);
+    (mean, var)
+}
+
+/// `Σ_c (Σ_{k ∈ c} dev(k))²` over the clusters `c` that share errors (`cluster[k]`): the
+/// cluster-robust ("sandwich") variance of the sum of `dev` over `ks` (Liang & Zeger,
+/// Biometrika 1986). Deviations are taken from the null's value, so a bin inside one cluster
+/// can never count as more than one observation.
+fn clustered_sum_var(ks: &[usize], dev: impl Fn(usize) -> f64, cluster: &[u32]) -> f64 {
+    let mut sums: BTreeMap<u32, f64> = BTreeMap::new();
+    for &k in ks {
+        *sums.entry(cluster[k]).or_default() += dev(k);
+    }
+    sums.values().map(|s| s * s).sum()
+}
+
+/// Every test of one sensor's residuals. `fits[k]` is the fit of row `rows[k]` of `data`.
+/// `whiteness`: whether to test the residuals' correlation in time (not against an estimated
+/// trajectory, whose errors a revolution's readings share).
+pub(crate) fn locate(
+    data: &SensorData,
+    rows: &[usize],
+    fits: &[Fit],
+    names: &dyn Fn(u32) -> String,
+    whiteness: bool,
+) -> Vec<Evidence> {
+    let sensor = data.sensor;
+    let mut out = Vec::new();
+    let n = rows.len();
+    if n < 2 * MIN_BIN {
+        return out;
+    }
+    // Position of each data row in `rows`.
+    let mut pos = vec![usize::MAX; data.len()];
+    for (k, &i) in rows.iter().enumerate() {
+        pos[i] = k;
+    }
+    let z: Vec<f64> = fits.iter().map(|f| f.z).collect();
+    // Readings that share an error (of an estimated trajectory) are not independent: the tests'
+    // variances are then the larger of the independent and the cluster-robust one.
+    let cluster: Option<Vec<u32>> = data
+        .clusters
+        .as_ref()
+        .map(|c| rows.iter().map(|&i| c[i]).collect());
+    let robust = |ks: &[usize], dev: &dyn Fn(usize) -> f64, independent: f64| match &cluster {
+        Some(c) => independent.max(clustered_sum_var(ks, dev, c)),
+        None => independent,
+    };
+    let (mean, sample_var) = moments(&z);
+    // Normal scores have variance 1 when the prediction is right. Every test below measures
+    // departures on that scale, or on the sample's when it is wider: residuals far smaller than
+    // the declared noise (a simulation that reproduces the data better than its noise model
+    // says) are no mismatch, however their tiny values are patterned.
+    let var = sample_var.max(1.0);
+    let residual_of = |k: usize| fits[k].residual;
+    let mean_residual = |ks: &[usize]| {
+        let r: Vec<f64> = ks
+            .iter()
+            .map(|&k| residual_of(k))
+            .filter(|r| r.is_finite())
+            .collect();
+        if r.is_empty() {
+            f64::NAN
+        } else {
+            r.iter().sum::<f64>() / r.len() as f64
+        }
+    };
+    let all: Vec<usize> = (0..n).collect();
+    // Overall bias: a t statistic of the scores.
+    let t = mean * n as f64 / robust(&all, &|k| z[k], var * n as f64).sqrt();
+    out.push(Evidence {
+        sensor,
+        test: TestKind::Bias,
+        covariate: None,
+        score: two_sided(t),
+        place: format!("all {sensor} readings"),
+        detail: format!(
+            "mean normal score {mean:+.2} (mean residual {:+.1} mm) over {n} readings",
+            mean_residual(&all) * 1000.0
+        ),
+        range: None,
+    });
+    // Overall spread: Σ z² against its χ²_n null, as a normal score.
+    let ss: f64 = z.iter().map(|v| v * v).sum();
+    out.push(Evidence {
+        sensor,
+        test: TestKind::Spread,
+        covariate: None,
+        score: (ss - n as f64) / robust(&all, &|k| z[k] * z[k] - 1.0, 2.0 * n as f64).sqrt(),
+        // (the mean square is tested against the declared 1, upwards only)
+        place: format!("all {sensor} readings"),
+        detail: format!(
+            "mean squared normal score {:.2} (1 for noise) over {n} readings",
+            ss / n as f64
+        ),
+        range: None,
+    });
+    for (c, values) in &data.covariates {
+        let groups = bins(values, rows, c.categorical());
+        if groups.len() < 2 {
+            continue;
+        }
+        let b = groups.len();
+        // Bias against the variable: the bins' means about the overall mean, χ²_{B−1}.
+        let mut chi_bias = 0.0;
+        let mut chi_spread = 0.0;
+        let mut best_bias = (0.0f64, 0usize);
+        let mut best_spread = (0.0f64, 0usize);
+        let mut stats = Vec::with_capacity(b);
+        let msq_all = (ss / n as f64).max(1.0);
+        for (g, (_, group)) in groups.iter().enumerate() {
+            let ks: Vec<usize> = group.iter().map(|&i| pos[i]).collect();
+            let nb = ks.len() as f64;
+            let mb = ks.iter().map(|&k| z[k]).sum::<f64>() / nb;
+            let vb = ks.iter().map(|&k| z[k] * z[k]).sum::<f64>() / nb;
+            let zb = (mb - mean) * nb / robust(&ks, &|k| z[k] - mean, var * nb).sqrt();
+            // The mean square of a bin of normal scores has variance 2 msq² / n_b.
+            let sb = (vb - msq_all) * nb
+                / robust(
+                    &ks,
+                    &|k| z[k] * z[k] - msq_all,
+                    2.0 * msq_all * msq_all * nb,
+                )
+                .sqrt();
+            chi_bias += zb * zb;
+            // Only an excess counts (a mismatch adds spread), so the sum is stochastically
+            // below its χ²_{B−1} reference: conservative.
+            chi_spread += sb.max(0.0).powi(2);
+            if zb.abs() > best_bias.0.abs() {
+                best_bias = (zb, g);
+            }
+            if sb > best_spread.0 {
+                best_spread = (sb, g);
+            }
+            stats.push((mb, vb, ks));
+        }
+        let (zb, g) = best_bias;
+        let (lim, _) = &groups[g];
+        let (mb, _, ks) = &stats[g];
+        out.push(Evidence {
+            sensor,
+            test: TestKind::BiasAgainst,
+            covariate: Some(*c),
+            score: chi2_score(chi_bias, b - 1),
+            place: place(*c, *lim, names),
+            detail: format!(
+                "mean normal score {mb:+.2} (mean residual {:+.1} mm, {zb:+.1}σ) over {} readings at {}, against {mean:+.2} overall; χ² {chi_bias:.0} on {} dof across {b} bins of {}",
+                mean_residual(ks) * 1000.0,
+                ks.len(),
+                place(*c, *lim, names),
+                b - 1,
+                c.name()
+            ),
+            range: (!c.categorical()).then_some(*lim),
+        });
+        let (sb, g) = best_spread;
+        let (lim, _) = &groups[g];
+        let (_, vb, ks) = &stats[g];
+        out.push(Evidence {
+            sensor,
+            test: TestKind::SpreadAgainst,
+            covariate: Some(*c),
+            score: chi2_score(chi_spread, b - 1),
+            place: place(*c, *lim, names),
+            detail: format!(
+                "mean squared normal score {vb:.2} ({sb:+.1}σ) over {} readings at {}, against {msq_all:.2} overall; χ² {chi_spread:.0} on {} dof across {b} bins of {}",
+                ks.len(),
+                place(*c, *lim, names),
+                b - 1,
+                c.name()
+            ),
+            range: (!c.categorical()).then_some(*lim),
+        });
+    }
+    // Whiteness: the scores in time order.
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| data.t[rows[a]].total_cmp(&data.t[rows[b]]));
+    let series: Vec<f64> = order.iter().map(|&k| z[k]).collect();
+    let (q, k) = ljung_box(&series, LAGS, 1.0);
+    if k > 0 && whiteness {
+        out.push(Evidence {
+            sensor,
+            test: TestKind::Whiteness,
+            covariate: Some(Covariate::Time),
+            score: chi2_score(q, k),
+            place: format!("{sensor} readings in time order"),
+            detail: format!("Ljung–Box Q {q:.0} on {k} lags (white noise: {k})"),
+            range: None,
+        });
+    }
+    out
+}
+
+/// The score a test must reach to count, for `tests` tests at family-wise level `alpha`
+/// (Bonferroni).
+#[must_use]
+pub fn threshold(alpha: f64, tests: usize) -> f64 {
+    -normal_quantile(alpha / tests.max(1) as f64)
+}

@@ -1,0 +1,16 @@
+//! `hilsim diagnose --self-test N --seed S`: the proof, blind. Each trial draws an effect (or
+//! none, each of the ten with probability 1/10) and its parameters from the documented moderate
+//! ranges (`docs/diagnose.md`), records a "real" run of the nominal scenario with that effect
+//! switched on (its own noise seed), diagnoses it against the nominal scenario without being
+//! told, and scores the answer. Trial `i` is a function of (S, i) alone.
+
+mod draw;
+mod report;
+mod run;
+mod score;
+mod trial;
+
+pub use draw::Drawn;
+pub use run::{one, run, Plan, SelfTest, TrialRun};
+pub use score::{Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_PARAM_ERROR};
+pub use trial::Outcome;

@@ -1,0 +1,148 @@
+//! Running the self-test: every trial in parallel, or one trial in full.
+
+use std::fmt::Write;
+
+use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::Recording;
+use hilsim_sim::Scenario;
+use rayon::prelude::*;
+use serde_json::{json, Value};
+
+use super::draw::{real_scenario, Drawn};
+use super::score::Score;
+use super::trial::{label, trial, Outcome};
+use crate::{show, Diagnosis, MismatchError, Options, SimPhysics};
+
+/// What a self-test is asked: trials of a nominal scenario.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plan {
+    /// Trials.
+    pub trials: u64,
+    /// The self-test's seed S: trial `i` is a function of (S, i) alone.
+    pub seed: u64,
+    /// The drawn parameters' scale (1: the documented moderate ranges).
+    pub strength: f64,
+    /// Draw only this class (0: none; 1..=9: the catalogue in order), or any.
+    pub only: Option<usize>,
+}
+
+/// A finished self-test.
+#[derive(Debug, Clone)]
+pub struct SelfTest {
+    /// The nominal scenario's name.
+    pub scenario: String,
+    /// The self-test's seed.
+    pub seed: u64,
+    /// The drawn parameters' scale.
+    pub strength: f64,
+    /// Every trial's outcome, in trial order.
+    pub outcomes: Vec<Outcome>,
+    /// Their score.
+    pub score: Score,
+}
+
+impl SelfTest {
+    /// Whether every goal was met.
+    #[must_use]
+    pub fn passed(&self) -> bool {
+        self.score.passed()
+    }
+}
+
+/// Runs `plan`'s trials of `nominal` in parallel.
+///
+/// # Errors
+/// [`MismatchError::Input`] when the nominal scenario's sensor models are invalid.
+pub fn run(nominal: &Scenario, plan: Plan) -> Result<SelfTest, MismatchError> {
+    SimPhysics::new(nominal)?;
+    let outcomes: Vec<Outcome> = (0..plan.trials)
+        .into_par_iter()
+        .map(|i| trial(nominal, plan.seed, i, plan.strength, plan.only))
+        .collect();
+    let score = Score::of(&outcomes);
+    Ok(SelfTest {
+        scenario: nominal.name.clone(),
+        seed: plan.seed,
+        strength: plan.strength,
+        outcomes,
+        score,
+    })
+}
+
+/// One trial in full (`--trial I`): what was concealed, the "real" recording and its diagnosis.
+#[derive(Debug, Clone)]
+pub struct TrialRun {
+    /// The trial's index.
+    pub index: u64,
+    /// The self-test's seed.
+    pub seed: u64,
+    /// What was concealed.
+    pub drawn: Drawn,
+    /// The "real" recording.
+    pub recording: Recording,
+    /// Its diagnosis against the nominal scenario.
+    pub diagnosis: Diagnosis,
+}
+
+/// Trial `index` of `plan` in full.
+///
+/// # Errors
+/// [`MismatchError`] when the "real" scenario cannot be emulated or the diagnosis refuses it.
+pub fn one(nominal: &Scenario, plan: Plan, index: u64) -> Result<TrialRun, MismatchError> {
+    let (real, drawn) = real_scenario(nominal, plan.seed, index, plan.strength, plan.only);
+    let recording = Emulation::new(&real, real.seed)
+        .map_err(|e| MismatchError::Input(e.to_string()))?
+        .run()
+        .recording;
+    let physics = SimPhysics::new(nominal)?;
+    let diagnosis = crate::diagnose(&physics, &recording, &Options::default())?;
+    Ok(TrialRun {
+        index,
+        seed: plan.seed,
+        drawn,
+        recording,
+        diagnosis,
+    })
+}
+
+impl TrialRun {
+    /// The diagnosis's JSON with the trial's truth under `trial`.
+    #[must_use]
+    pub fn to_json(&self) -> Value {
+        let mut j = show::to_json(&self.diagnosis);
+        j["trial"] = json!({
+            "index": self.index,
+            "truth": label(self.drawn.effect),
+            "drawn": self.drawn.params.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        });
+        j
+    }
+
+    /// What was concealed, the diagnosis's summary and its strongest evidence.
+    #[must_use]
+    pub fn to_text(&self) -> String {
+        let drawn_text: Vec<String> = self
+            .drawn
+            .params
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.4}"))
+            .collect();
+        let mut out = format!(
+            "trial {} (seed {}): concealed {} {}\n",
+            self.index,
+            self.seed,
+            label(self.drawn.effect),
+            drawn_text.join(", ")
+        );
+        out.push_str(&show::summary(&self.diagnosis));
+        for e in self.diagnosis.evidence.iter().take(8) {
+            let _ = writeln!(
+                out,
+                "evidence: {} {} ({:.1}σ): {}",
+                e.sensor, e.place, e.score, e.detail
+            );
+        }
+        let _ = writeln!(out, "threshold: {:.2}σ", self.diagnosis.threshold);
+        out
+    }
+}

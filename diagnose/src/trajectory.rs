@@ -1,0 +1,184 @@
+//! The robot's trajectory: poses at increasing times, interpolated linearly between them (the
+//! heading along the shorter arc), as the simulator interpolates within a physics step.
+
+use hilsim_recording::TruthSample;
+
+use crate::diagnosis::MismatchError;
+
+/// A planar pose: metres and radians (counter-clockwise from the world x axis).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Pose2 {
+    /// x, metres.
+    pub x: f64,
+    /// y, metres.
+    pub y: f64,
+    /// Heading, radians.
+    pub yaw: f64,
+}
+
+/// Wraps an angle into (−π, π] (the landmark calibrator's, shared).
+pub use hilsim_calibrator::landmarks::pose::wrap;
+
+/// Poses at increasing times.
+///
+/// ```
+/// use hilsim_diagnose::Trajectory;
+/// use hilsim_recording::TruthSample;
+/// let t = Trajectory::new(&[
+///     TruthSample { t_s: 0.0, x_m: 0.0, y_m: 0.0, yaw_rad: 3.1 },
+///     TruthSample { t_s: 1.0, x_m: 1.0, y_m: 0.0, yaw_rad: -3.1 },
+/// ])?;
+/// let mid = t.pose_at(0.5);
+/// assert!((mid.x - 0.5).abs() < 1e-12);
+/// assert!((mid.yaw.abs() - std::f64::consts::PI).abs() < 1e-9); // through ±π, not through 0
+/// # Ok::<(), hilsim_diagnose::MismatchError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    t: Vec<f64>,
+    poses: Vec<Pose2>,
+}
+
+impl Trajectory {
+    /// A trajectory through `samples` (time order; at least one, finite).
+    ///
+    /// # Errors
+    /// No samples, a non-finite value, or time going backwards.
+    pub fn new(samples: &[TruthSample]) -> Result<Self, MismatchError> {
+        if samples.is_empty() {
+            return Err(MismatchError::Input("the trajectory has no poses".into()));
+        }
+        let mut t = Vec::with_capacity(samples.len());
+        let mut poses = Vec::with_capacity(samples.len());
+        for s in samples {
+            if ![s.t_s, s.x_m, s.y_m, s.yaw_rad]
+                .iter()
+                .all(|v| v.is_finite())
+            {
+                return Err(MismatchError::Input(format!(
+                    "a pose at t = {} s is not finite",
+                    s.t_s
+                )));
+            }
+            if let Some(&last) = t.last() {
+                if s.t_s < last {
+                    return Err(MismatchError::Input(format!(
+                        "the trajectory's time goes backwards at {} s",
+                        s.t_s
+                    )));
+                }
+                if s.t_s == last {
+                    continue;
+                }
+            }
+            t.push(s.t_s);
+            poses.push(Pose2 {
+                x: s.x_m,
+                y: s.y_m,
+                yaw: s.yaw_rad,
+            });
+        }
+        Ok(Self { t, poses })
+    }
+
+    /// The sample times.
+    #[must_use]
+    pub fn times(&self) -> &[f64] {
+        &self.t
+    }
+
+    /// The sample poses.
+    #[must_use]
+    pub fn poses(&self) -> &[Pose2] {
+        &self.poses
+    }
+
+    /// The last sample's time.
+    #[must_use]
+    pub fn end_s(&self) -> f64 {
+        self.t[self.t.len() - 1]
+    }
+
+    /// The index of the interval holding `t`: samples `k` and `k + 1` bracket it (clamped).
+    #[must_use]
+    pub fn interval(&self, t: f64) -> usize {
+        let n = self.t.len();
+        if n < 2 {
+            return 0;
+        }
+        self.t.partition_point(|&s| s <= t).clamp(1, n - 1) - 1
+    }
+
+    /// The pose at `t`, interpolated (held constant beyond the ends).
+    #[must_use]
+    pub fn pose_at(&self, t: f64) -> Pose2 {
+        let n = self.t.len();
+        if n == 1 || t <= self.t[0] {
+            return self.poses[0];
+        }
+        if t >= self.t[n - 1] {
+            return self.poses[n - 1];
+        }
+        let k = self.interval(t);
+        let (p, q) = (self.poses[k], self.poses[k + 1]);
+        let u = (t - self.t[k]) / (self.t[k + 1] - self.t[k]);
+        Pose2 {
+            x: p.x + (q.x - p.x) * u,
+            y: p.y + (q.y - p.y) * u,
+            yaw: wrap(p.yaw + wrap(q.yaw - p.yaw) * u),
+        }
+    }
+
+    /// Forward speed (m/s) and turn rate (rad/s) over the interval holding `t`.
+    #[must_use]
+    pub fn twist_at(&self, t: f64) -> (f64, f64) {
+        if self.t.len() < 2 {
+            return (0.0, 0.0);
+        }
+        let k = self.interval(t);
+        let (p, q) = (self.poses[k], self.poses[k + 1]);
+        let dt = self.t[k + 1] - self.t[k];
+        let dyaw = wrap(q.yaw - p.yaw);
+        let mid = p.yaw + dyaw / 2.0;
+        let forward = (q.x - p.x) * mid.cos() + (q.y - p.y) * mid.sin();
+        (forward / dt, dyaw / dt)
+    }
+
+    /// The wheels' cumulative travel (left, right) at each sample, from zero at the first, for
+    /// wheels `wheel_base_m` apart: the body's forward displacement along the mean heading of
+    /// each interval and its turn split onto the wheels (the simulator's definition).
+    #[must_use]
+    pub fn wheel_travel(&self, wheel_base_m: f64) -> Vec<[f64; 2]> {
+        let mut out = Vec::with_capacity(self.t.len());
+        let mut w = [0.0; 2];
+        out.push(w);
+        for k in 1..self.t.len() {
+            let (p, q) = (self.poses[k - 1], self.poses[k]);
+            let dyaw = wrap(q.yaw - p.yaw);
+            let mid = p.yaw + dyaw / 2.0;
+            let forward = (q.x - p.x) * mid.cos() + (q.y - p.y) * mid.sin();
+            let turn = dyaw * wheel_base_m / 2.0;
+            w = [w[0] + forward - turn, w[1] + forward + turn];
+            out.push(w);
+        }
+        out
+    }
+
+    /// `travel` (one value per sample) interpolated at `t`.
+    #[must_use]
+    pub fn interpolate(&self, travel: &[[f64; 2]], t: f64) -> [f64; 2] {
+        let n = self.t.len();
+        if n == 1 || t <= self.t[0] {
+            return travel[0];
+        }
+        if t >= self.t[n - 1] {
+            return travel[n - 1];
+        }
+        let k = self.interval(t);
+        let u = (t - self.t[k]) / (self.t[k + 1] - self.t[k]);
+        [
+            travel[k][0] + (travel[k + 1][0] - travel[k][0]) * u,
+            travel[k][1] + (travel[k + 1][1] - travel[k][1]) * u,
+        ]
+    }
+}

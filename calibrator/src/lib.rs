@@ -7,7 +7,9 @@
 //! calibrator that could only read simulations would be useless on a real robot's data.
 #![warn(missing_docs)]
 
+mod by_method;
 pub mod calibration;
+mod describe;
 pub mod em;
 pub mod error;
 pub mod groundtruth;
@@ -16,5 +18,6 @@ pub mod landmarks;
 pub mod smoothing;
 pub mod target_samples;
 
+pub use by_method::{calibrate, em_options, TargetOptions};
 pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};
 pub use error::CalibrationError;

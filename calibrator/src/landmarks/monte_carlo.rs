@@ -7,7 +7,8 @@
 //! Each run draws its own landmarks and noise from its own seed, so a Monte Carlo is the same
 //! on one core or many.
 
-use rand::RngCore;
+use rand::{RngCore, SeedableRng};
+use rand_xoshiro::{SplitMix64, Xoshiro256PlusPlus};
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
@@ -392,6 +393,12 @@ pub fn run_seed(seed: u64, i: u64) -> u64 {
     splitmix64(seed ^ splitmix64(i.wrapping_add(0x9E37_79B9_7F4A_7C15)))
 }
 
+/// The SplitMix64 finaliser of `z + γ` (γ the golden-ratio increment): the first output of
+/// SplitMix64 started at `z`.
+fn splitmix64(z: u64) -> u64 {
+    SplitMix64::seed_from_u64(z).next_u64()
+}
+
 /// `runs` runs in parallel on rayon's pool, summarised.
 #[must_use]
 pub fn monte_carlo(setup: &Setup, runs: usize, seed: u64) -> Summary {
@@ -468,53 +475,32 @@ fn uniform(rng: &mut impl RngCore) -> f64 {
     (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
 }
 
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// xoshiro256++ (Blackman & Vigna, "Scrambled linear pseudorandom number generators", ACM TOMS
-/// 2021), seeded through SplitMix64 as its authors recommend: small, fast, and the same on every
-/// platform, so each run's numbers depend on its seed alone.
+/// 2021; `rand_xoshiro`'s), seeded through SplitMix64 as its authors recommend: small, fast, and
+/// the same on every platform, so each run's numbers depend on its seed alone.
 #[derive(Debug, Clone)]
-pub struct Xoshiro256pp {
-    s: [u64; 4],
-}
+pub struct Xoshiro256pp(Xoshiro256PlusPlus);
 
 impl Xoshiro256pp {
-    /// The generator seeded from one 64-bit number.
+    /// The generator seeded from one 64-bit number: its four state words are the first four
+    /// outputs of SplitMix64 started at `seed`.
     #[must_use]
     pub fn seed_from_u64(seed: u64) -> Self {
-        let mut z = seed;
-        let mut s = [0u64; 4];
-        for x in &mut s {
-            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            *x = splitmix64(z.wrapping_sub(0x9E37_79B9_7F4A_7C15));
-        }
-        Self { s }
+        Self(Xoshiro256PlusPlus::seed_from_u64(seed))
     }
 }
 
 impl RngCore for Xoshiro256pp {
     fn next_u32(&mut self) -> u32 {
-        (self.next_u64() >> 32) as u32
+        self.0.next_u32()
     }
 
     fn next_u64(&mut self) -> u64 {
-        let s = &mut self.s;
-        let result = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
-        let t = s[1] << 17;
-        s[2] ^= s[0];
-        s[3] ^= s[1];
-        s[1] ^= s[2];
-        s[0] ^= s[3];
-        s[2] ^= t;
-        s[3] = s[3].rotate_left(45);
-        result
+        self.0.next_u64()
     }
 
+    /// Little-endian bytes of successive `next_u64` outputs, the last one truncated (unlike
+    /// `rand_core`'s default, which ends a short tail with `next_u32`).
     fn fill_bytes(&mut self, dst: &mut [u8]) {
         for chunk in dst.chunks_mut(8) {
             let v = self.next_u64().to_le_bytes();

@@ -1,9 +1,11 @@
 //! Per-run seeds and per-run draws of varied parameters: pure functions of the dataset's seed,
 //! the run's index and (for a draw) the key, so any run can be made again on its own.
 
-use rand::RngCore as _;
+use rand::{RngCore as _, SeedableRng as _};
+use rand_xoshiro::SplitMix64;
 
-/// SplitMix64's increment: 2^64 divided by the golden ratio.
+/// SplitMix64's increment (2^64 divided by the golden ratio): its state after `n` outputs is its
+/// seed plus `n` times this.
 const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// The largest seed a scenario file can hold: TOML integers are signed 64-bit.
@@ -23,10 +25,8 @@ pub const MAX_SEED: u64 = i64::MAX as u64;
 /// ```
 #[must_use]
 pub fn run_seed(base: u64, run: u64) -> u64 {
-    let mut z = base.wrapping_add(run.wrapping_add(1).wrapping_mul(GAMMA));
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    (z ^ (z >> 31)) >> 1
+    // Jump over the first `run` outputs: `seed_from_u64` takes the value as the state as it is.
+    SplitMix64::seed_from_u64(base.wrapping_add(run.wrapping_mul(GAMMA))).next_u64() >> 1
 }
 
 /// A value drawn uniformly from `[lo, hi]` for `key` in run `run` of a dataset seeded with

@@ -1,8 +1,9 @@
 //! Seeded randomness: one independent stream per component, derived from the run's seed and the
 //! component's name alone, so that adding a sensor never changes another sensor's noise.
 
-use rand::SeedableRng;
+use rand::{RngCore as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_xoshiro::SplitMix64;
 
 /// The random stream type every component uses.
 pub type Rng = ChaCha8Rng;
@@ -28,20 +29,13 @@ pub fn stream(seed: u64, name: &str) -> Rng {
         name_hash ^= u64::from(byte);
         name_hash = name_hash.wrapping_mul(0x0000_0100_0000_01b3);
     }
-    let mut state = seed ^ name_hash.rotate_left(29);
+    // `seed_from_u64` takes the value as SplitMix64's state as it is.
+    let mut mix = SplitMix64::seed_from_u64(seed ^ name_hash.rotate_left(29));
     let mut key = [0u8; 32];
     for chunk in key.chunks_mut(8) {
-        chunk.copy_from_slice(&splitmix64(&mut state).to_le_bytes());
+        chunk.copy_from_slice(&mix.next_u64().to_le_bytes());
     }
     ChaCha8Rng::from_seed(key)
-}
-
-fn splitmix64(state: &mut u64) -> u64 {
-    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 #[cfg(test)]

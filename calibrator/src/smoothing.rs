@@ -32,6 +32,8 @@
 
 use hilsim_recording::Recording;
 
+/// The smoothed distance at one sample (EM's, re-exported here for the smoother's callers).
+pub use crate::em::Estimate;
 use crate::em::{self, EmOptions, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
 use crate::kalman_smoother::RtsSmoother;
 use crate::target_samples::{self, SampleOptions, TargetSamples};
@@ -40,25 +42,6 @@ use crate::{groundtruth, Calibration, CalibrationError, Sensor, SensorModel};
 /// Prior sd of the first distance, in units of the first lidar reading's sd, when the start
 /// distance is unknown (see the module docs).
 const UNKNOWN_START_SD_FACTOR: f64 = 10.0;
-
-/// The smoothed distance at one sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimate {
-    /// The sample instant, seconds.
-    pub t_s: f64,
-    /// Smoothed distance to the target, metres.
-    pub distance_m: f64,
-    /// Its posterior variance, m².
-    pub variance_m2: f64,
-}
-
-impl Estimate {
-    /// The posterior standard deviation, metres.
-    #[must_use]
-    pub fn sd_m(&self) -> f64 {
-        self.variance_m2.max(0.0).sqrt()
-    }
-}
 
 /// Smooths a recording's distances with a trained calibration.
 ///

@@ -1,0 +1,285 @@
+//! A run of EM: the samples checked, θ^(0) from dead reckoning, the iteration, and the
+//! calibration with its notes.
+
+use std::collections::BTreeMap;
+
+use nalgebra::Vector2;
+
+use super::engine::Engine;
+use super::estep::{build_data, e_step};
+use super::estimate::{estimates, Estimate};
+use super::model::{Data, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
+use super::mstep;
+use super::options::{EmOptions, MIN_LIDAR_READINGS, MIN_SPAN_M};
+use crate::kalman_smoother::RtsSmoother;
+use crate::target_samples::{self, TargetSamples};
+use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
+
+/// Everything a run of EM produced.
+#[derive(Debug, Clone)]
+pub struct EmOutcome {
+    /// The calibration (what [`calibrate`] returns).
+    pub calibration: Calibration,
+    /// The samples it was computed from.
+    pub samples: TargetSamples,
+    /// The smoothed distance of every sample under the final parameters.
+    pub estimates: Vec<Estimate>,
+    /// Log-likelihood `log p(y; θ^(t))` from each E-step, the last one at the final
+    /// parameters (under the linearisation in force at that step; see [`EStep`]).
+    pub log_likelihoods: Vec<f64>,
+    /// The process-noise scale used at the end (estimated or as given).
+    pub process_noise_rel: f64,
+}
+
+/// Calibrates the recording's lidar (and odometer, sonar) without ground truth.
+///
+/// # Errors
+/// [`CalibrationError`] for bad input (see the module's requirements) or a diverging estimate.
+pub fn calibrate(
+    rec: &hilsim_recording::Recording,
+    opts: &EmOptions,
+) -> Result<Calibration, CalibrationError> {
+    run(rec, opts).map(|o| o.calibration)
+}
+
+/// As [`calibrate`], returning the smoothed distances and the log-likelihood trace too.
+///
+/// # Errors
+/// As [`calibrate`].
+pub fn run(
+    rec: &hilsim_recording::Recording,
+    opts: &EmOptions,
+) -> Result<EmOutcome, CalibrationError> {
+    opts.validate()?;
+    let samples = target_samples::extract(rec, &opts.sample_options())?;
+    run_samples(samples, opts)
+}
+
+/// EM on samples already drawn from a recording.
+///
+/// # Errors
+/// As [`calibrate`].
+pub fn run_samples(
+    samples: TargetSamples,
+    opts: &EmOptions,
+) -> Result<EmOutcome, CalibrationError> {
+    opts.validate()?;
+    let (start, valid) = check_samples(&samples)?;
+    let mut notes = Vec::new();
+    let (data, params, lin) = initial_params(&samples, start, opts, &mut notes)?;
+    let fit = iterate(&data, opts, params, lin)?;
+    let estimates = estimates(&samples, &fit.smoother);
+    push_notes(&mut notes, &samples, opts, &fit, valid, start);
+    let metrics = samples.truth_m.as_ref().and_then(|truth| {
+        let calibrated: Vec<Option<f64>> = estimates.iter().map(|e| Some(e.distance_m)).collect();
+        target_samples::distance_metrics(truth, &samples.lidar_m, &calibrated)
+    });
+    let calibration = Calibration {
+        method: Method::Em,
+        sensors: sensor_models(&fit.params),
+        iterations: fit.iterations,
+        converged: fit.converged,
+        metrics,
+        order: None,
+        landmarks: None,
+        notes,
+    };
+    Ok(EmOutcome {
+        calibration,
+        samples,
+        estimates,
+        log_likelihoods: fit.log_likelihoods,
+        process_noise_rel: fit.params.q_rel,
+    })
+}
+
+/// Checks the samples can anchor and identify the model: a start distance, enough lidar
+/// readings, enough motion. Returns the start distance and the valid lidar readings' count.
+fn check_samples(samples: &TargetSamples) -> Result<(f64, usize), CalibrationError> {
+    let Some(start) = samples.start_distance_m else {
+        return Err(CalibrationError::Missing(
+            "no start distance: none was given (--start-distance), and meta.toml's [world] \
+             target_start_distance_m, when present, is the frontal target's (beam 0°) only; \
+             EM needs it to anchor the distance"
+                .into(),
+        ));
+    };
+    let valid = samples.lidar_count();
+    if valid < MIN_LIDAR_READINGS {
+        return Err(CalibrationError::TooFewSamples(format!(
+            "{valid} valid lidar readings of the target in {} revolutions; EM needs at least \
+             {MIN_LIDAR_READINGS}",
+            samples.len()
+        )));
+    }
+    let span = samples
+        .commanded_m
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
+    let spanned = span.1 - span.0;
+    if spanned.is_nan() || spanned < MIN_SPAN_M {
+        return Err(CalibrationError::Unidentifiable(format!(
+            "the commanded motion changes the distance by only {:.3} m (at least {MIN_SPAN_M} m \
+             needed): with no motion the bias cannot be told from the distance",
+            (span.1 - span.0).max(0.0)
+        )));
+    }
+    Ok((start, valid))
+}
+
+/// The smoother's data set (activating the sensors it can use, noting any dropped) and θ^(0):
+/// each sensor regressed on the dead-reckoned distance (the commands taken as truth; the paper
+/// leaves θ^(0) open). Returns the data, θ^(0) and the dead-reckoned linearisation.
+fn initial_params(
+    samples: &TargetSamples,
+    start: f64,
+    opts: &EmOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Data, Params, Vec<Lin>), CalibrationError> {
+    let mut params = Params {
+        sensors: [
+            SensorParams::paper(LIDAR),
+            SensorParams::paper(ODOMETER),
+            SensorParams::paper(SONAR),
+        ],
+        q_rel: opts.process_noise_rel,
+    };
+    params.sensors[LIDAR].active = true;
+    let mut data = build_data(samples, start, &mut params, opts, notes);
+    // The start distance is known exactly, as in the paper (Σ_d = 0).
+    data.prior_var = 0.0;
+
+    let lin: Vec<Lin> = (0..samples.len())
+        .map(|k| Lin::exact(start + samples.commanded_m[k]))
+        .collect();
+    let dr_means: Vec<Vector2<f64>> = lin.iter().map(|l| Vector2::new(l.m, l.d2)).collect();
+    let zeros = vec![nalgebra::Matrix2::zeros(); lin.len()];
+    let dead_reckoning = mstep::Posterior {
+        means: &dr_means,
+        covs: &zeros,
+        lag_one: &zeros,
+    };
+    let params = mstep::m_step(&data, &params, &dead_reckoning, &lin, true, false)?;
+    Ok((data, params, lin))
+}
+
+/// What the iteration ended with.
+struct Fit {
+    params: Params,
+    converged: bool,
+    iterations: usize,
+    /// The log-likelihood of the last E-step, at the final parameters.
+    ll: f64,
+    /// The smoother after that E-step (the smoothed distances under the final parameters).
+    smoother: RtsSmoother<2>,
+    log_likelihoods: Vec<f64>,
+}
+
+/// Iterates EM (plain or SQUAREM) from θ^(0) to convergence or the cap, then runs one more
+/// E-step for the smoothed distances under the final parameters.
+fn iterate(
+    data: &Data,
+    opts: &EmOptions,
+    mut params: Params,
+    lin: Vec<Lin>,
+) -> Result<Fit, CalibrationError> {
+    let mut engine = Engine {
+        data,
+        opts,
+        smoother: RtsSmoother::new(),
+        lin,
+        log_likelihoods: Vec::new(),
+        iterations: 0,
+    };
+    let converged = if opts.accelerate {
+        engine.squarem(&mut params)?
+    } else {
+        engine.plain(&mut params)?
+    };
+    let iterations = engine.iterations;
+    // The smoothed distances under the final parameters.
+    let ll = e_step(
+        &mut engine.smoother,
+        data,
+        &params,
+        &mut engine.lin,
+        opts.e_step,
+    )?;
+    engine.log_likelihoods.push(ll);
+    let Engine {
+        smoother,
+        log_likelihoods,
+        ..
+    } = engine;
+    Ok(Fit {
+        params,
+        converged,
+        iterations,
+        ll,
+        smoother,
+        log_likelihoods,
+    })
+}
+
+/// The calibration's notes on the iteration, the process noise and the samples.
+fn push_notes(
+    notes: &mut Vec<String>,
+    samples: &TargetSamples,
+    opts: &EmOptions,
+    fit: &Fit,
+    valid: usize,
+    start: f64,
+) {
+    let (ll, iterations, converged, params) = (fit.ll, fit.iterations, fit.converged, &fit.params);
+    notes.push(format!(
+        "E-step: {}; log-likelihood {ll:.3} after {iterations} iterations ({})",
+        opts.e_step.name(),
+        if converged {
+            "converged"
+        } else {
+            "iteration cap reached"
+        }
+    ));
+    notes.push(format!(
+        "process noise: {:.4} m per metre commanded ({})",
+        params.q_rel,
+        if opts.estimate_process_noise {
+            "estimated"
+        } else {
+            "fixed"
+        }
+    ));
+    notes.push(format!(
+        "samples: {} revolutions, {valid} valid lidar readings at beam {}°, start distance {start} m",
+        samples.len(),
+        opts.beam_deg.round().rem_euclid(360.0)
+    ));
+    if samples.turns {
+        notes.push(
+            "warning: the commands turn the robot; EM assumes motion along a line".to_string(),
+        );
+    }
+}
+
+/// The active sensors' models in the interface's form.
+fn sensor_models(params: &Params) -> BTreeMap<Sensor, SensorModel> {
+    let mut out = BTreeMap::new();
+    for (slot, sensor) in [Sensor::Lidar, Sensor::Odometer, Sensor::Sonar]
+        .into_iter()
+        .enumerate()
+    {
+        let p = &params.sensors[slot];
+        if p.active {
+            out.insert(
+                sensor,
+                SensorModel {
+                    alpha: p.alpha[..p.n_alpha].to_vec(),
+                    beta: p.beta[..=p.power].to_vec(),
+                },
+            );
+        }
+    }
+    out
+}

@@ -104,3 +104,22 @@ impl DriveProgram {
             .map_or_else(WheelCommand::default, |s| s.command)
     }
 }
+
+/// The run's length, which the drive program sets when the scenario gives no `duration_s`.
+impl Scenario {
+    /// The number of physics steps the drive program takes (each drive step rounded to whole
+    /// physics steps).
+    #[must_use]
+    pub fn drive_steps(&self) -> u64 {
+        DriveProgram::new(self).total_steps()
+    }
+
+    /// The run's length in physics steps: `duration_s` when set, else the drive program's end.
+    #[must_use]
+    pub fn run_steps(&self) -> u64 {
+        match self.duration_s {
+            Some(d) => (d * self.physics.step_hz).round() as u64,
+            None => self.drive_steps(),
+        }
+    }
+}

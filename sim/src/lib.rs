@@ -25,6 +25,7 @@
 
 mod actuation;
 pub mod drive;
+mod kinematics;
 mod motor_lag;
 pub mod pose;
 pub mod replay;

@@ -250,7 +250,7 @@ impl Simulation {
     /// displacement and turn, split onto the wheels. A robot pushed against a wall stalls its
     /// wheels: they report what the body did, not what was commanded.
     fn wheel_travel(&self, p0: Pose, p1: Pose) -> [f64; 2] {
-        crate::replay::wheel_travel(self.wheels, &p0, &p1, self.wheel_base_m)
+        crate::kinematics::wheel_travel(self.wheels, &p0, &p1, self.wheel_base_m)
     }
 
     fn log_contacts(&mut self, t: f64) {

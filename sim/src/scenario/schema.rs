@@ -45,6 +45,24 @@ pub struct Scenario {
     pub effects: super::effects::Effects,
 }
 
+impl Scenario {
+    /// The physics step, seconds.
+    #[must_use]
+    pub fn step_s(&self) -> f64 {
+        1.0 / self.physics.step_hz
+    }
+
+    /// The reflectivity of a named material (`None`: the built-in default).
+    #[must_use]
+    pub fn reflectivity(&self, material: Option<&str>) -> f64 {
+        material
+            .and_then(|m| self.world.materials.get(m))
+            .cloned()
+            .unwrap_or_default()
+            .reflectivity
+    }
+}
+
 /// `[physics]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -1,35 +1,11 @@
 //! Checks that serde cannot express: ranges, exactly-one-kind drive steps, references, and
 //! geometry (the robot must not start inside an obstacle).
 
+use super::check::{fail, toml_number, Check};
 use super::locate::{key_path, Key};
 use super::metrics;
 use super::schema::{DriveStep, Scenario};
-
-/// A failed check: where (a key path) and what was expected.
-pub(crate) struct Invalid {
-    pub(crate) path: Vec<Key>,
-    pub(crate) message: String,
-}
-
-type Check = Result<(), Invalid>;
-
-fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
-    Err(Invalid {
-        path,
-        message: message.into(),
-    })
-}
-
-/// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
-pub(super) fn toml_number(v: f64) -> String {
-    if v.is_nan() {
-        "nan".to_string()
-    } else if v.is_infinite() {
-        if v > 0.0 { "inf" } else { "-inf" }.to_string()
-    } else {
-        v.to_string()
-    }
-}
+use super::validate_effects;
 
 fn finite(path: Vec<Key>, v: f64) -> Check {
     if v.is_finite() {
@@ -105,7 +81,7 @@ fn polynomial(path: Vec<Key>, coeffs: &[f64], non_negative_terms: bool) -> Check
     Ok(())
 }
 
-pub(crate) fn validate(s: &Scenario) -> Check {
+pub(super) fn validate(s: &Scenario) -> Check {
     if s.name.trim().is_empty() {
         return fail(key_path!["name"], "expected a non-empty name");
     }
@@ -123,10 +99,7 @@ pub(crate) fn validate(s: &Scenario) -> Check {
     robot(s)?;
     drive(s)?;
     sensors(s)?;
-    super::effects::validate(s).map_err(|e| Invalid {
-        path: e.path,
-        message: e.message,
-    })?;
+    validate_effects::validate(s)?;
     for (i, e) in s.expect.iter().enumerate() {
         if !metrics::is_known(&e.metric) {
             return fail(

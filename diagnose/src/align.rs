@@ -5,7 +5,7 @@
 
 use hilsim_recording::Recording;
 
-use crate::diagnosis::MismatchError;
+use crate::error::MismatchError;
 use crate::estimate::estimate_trajectory;
 use crate::physics::{Hypothesis, Physics};
 use crate::trajectory::{wrap, Trajectory};

@@ -6,29 +6,18 @@ use hilsim_recording::Recording;
 
 use crate::align::{self, Alignment};
 use crate::catalogue::{Effect, Sensor};
+use crate::error::MismatchError;
 use crate::explain::{self, CandidateFit};
 use crate::locate::{self, Evidence, TestKind};
 use crate::physics::{Hypothesis, Physics};
+use crate::plot::{self, PlotData};
 use crate::residuals::{self, Context, SensorData};
-use crate::show::{self, PlotData};
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
 /// it (against an estimated trajectory only); they stop once the parameter moves by less than
 /// [`REALIGN_SETTLED`] of its value.
 const REALIGN_ROUNDS: usize = 4;
 const REALIGN_SETTLED: f64 = 0.02;
-
-/// A diagnosis that could not be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum MismatchError {
-    /// The input is malformed (a trajectory that goes back in time, a non-finite value).
-    #[error("{0}")]
-    Input(String),
-    /// The recording cannot be diagnosed against this scenario; the message says why.
-    #[error("{0}")]
-    Refused(String),
-}
 
 /// Settings of the diagnosis. The defaults are the ones `docs/diagnose.md` derives and the
 /// self-test measures.
@@ -441,7 +430,7 @@ pub fn diagnose(
             ));
         }
     }
-    let plots = show::plots(plot_ctx, &data, located.as_ref(), fitted.as_ref());
+    let plots = plot::plots(plot_ctx, &data, located.as_ref(), fitted.as_ref());
     Ok(Diagnosis {
         verdict,
         located,

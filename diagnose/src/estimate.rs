@@ -18,7 +18,7 @@
 
 use hilsim_recording::{LidarSample, Recording, TruthSample};
 
-use crate::diagnosis::MismatchError;
+use crate::error::MismatchError;
 use crate::physics::{Hypothesis, LidarQuery, Physics};
 use crate::trajectory::{wrap, Trajectory};
 

@@ -19,11 +19,13 @@
 pub mod align;
 mod catalogue;
 mod diagnosis;
+mod error;
 mod estimate;
 pub mod explain;
 pub mod locate;
 mod optimize;
 mod physics;
+mod plot;
 mod residuals;
 pub mod self_test;
 pub mod show;
@@ -33,14 +35,15 @@ mod trajectory;
 
 pub use align::Alignment;
 pub use catalogue::{Effect, ParamSpec, Sensor};
-pub use diagnosis::{diagnose, Diagnosis, MismatchError, Options, SensorSummary, Verdict};
+pub use diagnosis::{diagnose, Diagnosis, Options, SensorSummary, Verdict};
+pub use error::MismatchError;
 pub use explain::CandidateFit;
 pub use locate::{Evidence, TestKind};
 pub use physics::{
     Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
     OdometryPrediction, Physics, SonarPrediction,
 };
+pub use plot::PlotData;
 pub use residuals::Covariate;
-pub use show::PlotData;
 pub use sim_physics::SimPhysics;
 pub use trajectory::{wrap, Pose2, Trajectory};

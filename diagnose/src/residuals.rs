@@ -11,7 +11,7 @@
 use hilsim_recording::Recording;
 
 use crate::catalogue::Sensor;
-use crate::diagnosis::MismatchError;
+use crate::error::MismatchError;
 use crate::physics::{DeclaredActuation, Gaussian, Hypothesis, LidarQuery, Physics};
 use crate::stats::normal_quantile;
 use crate::trajectory::Trajectory;

@@ -3,7 +3,7 @@
 
 use hilsim_recording::TruthSample;
 
-use crate::diagnosis::MismatchError;
+use crate::error::MismatchError;
 
 /// A planar pose: metres and radians (counter-clockwise from the world x axis).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -1,0 +1,146 @@
+//! The report page: the verdict, the evidence, the fit and the plots.
+
+use std::fmt::Write as _;
+
+use super::format::{escape, fmt_sig, mm};
+use crate::diagnosis::{Diagnosis, Verdict};
+
+/// The report page: the verdict, the evidence, the fit and the plots (`plot_files[i]` is where
+/// the caller wrote `svg(&d.plots[i])`, relative to the page).
+#[must_use]
+pub fn html(d: &Diagnosis, title: &str, plot_files: &[String]) -> String {
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r##"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{t}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 62em; margin: 2em auto; color: #222; line-height: 1.45; }}
+h1 {{ font-size: 1.5em; }} .verdict {{ font-size: 1.3em; padding: .6em 1em; border-radius: 6px; }}
+.none {{ background: #e6f4e6; }} .effect {{ background: #fdf0d8; }} .unexplained {{ background: #f9dede; }}
+table {{ border-collapse: collapse; margin: .8em 0; }} td, th {{ border: 1px solid #ccc; padding: .25em .6em; text-align: left; }}
+th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} img {{ max-width: 100%; border: 1px solid #ddd; margin: .5em 0; }}
+</style></head><body>
+<h1>{t}</h1>
+"##,
+        t = escape(title)
+    );
+    let class = match d.verdict {
+        Verdict::None => "none",
+        Verdict::Effect(_) => "effect",
+        Verdict::Unexplained => "unexplained",
+    };
+    let _ = writeln!(
+        s,
+        r##"<p class="verdict {class}"><b>{}</b>: {}</p>"##,
+        escape(d.verdict.name()),
+        escape(&d.explanation)
+    );
+    if let Some(l) = &d.located {
+        let _ = writeln!(
+            s,
+            "<h2>Where</h2><p><b>{}</b>, {} ({:.1}σ; a test counts above {:.1}σ).</p><p>{}</p>",
+            l.sensor,
+            escape(&l.place),
+            l.score,
+            d.threshold,
+            escape(&l.detail)
+        );
+    }
+    if let Some(f) = &d.fitted {
+        let _ = writeln!(
+            s,
+            "<h2>The fix</h2><table><tr><th>parameter</th><th>fitted</th><th>± (1 s.e.)</th><th>unit</th></tr>"
+        );
+        for (i, spec) in f.effect.params().iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                spec.name,
+                fmt_sig(f.params[i]),
+                fmt_sig(f.param_sd[i]),
+                spec.unit
+            );
+        }
+        let _ = writeln!(
+            s,
+            "</table><p>Held-out {} RMSE: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
+            f.effect.sensor(),
+            mm(f.rmse_before),
+            mm(f.rmse_after),
+            mm(f.noise_floor),
+            f.heldout_n
+        );
+    }
+    for (p, file) in d.plots.iter().zip(plot_files) {
+        let _ = writeln!(
+            s,
+            r##"<img src="{}" alt="{}">"##,
+            escape(file),
+            escape(&p.title)
+        );
+    }
+    if !d.candidates.is_empty() {
+        let _ = writeln!(
+            s,
+            "<h2>Candidates</h2><p>Each effect fitted by maximum likelihood on the training half; score: the log-likelihood gain over the nominal simulation on the held-out half (nats); BIC gain on the training half.</p><table><tr><th>effect</th><th>held-out gain</th><th>BIC gain</th><th>parameters</th></tr>"
+        );
+        for c in &d.candidates {
+            let params: Vec<String> = c
+                .effect
+                .params()
+                .iter()
+                .zip(&c.params)
+                .map(|(spec, v)| format!("{} = {}", spec.name, fmt_sig(*v)))
+                .collect();
+            let _ = writeln!(
+                s,
+                "<tr><td><code>{}</code></td><td>{:+.1}</td><td>{:+.1}</td><td>{}</td></tr>",
+                c.effect,
+                c.heldout_gain,
+                c.bic_gain,
+                escape(&params.join(", "))
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
+    let _ = writeln!(
+        s,
+        "<h2>Sensors</h2><table><tr><th>sensor</th><th>readings</th><th>held-out RMSE (nominal)</th><th>noise floor</th><th>strongest test</th></tr>"
+    );
+    for x in &d.sensors {
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}σ</td></tr>",
+            x.sensor,
+            x.readings,
+            mm(x.heldout_rmse_m),
+            mm(x.noise_floor_m),
+            x.strongest
+        );
+    }
+    let _ = writeln!(s, "</table>");
+    if !d.evidence.is_empty() {
+        let _ = writeln!(
+            s,
+            "<h2>Evidence</h2><table><tr><th>sensor</th><th>where</th><th>score</th><th>detail</th></tr>"
+        );
+        for e in d.evidence.iter().take(12) {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{}</td><td>{:.1}σ</td><td>{}</td></tr>",
+                e.sensor,
+                escape(&e.place),
+                e.score,
+                escape(&e.detail)
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
+    let _ = writeln!(s, "<p>Aligned by {}.</p>", escape(d.alignment.name()));
+    for n in &d.notes {
+        let _ = writeln!(s, "<p>Note: {}</p>", escape(n));
+    }
+    let _ = writeln!(s, "</body></html>");
+    s
+}

@@ -1,0 +1,65 @@
+//! The diagnosis as text for people.
+
+use std::fmt::Write as _;
+
+use super::format::{fmt_sig, mm};
+use crate::diagnosis::Diagnosis;
+
+/// The diagnosis for people: a few lines.
+#[must_use]
+pub fn summary(d: &Diagnosis) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "verdict: {}", d.verdict.name());
+    let _ = writeln!(s, "  {}", d.explanation);
+    if let Some(l) = &d.located {
+        let _ = writeln!(s, "located: {} — {}", l.sensor, l.place);
+        let _ = writeln!(s, "  {} ({:.1}σ)", l.detail, l.score);
+    }
+    if let Some(f) = &d.fitted {
+        let params: Vec<String> = f
+            .effect
+            .params()
+            .iter()
+            .enumerate()
+            .map(|(i, spec)| {
+                let sd = f.param_sd[i];
+                let sd = if sd.is_finite() {
+                    format!(" ± {}", fmt_sig(sd))
+                } else {
+                    String::new()
+                };
+                format!("{} = {}{sd} {}", spec.name, fmt_sig(f.params[i]), spec.unit)
+                    .trim_end()
+                    .to_string()
+            })
+            .collect();
+        let _ = writeln!(s, "fitted: {}", params.join(", "));
+        let _ = writeln!(
+            s,
+            "held-out {} RMSE: {} before, {} after (noise floor {}, {} readings)",
+            f.effect.sensor(),
+            mm(f.rmse_before),
+            mm(f.rmse_after),
+            mm(f.noise_floor),
+            f.heldout_n
+        );
+    }
+    if !d.candidates.is_empty() {
+        let top: Vec<String> = d
+            .candidates
+            .iter()
+            .take(4)
+            .map(|c| format!("{} {:+.1}", c.effect, c.heldout_gain))
+            .collect();
+        let _ = writeln!(
+            s,
+            "candidates (held-out log-likelihood gain over none): {}",
+            top.join(", ")
+        );
+    }
+    let _ = writeln!(s, "aligned by {}", d.alignment.name());
+    for n in &d.notes {
+        let _ = writeln!(s, "note: {n}");
+    }
+    s
+}

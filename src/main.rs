@@ -5,8 +5,6 @@
 
 mod cli;
 mod commands;
-mod decode_cmd;
-mod metrics;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -30,7 +28,7 @@ fn main() -> ExitCode {
         }
         Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
         Command::Decode(args) => {
-            decode_cmd::run(&args.input, args.csv.as_deref(), args.json, &mut out)
+            commands::decode::run(&args.input, args.csv.as_deref(), args.json, &mut out)
                 .map(|()| ExitCode::SUCCESS)
         }
         Command::Scenario(ScenarioCommand::Test(args)) => {

@@ -52,9 +52,6 @@ pub struct DiagnoseArgs {
     pub trial: Option<u64>,
 }
 
-/// The built-in scenario of the self-test.
-const SELF_TEST_SCENARIO: &str = include_str!("../../scenarios/diagnose-room.toml");
-
 pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(n) = args.self_test {
         if n == 0 {
@@ -65,22 +62,14 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
         let scenario = match &args.sim {
             Some(path) => hilsim_sim::Scenario::load(path)?,
-            None => hilsim_sim::Scenario::from_toml(
-                SELF_TEST_SCENARIO,
-                Path::new("<built-in diagnose-room>"),
-            )?,
+            None => hilsim_scenarios::builtin::diagnose_room()?,
         };
         let seed = args.seed.unwrap_or(1);
         let only = match args.only.as_deref() {
             None => None,
             Some("none") => Some(0),
             Some(name) => match Effect::from_name(name) {
-                Some(e) => Some(
-                    1 + Effect::ALL
-                        .iter()
-                        .position(|x| *x == e)
-                        .unwrap_or(0),
-                ),
+                Some(e) => Some(1 + Effect::ALL.iter().position(|x| *x == e).unwrap_or(0)),
                 None => bail!("--only: expected `none` or a catalogued effect, found `{name}`"),
             },
         };
@@ -156,12 +145,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
 }
 
 /// Writes `index.html` and its plots into `dir` (created if needed), each file atomically.
-fn write_report(
-    dir: &Path,
-    d: &hilsim_diagnose::Diagnosis,
-    sim: &Path,
-    real: &Path,
-) -> Result<()> {
+fn write_report(dir: &Path, d: &hilsim_diagnose::Diagnosis, sim: &Path, real: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     let mut files = Vec::new();
     for (i, p) in d.plots.iter().enumerate() {

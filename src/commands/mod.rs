@@ -2,6 +2,7 @@
 
 pub mod calibrate;
 pub mod dataset;
+pub mod decode;
 pub mod diagnose;
 pub mod hil;
 pub mod record;
@@ -14,14 +15,11 @@ use std::path::Path;
 use anyhow::Result;
 use hilsim_sim::Scenario;
 
-/// The built-in default scenario: the straight-board run of the EM paper (Sec. VI).
-const BUILTIN_SCENARIO: &str = include_str!("../../scenarios/straight-board.toml");
-
 /// Loads a scenario file, or the built-in one, and applies a `--seed` override.
 pub fn load_scenario(path: Option<&Path>, seed: Option<u64>) -> Result<Scenario> {
     let mut scenario = match path {
         Some(path) => Scenario::load(path)?,
-        None => Scenario::from_toml(BUILTIN_SCENARIO, Path::new("<built-in straight-board>"))?,
+        None => hilsim_scenarios::builtin::straight_board()?,
     };
     if let Some(seed) = seed {
         scenario.seed = seed;

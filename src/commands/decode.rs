@@ -14,63 +14,21 @@
 //! `4 * packet_index + slot` (0..=359, counter-clockwise as the ROS driver reads it),
 //! `distance_mm` and `range_m` are 0 for an invalid reading, `invalid` and `warning` are 0/1,
 //! `error_code` is the invalid reading's code as `0x21`-style hex (empty when valid) and `rpm`
-//! is that packet's motor speed. The file is written to a hidden temporary sibling and renamed
-//! into place when complete, so a failed run never leaves half a file where a good one was.
+//! is that packet's motor speed (`hilsim_hil::decode`). The file is written to a hidden temporary
+//! sibling and renamed into place when complete, so a failed run never leaves half a file where
+//! a good one was.
 //!
 //! `--json` prints one object: `bytes`, `packets`, `bad_checksum`, `skipped_bytes`,
 //! `index_gaps`, `readings`, `invalid`, `strength_warning` (integers) and `rpm_min`,
 //! `rpm_median`, `rpm_max` (floats over accepted packets, 0.0 when there are none).
 
 use std::fs::File;
-use std::io::{BufWriter, ErrorKind, Read, Write};
-use std::path::{Path, PathBuf};
+use std::io::{BufWriter, ErrorKind, Write};
+use std::path::Path;
 
 use anyhow::{bail, Context};
-use hilsim_lidar_emulator::neato_packet::{
-    Decoder, DecoderStats, Packet, PacketSummary, Revolution, RevolutionAssembler,
-};
-use serde::Serialize;
-
-/// Bytes read from the input at a time.
-const CHUNK_LEN: usize = 64 * 1024;
-
-/// `EIO` on Linux and the BSDs: what a pty master's reader gets once the slave side is closed.
-#[cfg(unix)]
-const EIO: i32 = 5;
-
-/// The `--json` object; field names are the interface (`interfaces.md`).
-#[derive(Debug, Serialize)]
-struct DecodeCounts {
-    bytes: u64,
-    packets: u64,
-    bad_checksum: u64,
-    skipped_bytes: u64,
-    index_gaps: u64,
-    readings: u64,
-    invalid: u64,
-    strength_warning: u64,
-    rpm_min: f64,
-    rpm_median: f64,
-    rpm_max: f64,
-}
-
-impl DecodeCounts {
-    fn new(stats: &DecoderStats, summary: &PacketSummary) -> Self {
-        Self {
-            bytes: stats.bytes,
-            packets: stats.packets,
-            bad_checksum: stats.bad_checksum,
-            skipped_bytes: stats.skipped_bytes,
-            index_gaps: stats.index_gaps,
-            readings: summary.readings(),
-            invalid: summary.invalid(),
-            strength_warning: summary.strength_warning(),
-            rpm_min: summary.rpm_min(),
-            rpm_median: summary.rpm_median(),
-            rpm_max: summary.rpm_max(),
-        }
-    }
-}
+use hilsim_hil::decode::{decode_stream, decoded_csv_rows, DecodeCounts, DECODED_CSV_HEADER};
+use tempfile::NamedTempFile;
 
 /// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
 /// (one JSON object with `json`, else a short human summary).
@@ -85,38 +43,60 @@ pub fn run(
     stdout: &mut dyn Write,
 ) -> anyhow::Result<()> {
     let mut source = open_input(input)?;
-    let mut csv_out = csv.map(CsvOut::create).transpose()?;
-
-    let mut decoder = Decoder::new();
-    let mut summary = PacketSummary::new();
-    let mut assembler = RevolutionAssembler::new();
-    let mut chunk = vec![0; CHUNK_LEN];
-    loop {
-        let len = match source.read(&mut chunk) {
-            Ok(0) => break,
-            Ok(len) => len,
-            Err(err) if err.kind() == ErrorKind::Interrupted => continue,
-            Err(err) if is_closed_pty(&err) => break,
-            Err(err) => bail!("{}: cannot read: {err}", input.display()),
-        };
-        for packet in decoder.feed(&chunk[..len]) {
-            summary.add(&packet);
-            if let Some(out) = csv_out.as_mut() {
-                if let Some(revolution) = assembler.push(packet) {
-                    out.write_revolution(&revolution)?;
-                }
-            }
+    let read_error =
+        |err: std::io::Error| anyhow::anyhow!("{}: cannot read: {err}", input.display());
+    let counts = match csv {
+        None => decode_stream::<std::io::Error>(&mut source, None).map_err(read_error)?,
+        Some(path) => {
+            let cannot_write = || format!("{}: cannot write", path.display());
+            let mut out = create_csv(path)?;
+            let mut rows = String::new();
+            let mut write = |revolution: &_| -> std::io::Result<()> {
+                rows.clear();
+                decoded_csv_rows(revolution, &mut rows);
+                out.write_all(rows.as_bytes())
+            };
+            // A read error names the input, a write error the CSV.
+            let mut write_failed = false;
+            let mut sink = |revolution: &_| write(revolution).inspect_err(|_| write_failed = true);
+            let counts = decode_stream::<std::io::Error>(&mut source, Some(&mut sink));
+            let counts = match counts {
+                Err(err) if write_failed => return Err(err).with_context(cannot_write),
+                other => other.map_err(read_error)?,
+            };
+            let file = out
+                .into_inner()
+                .map_err(|err| err.into_error())
+                .with_context(cannot_write)?;
+            file.as_file().sync_all().with_context(cannot_write)?;
+            file.persist(path)
+                .map_err(|err| err.error)
+                .with_context(cannot_write)?;
+            counts
         }
-    }
-    if let Some(mut out) = csv_out {
-        if let Some(revolution) = assembler.finish() {
-            out.write_revolution(&revolution)?;
-        }
-        out.commit()?;
-    }
-
-    let counts = DecodeCounts::new(&decoder.finish(), &summary);
+    };
     report(input, &counts, json, stdout).context("stdout: cannot write")
+}
+
+/// The CSV being written, with its header: a hidden temporary sibling of `path` (so the final
+/// rename is atomic), removed if anything fails before it is persisted.
+fn create_csv(path: &Path) -> anyhow::Result<BufWriter<NamedTempFile>> {
+    let Some(name) = path.file_name() else {
+        bail!("{}: not a file name for the CSV output", path.display());
+    };
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let file = tempfile::Builder::new()
+        .prefix(&format!(".{}.", name.to_string_lossy()))
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .with_context(|| format!("{}: cannot create", path.display()))?;
+    let mut out = BufWriter::new(file);
+    writeln!(out, "{DECODED_CSV_HEADER}")
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    Ok(out)
 }
 
 fn open_input(input: &Path) -> anyhow::Result<File> {
@@ -139,16 +119,6 @@ fn open_input(input: &Path) -> anyhow::Result<File> {
         );
     }
     Ok(file)
-}
-
-#[cfg(unix)]
-fn is_closed_pty(err: &std::io::Error) -> bool {
-    err.raw_os_error() == Some(EIO)
-}
-
-#[cfg(not(unix))]
-fn is_closed_pty(_err: &std::io::Error) -> bool {
-    false
 }
 
 fn report(
@@ -191,106 +161,6 @@ fn report(
     Ok(())
 }
 
-/// The CSV being written: a temporary sibling of `path`, renamed over it by [`CsvOut::commit`]
-/// and removed if anything fails before that.
-struct CsvOut {
-    path: PathBuf,
-    tmp: PathBuf,
-    writer: Option<BufWriter<File>>,
-    committed: bool,
-}
-
-impl CsvOut {
-    const HEADER: &'static str =
-        "rev,packet_index,angle_deg,distance_mm,range_m,strength,invalid,warning,error_code,rpm";
-
-    fn create(path: &Path) -> anyhow::Result<Self> {
-        let Some(name) = path.file_name() else {
-            bail!("{}: not a file name for the CSV output", path.display());
-        };
-        // Hidden and in the same directory, so the final rename is atomic; unique per process.
-        let tmp = path.with_file_name(format!(
-            ".{}.tmp.{}",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let file =
-            File::create(&tmp).with_context(|| format!("{}: cannot create", path.display()))?;
-        let mut out = Self {
-            path: path.to_path_buf(),
-            tmp,
-            writer: Some(BufWriter::new(file)),
-            committed: false,
-        };
-        out.write_line(format_args!("{}", Self::HEADER))?;
-        Ok(out)
-    }
-
-    fn write_revolution(&mut self, revolution: &Revolution) -> anyhow::Result<()> {
-        for packet in revolution.packets.iter().flatten() {
-            self.write_packet(revolution.number, packet)?;
-        }
-        Ok(())
-    }
-
-    fn write_packet(&mut self, rev: u64, packet: &Packet) -> anyhow::Result<()> {
-        for (angle_deg, reading) in (packet.first_angle_deg()..).zip(&packet.readings) {
-            let distance_mm = if reading.invalid {
-                0
-            } else {
-                reading.distance_mm
-            };
-            let error_code = reading
-                .error_code()
-                .map(|code| format!("{code:#04x}"))
-                .unwrap_or_default();
-            self.write_line(format_args!(
-                "{rev},{},{angle_deg},{distance_mm},{:.3},{},{},{},{error_code},{}",
-                packet.index,
-                f64::from(distance_mm) / 1000.0,
-                reading.strength,
-                u8::from(reading.invalid),
-                u8::from(reading.strength_warning),
-                packet.rpm(),
-            ))?;
-        }
-        Ok(())
-    }
-
-    fn write_line(&mut self, line: std::fmt::Arguments<'_>) -> anyhow::Result<()> {
-        let Some(writer) = self.writer.as_mut() else {
-            bail!("{}: already closed", self.path.display());
-        };
-        writeln!(writer, "{line}").with_context(|| format!("{}: cannot write", self.path.display()))
-    }
-
-    /// Flushes, syncs and renames the temporary file over `path`.
-    fn commit(mut self) -> anyhow::Result<()> {
-        let context = || format!("{}: cannot write", self.path.display());
-        if let Some(writer) = self.writer.take() {
-            let file = writer
-                .into_inner()
-                .map_err(|err| err.into_error())
-                .with_context(context)?;
-            file.sync_all().with_context(context)?;
-        }
-        std::fs::rename(&self.tmp, &self.path).with_context(context)?;
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for CsvOut {
-    fn drop(&mut self) {
-        if !self.committed {
-            // Close before removing, then drop the half-written file; nothing else to report
-            // from a destructor, and the error that got us here is already on its way.
-            self.writer.take();
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -321,7 +191,7 @@ mod tests {
         let leftovers: Vec<_> = std::fs::read_dir(dir.path())
             .expect("list dir")
             .filter_map(|entry| entry.ok())
-            .filter(|entry| entry.file_name().to_string_lossy().contains(".tmp."))
+            .filter(|entry| entry.file_name().to_string_lossy().ends_with(".tmp"))
             .collect();
         assert!(leftovers.is_empty(), "temporary file left behind");
         let csv_text = csv.then(|| std::fs::read_to_string(&csv_path).expect("csv written"));
@@ -353,7 +223,7 @@ mod tests {
         assert!(stdout.contains("178 packets"), "{stdout}");
         let csv = csv.expect("csv requested");
         let mut lines = csv.lines();
-        assert_eq!(lines.next(), Some(CsvOut::HEADER));
+        assert_eq!(lines.next(), Some(DECODED_CSV_HEADER));
         let rows: Vec<Vec<&str>> = lines.map(|line| line.split(',').collect()).collect();
         assert_eq!(rows.len(), 4 * 178);
         assert_eq!(
@@ -379,7 +249,7 @@ mod tests {
         assert_eq!(value["rpm_median"], 0.0);
         assert_eq!(
             csv.as_deref(),
-            Some(format!("{}\n", CsvOut::HEADER).as_str())
+            Some(format!("{DECODED_CSV_HEADER}\n").as_str())
         );
     }
 

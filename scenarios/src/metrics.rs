@@ -10,6 +10,7 @@ use hilsim_sim::scenario::Expect;
 pub type Metrics = BTreeMap<String, f64>;
 
 /// The metrics of a finished run.
+#[must_use]
 pub fn of_run(run: &Run) -> Metrics {
     let rec = &run.recording;
     let mut m = Metrics::new();
@@ -81,6 +82,7 @@ pub fn of_run(run: &Run) -> Metrics {
 }
 
 /// The metrics of one calibration: `<method>.lidar.mse_ratio` and friends (see the catalogue).
+#[must_use]
 pub fn of_calibration(c: &hilsim_calibrator::Calibration) -> Metrics {
     let mut m = Metrics::new();
     let method = c.method.name();
@@ -116,15 +118,21 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
 /// The outcome of one assertion.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Outcome {
+    /// The metric asserted on.
     pub metric: String,
+    /// Its value, when it could be computed.
     pub value: Option<f64>,
+    /// The assertion's lower bound.
     pub at_least: Option<f64>,
+    /// The assertion's upper bound.
     pub at_most: Option<f64>,
+    /// Whether the value was computed and within the bounds.
     pub passed: bool,
 }
 
 impl Outcome {
     /// One line for people: `PASS lidar.readings = 72000 (≥ 1000)`.
+    #[must_use]
     pub fn describe(&self) -> String {
         let bounds: Vec<String> = [
             self.at_least.map(|v| format!("≥ {v}")),
@@ -146,6 +154,7 @@ impl Outcome {
 }
 
 /// Checks every assertion; a metric that was not computed fails its assertion.
+#[must_use]
 pub fn check(expects: &[Expect], metrics: &Metrics) -> Vec<Outcome> {
     expects
         .iter()

@@ -1,0 +1,60 @@
+//! Finding the scenario files `hilsim scenario test` runs.
+
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// A path that could not be read or listed.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {what}: {error}", path.display())]
+pub struct DiscoverError {
+    /// The file or directory.
+    pub path: PathBuf,
+    /// What failed ("cannot read", "cannot list").
+    pub what: &'static str,
+    /// Why.
+    pub error: io::Error,
+}
+
+impl DiscoverError {
+    fn at<'a>(path: &'a Path, what: &'static str) -> impl FnOnce(io::Error) -> Self + 'a {
+        move |error| Self {
+            path: path.to_path_buf(),
+            what,
+            error,
+        }
+    }
+}
+
+/// The scenario files at `path`: the file itself, or every `*.toml` below the directory in
+/// name order, except `Cargo.toml` (a crate's manifest, as beside the checked-in scenarios).
+///
+/// # Errors
+/// [`DiscoverError`]: the path that could not be read or listed.
+pub fn scenario_files(path: &Path) -> Result<Vec<PathBuf>, DiscoverError> {
+    let mut files = Vec::new();
+    collect(path, &mut files)?;
+    Ok(files)
+}
+
+fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<(), DiscoverError> {
+    let meta = std::fs::metadata(path).map_err(DiscoverError::at(path, "cannot read"))?;
+    if meta.is_file() {
+        files.push(path.to_path_buf());
+        return Ok(());
+    }
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(path)
+        .map_err(DiscoverError::at(path, "cannot list"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    for entry in entries {
+        if entry.is_dir() {
+            collect(&entry, files)?;
+        } else if entry.extension().is_some_and(|e| e == "toml")
+            && entry.file_name().is_some_and(|n| n != "Cargo.toml")
+        {
+            files.push(entry);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,15 @@
+//! The checked-in scenarios (the `*.toml` files beside this crate, two of them built in) and the
+//! pipeline that runs one end to end, as `hilsim run` and `hilsim scenario test` do: emulate the
+//! sensors in the scenario's world, calibrate with the methods it names, compute the metrics
+//! (`hilsim_sim::scenario::metrics` is their catalogue) and check its `[[expect]]` assertions.
+#![warn(missing_docs)]
+
+pub mod builtin;
+mod discover;
+pub mod metrics;
+mod pipeline;
+mod summary;
+
+pub use discover::{scenario_files, DiscoverError};
+pub use metrics::{Metrics, Outcome};
+pub use pipeline::{execute, execute_all, Report, RunError, Via};

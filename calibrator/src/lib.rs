@@ -16,6 +16,7 @@ pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
 pub mod smoothing;
+pub mod stats;
 pub mod target_samples;
 
 pub use by_method::{calibrate, em_options, TargetOptions};

@@ -15,8 +15,9 @@ use super::inversion::Inverse;
 use super::options::{Estimator, Options, OrderSelection};
 use super::pose::Pose2;
 use super::positions::{intersect, BearingLine, PositionError, Weights, MIN_BEARING_SPREAD_RAD};
-use super::scan::{average_stop, median};
+use super::scan::average_stop;
 use super::stops::{find_stops, Stop};
+use crate::stats::median;
 use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
 
 /// Standard deviation given to the stops before the robot first moved: they are at the start

@@ -13,6 +13,7 @@ use hilsim_recording::LidarSample;
 
 use super::options::DetectionOptions;
 use super::stops::Stop;
+use crate::stats::median;
 
 /// Beams per revolution: the XV-11 takes one reading per degree.
 pub const BEAMS: usize = 360;
@@ -170,20 +171,6 @@ fn average(
         readings,
         all_m,
         samples: sampled,
-    }
-}
-
-/// The median (the slice is reordered).
-pub(crate) fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
     }
 }
 

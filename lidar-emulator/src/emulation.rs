@@ -7,7 +7,8 @@ use hilsim_recording::{
 };
 use hilsim_sim::{Collision, Scenario, Simulation, StepState};
 
-use crate::lidar::{Lidar, LidarReading, READINGS_PER_REV};
+use crate::lidar::{Lidar, LidarReading};
+use crate::neato_packet::READINGS_PER_REVOLUTION;
 use crate::odometer::Odometer;
 use crate::range_model::ModelError;
 use crate::sonar::Sonar;
@@ -200,7 +201,7 @@ impl Emulation {
         // A real unit only ever delivers whole revolutions: the one the run ended inside is not
         // part of the recording (so the in-process and serial paths carry the same data).
         if let Some(readings) = &mut lidar {
-            let whole = readings.len() - readings.len() % usize::from(READINGS_PER_REV);
+            let whole = readings.len() - readings.len() % READINGS_PER_REVOLUTION;
             readings.truncate(whole);
         }
         let (commands, truth, collisions) = self.sim.take_logs();

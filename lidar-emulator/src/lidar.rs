@@ -9,13 +9,8 @@ use rand_distr::{Distribution, StandardNormal};
 
 use crate::effects::LidarEffects;
 use crate::mount::Mount;
+use crate::neato_packet::{MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
-
-/// Readings per revolution: one per degree.
-pub const READINGS_PER_REV: u16 = 360;
-
-/// Largest distance the 14-bit field carries, millimetres.
-pub const MAX_DISTANCE_MM: u16 = 0x3FFF;
 
 /// Error code for "no return": nothing within range, or the reading fell beyond the maximum.
 /// The most frequent code in the real capture `xv11-hand-in-box.bin` (1,996 of ~2,800 invalid
@@ -220,7 +215,7 @@ impl Lidar {
                 out.push(self.read(world, origin, yaw, t));
             }
             self.index += 1;
-            if self.index == READINGS_PER_REV {
+            if usize::from(self.index) == READINGS_PER_REVOLUTION {
                 self.index = 0;
                 self.rev_start_s = next_revolution_start_s(self.rev_start_s, self.rev_rpm);
                 self.rev += 1;
@@ -326,7 +321,7 @@ impl SensorTrack {
 /// Seconds between two readings at `rpm`.
 #[must_use]
 pub fn reading_period_s(rpm: f64) -> f64 {
-    60.0 / (rpm * f64::from(READINGS_PER_REV))
+    60.0 / (rpm * READINGS_PER_REVOLUTION as f64)
 }
 
 /// When reading `index` of a revolution that started at `rev_start_s` and turns at `rpm` is
@@ -340,5 +335,5 @@ pub fn reading_time_s(rev_start_s: f64, index: u16, rpm: f64) -> f64 {
 /// When the revolution after one that started at `rev_start_s` at `rpm` starts.
 #[must_use]
 pub fn next_revolution_start_s(rev_start_s: f64, rpm: f64) -> f64 {
-    rev_start_s + f64::from(READINGS_PER_REV) * reading_period_s(rpm)
+    rev_start_s + READINGS_PER_REVOLUTION as f64 * reading_period_s(rpm)
 }

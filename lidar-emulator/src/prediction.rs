@@ -17,8 +17,8 @@
 use hilsim_sim::{scenario, Obstacle, Pose, World};
 
 use crate::effects::{BeamReturn, LidarEffects};
-use crate::lidar::MAX_DISTANCE_MM;
 use crate::mount::Mount;
+use crate::neato_packet::MAX_DISTANCE_MM;
 use crate::range_model::{ModelError, RangeModel};
 use crate::sonar::Sonar;
 

@@ -3,7 +3,7 @@
 
 use hilsim_recording::LidarSample;
 
-use crate::lidar::{next_revolution_start_s, reading_time_s, LidarReading, READINGS_PER_REV};
+use crate::lidar::{next_revolution_start_s, reading_time_s, LidarReading};
 use crate::neato_packet::{encode_revolution, Reading, Revolution, READINGS_PER_REVOLUTION};
 
 /// The wire form of one emulated reading. An invalid reading carries its error code and no
@@ -53,7 +53,7 @@ impl RevolutionFrame {
 pub struct RevolutionCollector {
     current: Option<(u64, f64)>,
     readings: [Reading; READINGS_PER_REVOLUTION],
-    filled: u16,
+    filled: usize,
 }
 
 impl Default for RevolutionCollector {
@@ -77,7 +77,9 @@ impl RevolutionCollector {
         self.readings[usize::from(reading.angle_deg)] = to_wire(reading);
         self.filled += 1;
         let (rev, start_s) = self.current?;
-        if reading.angle_deg != READINGS_PER_REV - 1 || self.filled != READINGS_PER_REV {
+        if usize::from(reading.angle_deg) != READINGS_PER_REVOLUTION - 1
+            || self.filled != READINGS_PER_REVOLUTION
+        {
             return None;
         }
         Some(RevolutionFrame {

@@ -18,12 +18,14 @@
 
 pub mod align;
 mod catalogue;
+mod conclude;
 mod diagnosis;
 mod error;
 mod estimate;
 pub mod explain;
 pub mod locate;
 mod optimize;
+mod outcome;
 mod physics;
 mod plot;
 mod residuals;
@@ -35,10 +37,11 @@ mod trajectory;
 
 pub use align::Alignment;
 pub use catalogue::{Effect, ParamSpec, Sensor};
-pub use diagnosis::{diagnose, Diagnosis, Options, SensorSummary, Verdict};
+pub use diagnosis::diagnose;
 pub use error::MismatchError;
 pub use explain::CandidateFit;
 pub use locate::{Evidence, TestKind};
+pub use outcome::{Diagnosis, Options, SensorSummary, Verdict};
 pub use physics::{
     Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
     OdometryPrediction, Physics, SonarPrediction,

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use super::format::{escape, fmt_sig, mm};
-use crate::diagnosis::{Diagnosis, Verdict};
+use crate::outcome::{Diagnosis, Verdict};
 
 /// The report page: the verdict, the evidence, the fit and the plots (`plot_files[i]` is where
 /// the caller wrote `svg(&d.plots[i])`, relative to the page).

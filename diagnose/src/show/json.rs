@@ -2,7 +2,7 @@
 
 use serde_json::{json, Map, Value};
 
-use crate::diagnosis::Diagnosis;
+use crate::outcome::Diagnosis;
 
 /// A finite number as JSON, anything else as `null`: no NaN ever reaches a user.
 fn num(v: f64) -> Value {

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use super::format::{fmt_sig, mm};
-use crate::diagnosis::Diagnosis;
+use crate::outcome::Diagnosis;
 
 /// The diagnosis for people: a few lines.
 #[must_use]

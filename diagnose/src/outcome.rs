@@ -1,0 +1,112 @@
+//! What a diagnosis takes and gives: its options, the verdict and the diagnosis.
+
+use crate::align::Alignment;
+use crate::catalogue::{Effect, Sensor};
+use crate::explain::CandidateFit;
+use crate::locate::Evidence;
+use crate::plot::PlotData;
+
+/// Settings of the diagnosis. The defaults are the ones `docs/diagnose.md` derives and the
+/// self-test measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Family-wise false-alarm level of the locate tests (Bonferroni over all of them).
+    pub alpha: f64,
+    /// Held-out log-likelihood gain over "none" (nats) an effect needs to be named.
+    pub min_gain: f64,
+    /// Share of the located structure (in normal-score terms) the fitted effect may leave.
+    pub max_remaining: f64,
+    /// The effects tried (default: the whole catalogue).
+    pub effects: Vec<Effect>,
+    /// Training readings per sensor used to fit an effect (evenly thinned beyond this).
+    pub max_fit_rows: usize,
+    /// Share of a sensor's readings that are outliers to the simulation (the outlier component
+    /// explains them better than the prediction) above which the recording "does not align".
+    pub misaligned_share: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            alpha: 0.01,
+            min_gain: 10.0,
+            max_remaining: 0.25,
+            effects: Effect::ALL.to_vec(),
+            max_fit_rows: 15_000,
+            misaligned_share: 0.5,
+        }
+    }
+}
+
+/// The answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The recording agrees with the simulation within its noise.
+    None,
+    /// A catalogued effect explains the mismatch.
+    Effect(Effect),
+    /// A mismatch is located but no catalogued effect explains it.
+    Unexplained,
+}
+
+impl Verdict {
+    /// The name in the JSON's `effect` key.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::None => "none",
+            Verdict::Effect(e) => e.name(),
+            Verdict::Unexplained => "unexplained",
+        }
+    }
+}
+
+/// One sensor's held-out residuals under the nominal model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorSummary {
+    /// The sensor.
+    pub sensor: Sensor,
+    /// Readings compared (both halves).
+    pub readings: usize,
+    /// Held-out RMSE of the nominal residuals, metres.
+    pub heldout_rmse_m: f64,
+    /// The noise floor there, metres.
+    pub noise_floor_m: f64,
+    /// The strongest test's normal score.
+    pub strongest: f64,
+}
+
+/// The diagnosis of one recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnosis {
+    /// The answer.
+    pub verdict: Verdict,
+    /// Where the residuals stop being noise (the strongest evidence), when they do.
+    pub located: Option<Evidence>,
+    /// One sentence: what physics was left out (or why none or no effect is named).
+    pub explanation: String,
+    /// The named effect's fit.
+    pub fitted: Option<CandidateFit>,
+    /// Every candidate tried, best held-out score first.
+    pub candidates: Vec<CandidateFit>,
+    /// Each sensor compared.
+    pub sensors: Vec<SensorSummary>,
+    /// The significant evidence under the nominal model, strongest first.
+    pub evidence: Vec<Evidence>,
+    /// The score a test had to reach.
+    pub threshold: f64,
+    /// Where the real trajectory came from.
+    pub alignment: Alignment,
+    /// What else the user should know.
+    pub notes: Vec<String>,
+    /// Residuals against the located variable, before and after the fix (held-out half).
+    pub plots: Vec<PlotData>,
+}
+
+impl Diagnosis {
+    /// Whether a mismatch was found.
+    #[must_use]
+    pub fn mismatch(&self) -> bool {
+        self.verdict != Verdict::None
+    }
+}

@@ -10,14 +10,11 @@
 //! Criterion reports each benchmark; a summary of ratios (measured again, median of
 //! repetitions) is printed at the end.
 
-#[path = "../tests/issue_5_fixtures.rs"]
-mod fixtures;
-
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
-use hilsim_calibrator::em::{self, EStep, EmOptions};
+use hilsim_calibrator::em::{self, experiment, EStep, EmOptions};
 use hilsim_calibrator::kalman_smoother::{
     Gaussian, Observation, Observations, RtsSmoother, StateSpaceModel, Transition,
 };
@@ -305,7 +302,8 @@ fn export_for_pykalman(dir: &std::path::Path, model: &ExplicitModel, ns_per_step
 }
 
 fn main() {
-    let rec = fixtures::synthetic_recording(N, 1);
+    let rec =
+        experiment::synthetic_recording(N, &mut hilsim_sim::rng::stream(1, "issue-5-synthetic"));
     let s = samples(&rec);
     // `EM_BENCH_PYKALMAN_DIR=DIR cargo bench -p hilsim-calibrator --bench em -- --list` (any
     // filter) exports the model for the pykalman comparison and times the Rust pass on it.

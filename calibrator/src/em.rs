@@ -34,6 +34,7 @@
 mod engine;
 mod estep;
 mod estimate;
+pub mod experiment;
 mod model;
 mod mstep;
 mod options;

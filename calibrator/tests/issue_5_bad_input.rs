@@ -6,7 +6,7 @@ mod fixtures;
 
 use std::sync::OnceLock;
 
-use fixtures::Run;
+use fixtures::{Record, Run};
 use hilsim_calibrator::em::{self, EmOptions};
 use hilsim_calibrator::{groundtruth, smoothing, CalibrationError, Sensor, SensorModel};
 use hilsim_recording::{CommandSample, Recording};

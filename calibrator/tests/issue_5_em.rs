@@ -5,7 +5,7 @@
 #[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
-use fixtures::{Run, LIDAR_ALPHA, LIDAR_BETA2};
+use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};
 use hilsim_calibrator::em::{self, EStep, EmOptions};
 use hilsim_calibrator::{Method, Sensor};
 use nalgebra::{Matrix3, Vector3};

@@ -4,7 +4,7 @@
 #[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
-use fixtures::{Run, LIDAR_ALPHA, LIDAR_BETA2};
+use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};
 use hilsim_calibrator::groundtruth::{self, fit_aic, fit_ml};
 use hilsim_calibrator::target_samples::{extract, SampleOptions};
 use hilsim_calibrator::{Method, Sensor};

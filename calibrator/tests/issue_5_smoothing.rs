@@ -4,7 +4,7 @@
 #[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
-use fixtures::Run;
+use fixtures::{Record, Run};
 use hilsim_calibrator::em::{self, EStep, EmOptions};
 use hilsim_calibrator::target_samples::{distance_metrics, extract, SampleOptions};
 use hilsim_calibrator::{smoothing, Sensor};

@@ -59,7 +59,9 @@ mod tests {
     /// figure in the docs depends on them.
     #[test]
     fn the_random_streams_are_pinned() {
-        let pins: [(u64, [u64; 4], [u32; 2], [u8; 13]); 3] = [
+        /// A seed, its first four `next_u64`, the next two `next_u32`, then 13 bytes.
+        type Pin = (u64, [u64; 4], [u32; 2], [u8; 13]);
+        let pins: [Pin; 3] = [
             (
                 0,
                 [

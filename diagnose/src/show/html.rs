@@ -47,6 +47,28 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
             escape(&l.detail)
         );
     }
+    fix(&mut s, d);
+    for (p, file) in d.plots.iter().zip(plot_files) {
+        let _ = writeln!(
+            s,
+            r##"<img src="{}" alt="{}">"##,
+            escape(file),
+            escape(&p.title)
+        );
+    }
+    candidates(&mut s, d);
+    sensors(&mut s, d);
+    evidence(&mut s, d);
+    let _ = writeln!(s, "<p>Aligned by {}.</p>", escape(d.alignment.name()));
+    for n in &d.notes {
+        let _ = writeln!(s, "<p>Note: {}</p>", escape(n));
+    }
+    let _ = writeln!(s, "</body></html>");
+    s
+}
+
+/// The named effect's fitted parameters and its held-out RMSE before and after.
+fn fix(s: &mut String, d: &Diagnosis) {
     if let Some(f) = &d.fitted {
         let _ = writeln!(
             s,
@@ -72,14 +94,10 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
             f.heldout_n
         );
     }
-    for (p, file) in d.plots.iter().zip(plot_files) {
-        let _ = writeln!(
-            s,
-            r##"<img src="{}" alt="{}">"##,
-            escape(file),
-            escape(&p.title)
-        );
-    }
+}
+
+/// Every candidate's held-out and BIC gains and parameters.
+fn candidates(s: &mut String, d: &Diagnosis) {
     if !d.candidates.is_empty() {
         let _ = writeln!(
             s,
@@ -104,6 +122,10 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
         }
         let _ = writeln!(s, "</table>");
     }
+}
+
+/// Each sensor's held-out residuals under the nominal model.
+fn sensors(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
         "<h2>Sensors</h2><table><tr><th>sensor</th><th>readings</th><th>held-out RMSE (nominal)</th><th>noise floor</th><th>strongest test</th></tr>"
@@ -120,6 +142,10 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
         );
     }
     let _ = writeln!(s, "</table>");
+}
+
+/// The significant evidence (the strongest twelve).
+fn evidence(s: &mut String, d: &Diagnosis) {
     if !d.evidence.is_empty() {
         let _ = writeln!(
             s,
@@ -137,10 +163,4 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
         }
         let _ = writeln!(s, "</table>");
     }
-    let _ = writeln!(s, "<p>Aligned by {}.</p>", escape(d.alignment.name()));
-    for n in &d.notes {
-        let _ = writeln!(s, "<p>Note: {}</p>", escape(n));
-    }
-    let _ = writeln!(s, "</body></html>");
-    s
 }

@@ -1,0 +1,93 @@
+//! What a run is set up from: the two ports the firmware talks to, the scenario's world driven
+//! from outside, and the signals that stop a run at the terminal.
+
+use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread;
+
+use hilsim_lidar_emulator::{Emulation, ModelError};
+use hilsim_sim::{Scenario, Simulation};
+use nix::sys::signal::{SigSet, Signal};
+
+use crate::pty::PtyLink;
+
+/// The two ports a firmware talks to: open them, start the firmware with their paths, then
+/// [`run`].
+pub struct HilPorts {
+    pub(super) lidar: PtyLink,
+    pub(super) robot: PtyLink,
+}
+
+impl HilPorts {
+    /// Opens both pty pairs (close-on-exec, with hilsim's own client-side handles).
+    ///
+    /// # Errors
+    /// No free pty.
+    pub fn open() -> io::Result<Self> {
+        Ok(Self {
+            lidar: PtyLink::open()?,
+            robot: PtyLink::open()?,
+        })
+    }
+
+    /// The lidar port's path (`HILSIM_LIDAR_PORT`).
+    #[must_use]
+    pub fn lidar_path(&self) -> &str {
+        self.lidar.client_path()
+    }
+
+    /// The robot command port's path (`HILSIM_ROBOT_PORT`).
+    #[must_use]
+    pub fn robot_path(&self) -> &str {
+        self.robot.client_path()
+    }
+}
+
+/// The scenario's world and sensors with the wheels left to the firmware: its drive program is
+/// not run.
+pub struct HilWorld {
+    pub(super) emulation: Emulation,
+    pub(super) sonar_period_s: Option<f64>,
+    pub(super) odometer: bool,
+}
+
+impl HilWorld {
+    /// The scenario's world with its sensors, every random stream drawn from `seed`, driven
+    /// from outside (`Simulation::externally_driven`).
+    ///
+    /// # Errors
+    /// A sensor's range model makes no sense.
+    pub fn new(scenario: &Scenario, seed: u64) -> Result<Self, ModelError> {
+        let sim = Simulation::externally_driven(scenario);
+        Ok(Self {
+            emulation: Emulation::with_simulation(scenario, seed, sim)?,
+            sonar_period_s: scenario.sensors.sonar.as_ref().map(|s| 1.0 / s.rate_hz),
+            odometer: scenario.sensors.odometer.is_some(),
+        })
+    }
+}
+
+/// Blocks `SIGINT`, `SIGTERM` and `SIGHUP` in the calling thread and raises `stop` whenever one
+/// arrives, so that a run interrupted at the terminal still shuts its firmware down (the
+/// firmware runs in its own process group, out of reach of the terminal's Ctrl-C). Call it
+/// before any other thread is started: threads inherit the mask (child processes do not; the
+/// standard library clears it for them).
+///
+/// # Errors
+/// The mask cannot be set or the waiting thread started.
+pub fn stop_on_signals(stop: Arc<AtomicBool>) -> io::Result<()> {
+    let mut signals = SigSet::empty();
+    for signal in [Signal::SIGINT, Signal::SIGTERM, Signal::SIGHUP] {
+        signals.add(signal);
+    }
+    signals.thread_block().map_err(io::Error::from)?;
+    thread::Builder::new()
+        .name("hil-signals".into())
+        .spawn(move || {
+            while signals.wait().is_ok() {
+                stop.store(true, Ordering::Relaxed);
+            }
+        })?;
+    Ok(())
+}

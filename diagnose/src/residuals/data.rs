@@ -1,0 +1,177 @@
+//! What the residuals are computed from: one sensor's readings, the variables they are tested
+//! against, and the context the diagnosis holds while it works.
+
+use hilsim_recording::Recording;
+
+use crate::catalogue::Sensor;
+use crate::physics::{Gaussian, LidarQuery, Physics};
+use crate::trajectory::Trajectory;
+
+/// Length of the alternating training / held-out blocks, seconds.
+pub const SPLIT_BLOCK_S: f64 = 2.0;
+/// Window of the drive's residuals (wheel travel increments), seconds.
+pub const DRIVE_WINDOW_S: f64 = 0.1;
+/// Normal scores are clipped here, so one wild reading cannot dominate a test.
+pub const Z_CLIP: f64 = 6.0;
+
+/// A variable the residuals are tested against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Covariate {
+    /// The true range, metres.
+    Range,
+    /// The beam's angle in the lidar frame, degrees.
+    Bearing,
+    /// The angle of incidence on the surface, degrees.
+    Incidence,
+    /// The object the beam hit (categorical).
+    Object,
+    /// Whether the beam's direction noise reaches an edge (0 or 1).
+    Edge,
+    /// Time since the recording's start, seconds.
+    Time,
+    /// The robot's forward speed, m/s (absolute).
+    Speed,
+    /// The robot's acceleration, m/s² (absolute).
+    Accel,
+    /// The robot's turn rate, degrees per second (absolute).
+    TurnRate,
+    /// The wheel's speed, m/s (signed).
+    WheelSpeed,
+    /// How much nearer than the axis an echo within 30° of it is, metres.
+    OffAxisNearer,
+    /// Time since the wheel command last changed, seconds.
+    SinceCommand,
+}
+
+impl Covariate {
+    /// Its name in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Covariate::Range => "range",
+            Covariate::Bearing => "bearing",
+            Covariate::Incidence => "incidence angle",
+            Covariate::Object => "object",
+            Covariate::Edge => "edge",
+            Covariate::Time => "time",
+            Covariate::Speed => "speed",
+            Covariate::Accel => "acceleration",
+            Covariate::TurnRate => "turn rate",
+            Covariate::WheelSpeed => "wheel speed",
+            Covariate::OffAxisNearer => "off-axis echo nearer by",
+            Covariate::SinceCommand => "time since a command change",
+        }
+    }
+
+    /// Its unit in reports.
+    #[must_use]
+    pub fn unit(self) -> &'static str {
+        match self {
+            Covariate::Range | Covariate::OffAxisNearer => "m",
+            Covariate::Bearing | Covariate::Incidence => "deg",
+            Covariate::Object | Covariate::Edge => "",
+            Covariate::Time | Covariate::SinceCommand => "s",
+            Covariate::Speed | Covariate::WheelSpeed => "m/s",
+            Covariate::Accel => "m/s²",
+            Covariate::TurnRate => "deg/s",
+        }
+    }
+
+    /// Whether its values are categories rather than quantities.
+    #[must_use]
+    pub fn categorical(self) -> bool {
+        matches!(self, Covariate::Object | Covariate::Edge)
+    }
+
+    /// Whether it describes the robot's motion (reported as "while …").
+    #[must_use]
+    pub fn is_motion(self) -> bool {
+        matches!(
+            self,
+            Covariate::Speed
+                | Covariate::Accel
+                | Covariate::TurnRate
+                | Covariate::WheelSpeed
+                | Covariate::SinceCommand
+        )
+    }
+}
+
+/// What to ask the physics for a sensor's readings.
+#[derive(Debug, Clone)]
+pub(crate) enum Queries {
+    Lidar(Vec<LidarQuery>),
+    Sonar(Vec<f64>),
+    /// One reading time per pair of rows (left, right).
+    Odometer(Vec<f64>),
+    /// One window per pair of rows (left, right).
+    Drive(Vec<(f64, f64)>),
+}
+
+/// One sensor's readings, ready to be predicted.
+#[derive(Debug, Clone)]
+pub(crate) struct SensorData {
+    pub sensor: Sensor,
+    pub t: Vec<f64>,
+    pub y: Vec<f64>,
+    pub heldout: Vec<bool>,
+    pub covariates: Vec<(Covariate, Vec<f64>)>,
+    pub queries: Queries,
+    /// Weight of the uniform outlier component.
+    pub epsilon: f64,
+    /// Its density: ε over the span readings can take.
+    pub outlier_density: f64,
+    /// Groups of readings that share an error (of an estimated trajectory), by row; `None`:
+    /// every reading's error is its own.
+    pub clusters: Option<Vec<u32>>,
+}
+
+/// One reading's predictive distribution (empty: no reading expected).
+pub(crate) type Predictive = Vec<Gaussian>;
+
+impl SensorData {
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Row indices of one half (`heldout`) or of both (`None`).
+    pub fn rows(&self, half: Option<bool>) -> Vec<usize> {
+        (0..self.len())
+            .filter(|&i| half.is_none_or(|h| self.heldout[i] == h))
+            .collect()
+    }
+
+    pub fn covariate(&self, c: Covariate) -> Option<&[f64]> {
+        self.covariates
+            .iter()
+            .find(|(k, _)| *k == c)
+            .map(|(_, v)| v.as_slice())
+    }
+}
+
+/// What the diagnosis holds while it works: the physics, the aligned trajectory, the commands.
+pub(crate) struct Context<'a> {
+    pub physics: &'a dyn Physics,
+    pub trajectory: &'a Trajectory,
+    pub recording: &'a Recording,
+    pub end_s: f64,
+    /// The trajectory's position noise, metres (widens the drive's and encoders' residuals,
+    /// and those of the lidar and sonar when the trajectory is estimated).
+    pub position_sd_m: f64,
+    /// The trajectory's heading noise, radians (0 for a recorded one).
+    pub yaw_sd_rad: f64,
+    /// Whether the trajectory is estimated (its errors then widen every range).
+    pub estimated: bool,
+}
+
+impl Context<'_> {
+    /// Widens range predictions by the estimated trajectory's uncertainty: its position error
+    /// along the beam and its heading error times the range.
+    pub(super) fn widen(&self, mut g: Gaussian) -> Gaussian {
+        if self.estimated {
+            let extra = self.position_sd_m.powi(2) + (g.mean_m * self.yaw_sd_rad).powi(2);
+            g.sd_m = (g.sd_m * g.sd_m + extra).sqrt();
+        }
+        g
+    }
+}

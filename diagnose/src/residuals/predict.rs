@@ -1,0 +1,69 @@
+//! A sensor's readings predicted under a hypothesis.
+
+use super::data::{Context, Predictive, Queries, SensorData};
+use super::drive_filter::drive_predictions;
+use crate::physics::{Hypothesis, LidarQuery};
+use crate::trajectory::Trajectory;
+
+impl Context<'_> {
+    /// The predictive distributions of `rows` of `data` under `h`.
+    pub fn predict(&self, data: &SensorData, h: &Hypothesis, rows: &[usize]) -> Vec<Predictive> {
+        match &data.queries {
+            Queries::Lidar(q) => {
+                let qs: Vec<LidarQuery> = rows.iter().map(|&i| q[i]).collect();
+                self.physics
+                    .lidar(self.trajectory, &qs, h)
+                    .into_iter()
+                    .map(|p| p.components.into_iter().map(|g| self.widen(g)).collect())
+                    .collect()
+            }
+            Queries::Sonar(times) => {
+                let ts: Vec<f64> = rows.iter().map(|&i| times[i]).collect();
+                self.physics
+                    .sonar(self.trajectory, &ts, h)
+                    .into_iter()
+                    .map(|p| p.reading.into_iter().map(|g| self.widen(g)).collect())
+                    .collect()
+            }
+            Queries::Odometer(times) => {
+                let ts: Vec<f64> = rows.iter().map(|&i| times[i / 2]).collect();
+                let preds = self.physics.odometry(self.trajectory, &ts, h);
+                // The trajectory's own position noise enters each wheel's travel.
+                let extra = self.position_sd_m * self.position_sd_m;
+                rows.iter()
+                    .zip(preds)
+                    .map(|(&i, p)| {
+                        let mut g = p.wheels[i % 2];
+                        g.sd_m = (g.sd_m * g.sd_m + extra).sqrt();
+                        vec![g]
+                    })
+                    .collect()
+            }
+            Queries::Drive(windows) => {
+                let predicted = self.physics.drive(&self.recording.commands, self.end_s, h);
+                let Ok(path) = Trajectory::new(&predicted) else {
+                    return rows.iter().map(|_| Vec::new()).collect();
+                };
+                let travel = path.wheel_travel(self.physics.declared().wheel_base_m);
+                let increments: Vec<f64> = (0..data.len())
+                    .map(|i| {
+                        let (a, b) = windows[i / 2];
+                        let (wa, wb) = (path.interpolate(&travel, a), path.interpolate(&travel, b));
+                        wb[i % 2] - wa[i % 2]
+                    })
+                    .collect();
+                // Two differences of the trajectory's positions per window.
+                let noise_var = 2.0 * self.position_sd_m * self.position_sd_m;
+                let starts: Vec<f64> = windows.iter().map(|w| w.0).collect();
+                let all = drive_predictions(
+                    &increments,
+                    &data.y,
+                    &starts,
+                    self.physics.declared().actuation,
+                    noise_var,
+                );
+                rows.iter().map(|&i| vec![all[i]]).collect()
+            }
+        }
+    }
+}

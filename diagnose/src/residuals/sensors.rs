@@ -1,0 +1,296 @@
+//! Each sensor's readings (lidar, sonar, encoders, drive) gathered against the aligned
+//! trajectory, with their covariates and their training / held-out split.
+
+use super::data::{Context, Covariate, Queries, SensorData, DRIVE_WINDOW_S, SPLIT_BLOCK_S};
+use crate::catalogue::Sensor;
+use crate::error::MismatchError;
+use crate::physics::{Hypothesis, LidarQuery};
+use crate::trajectory::Trajectory;
+
+/// Margin around a contact of the replayed robot in which the drive is not compared, seconds.
+const CONTACT_MARGIN_S: f64 = 0.5;
+
+fn split(t: f64) -> bool {
+    ((t / SPLIT_BLOCK_S).floor() as i64).rem_euclid(2) == 1
+}
+
+/// Forward acceleration magnitude at `t` from the trajectory's speeds 50 ms either side.
+fn accel_at(tr: &Trajectory, t: f64) -> f64 {
+    let (a, _) = tr.twist_at(t - 0.05);
+    let (b, _) = tr.twist_at(t + 0.05);
+    ((b - a) / 0.1).abs()
+}
+
+/// The motion covariates at `t`.
+fn motion(tr: &Trajectory, t: f64) -> [f64; 3] {
+    let (v, w) = tr.twist_at(t);
+    [v.abs(), accel_at(tr, t), w.abs().to_degrees()]
+}
+
+/// The lidar's valid readings.
+pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let (Some(samples), Some(declared)) = (&ctx.recording.lidar, ctx.physics.declared().lidar)
+    else {
+        return Ok(None);
+    };
+    // Each revolution's start: the timestamp of its reading 0, or extrapolated from its first
+    // reading at the nominal reading period.
+    let period = 60.0 / (declared.rpm * 360.0);
+    let mut rev_start = std::collections::HashMap::new();
+    for s in samples {
+        rev_start
+            .entry(s.rev)
+            .or_insert(s.t_s - f64::from(s.angle_deg) * period);
+    }
+    let valid: Vec<_> = samples
+        .iter()
+        .filter(|s| !s.invalid && s.range_m > 0.0 && s.t_s <= ctx.end_s)
+        .collect();
+    let queries: Vec<LidarQuery> = valid
+        .iter()
+        .map(|s| LidarQuery {
+            t_s: s.t_s,
+            rev_start_s: rev_start[&s.rev],
+            angle_deg: f64::from(s.angle_deg),
+        })
+        .collect();
+    let nominal = ctx
+        .physics
+        .lidar(ctx.trajectory, &queries, &Hypothesis::nominal());
+    let mut cov: Vec<(Covariate, Vec<f64>)> = [
+        Covariate::Range,
+        Covariate::Bearing,
+        Covariate::Incidence,
+        Covariate::Object,
+        Covariate::Edge,
+        Covariate::Time,
+        Covariate::Speed,
+        Covariate::Accel,
+        Covariate::TurnRate,
+    ]
+    .into_iter()
+    .map(|c| (c, Vec::with_capacity(valid.len())))
+    .collect();
+    for (q, p) in queries.iter().zip(&nominal) {
+        let m = motion(ctx.trajectory, q.t_s);
+        let values = [
+            p.true_range_m.unwrap_or(f64::NAN),
+            q.angle_deg,
+            if p.true_range_m.is_some() {
+                p.incidence_deg
+            } else {
+                f64::NAN
+            },
+            p.object.map_or(f64::NAN, f64::from),
+            f64::from(u8::from(p.near_edge)),
+            q.t_s,
+            m[0],
+            m[1],
+            m[2],
+        ];
+        for ((_, col), v) in cov.iter_mut().zip(values) {
+            col.push(v);
+        }
+    }
+    Ok(Some(SensorData {
+        sensor: Sensor::Lidar,
+        t: valid.iter().map(|s| s.t_s).collect(),
+        y: valid.iter().map(|s| s.range_m).collect(),
+        heldout: queries.iter().map(|q| split(q.rev_start_s)).collect(),
+        covariates: cov,
+        queries: Queries::Lidar(queries),
+        epsilon: 0.002,
+        outlier_density: 0.002 / declared.max_range_m,
+        clusters: None,
+    }))
+}
+
+/// The sonar's pings.
+pub(crate) fn sonar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let (Some(samples), Some(_)) = (
+        &ctx.recording.sonar,
+        ctx.physics.declared().sonar_half_angle_deg,
+    ) else {
+        return Ok(None);
+    };
+    let rows: Vec<_> = samples
+        .iter()
+        .filter(|s| s.range_m.is_finite() && s.t_s <= ctx.end_s)
+        .collect();
+    let times: Vec<f64> = rows.iter().map(|s| s.t_s).collect();
+    let nominal = ctx
+        .physics
+        .sonar(ctx.trajectory, &times, &Hypothesis::nominal());
+    let mut cov: Vec<(Covariate, Vec<f64>)> = [
+        Covariate::Range,
+        Covariate::OffAxisNearer,
+        Covariate::Time,
+        Covariate::Speed,
+        Covariate::TurnRate,
+    ]
+    .into_iter()
+    .map(|c| (c, Vec::new()))
+    .collect();
+    for (s, p) in rows.iter().zip(&nominal) {
+        let m = motion(ctx.trajectory, s.t_s);
+        let axis = p.true_range_m.unwrap_or(f64::INFINITY);
+        let nearer = p.wide_cone_m.map_or(0.0, |w| (axis - w).clamp(0.0, 5.0));
+        let values = [
+            p.true_range_m.unwrap_or(s.range_m),
+            nearer,
+            s.t_s,
+            m[0],
+            m[2],
+        ];
+        for ((_, col), v) in cov.iter_mut().zip(values) {
+            col.push(v);
+        }
+    }
+    Ok(Some(SensorData {
+        sensor: Sensor::Sonar,
+        t: times.clone(),
+        y: rows.iter().map(|s| s.range_m).collect(),
+        heldout: times.iter().map(|&t| split(t)).collect(),
+        covariates: cov,
+        queries: Queries::Sonar(times),
+        epsilon: 0.002,
+        outlier_density: 0.002 / 5.0,
+        clusters: None,
+    }))
+}
+
+/// The encoders' readings: two rows (left, right) per reading.
+pub(crate) fn odometer(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let (Some(samples), true) = (&ctx.recording.odometry, ctx.physics.declared().odometer) else {
+        return Ok(None);
+    };
+    let rows: Vec<_> = samples.iter().filter(|s| s.t_s <= ctx.end_s).collect();
+    let times: Vec<f64> = rows.iter().map(|s| s.t_s).collect();
+    let tr = ctx.trajectory;
+    let travel = tr.wheel_travel(ctx.physics.declared().wheel_base_m);
+    let speed = |t: f64, wheel: usize| {
+        let k = tr.interval(t);
+        let dt = tr.times().get(k + 1).map_or(1.0, |t1| t1 - tr.times()[k]);
+        travel
+            .get(k + 1)
+            .map_or(0.0, |next| (next[wheel] - travel[k][wheel]) / dt)
+    };
+    let mut t = Vec::new();
+    let mut y = Vec::new();
+    let mut cov: Vec<(Covariate, Vec<f64>)> = [
+        Covariate::WheelSpeed,
+        Covariate::Accel,
+        Covariate::Time,
+        Covariate::TurnRate,
+    ]
+    .into_iter()
+    .map(|c| (c, Vec::new()))
+    .collect();
+    for s in &rows {
+        for wheel in 0..2 {
+            t.push(s.t_s);
+            y.push(if wheel == 0 { s.left_m } else { s.right_m });
+            let v = speed(s.t_s, wheel);
+            let a = (speed(s.t_s + 0.05, wheel) - speed(s.t_s - 0.05, wheel)) / 0.1;
+            let values = [v, a.abs(), s.t_s, motion(tr, s.t_s)[2]];
+            for ((_, col), v) in cov.iter_mut().zip(values) {
+                col.push(v);
+            }
+        }
+    }
+    Ok(Some(SensorData {
+        sensor: Sensor::Odometer,
+        heldout: t.iter().map(|&t| split(t)).collect(),
+        t,
+        y,
+        covariates: cov,
+        queries: Queries::Odometer(times),
+        epsilon: 1e-4,
+        outlier_density: 1e-4 / 1.0,
+        clusters: None,
+    }))
+}
+
+/// The drive: the wheels' travel over 0.1 s windows along the aligned trajectory, against the
+/// travel the commands give.
+pub(crate) fn drive(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let commands = &ctx.recording.commands;
+    if commands.is_empty() {
+        return Ok(None);
+    }
+    let tr = ctx.trajectory;
+    let travel = tr.wheel_travel(ctx.physics.declared().wheel_base_m);
+    let n = (ctx.end_s / DRIVE_WINDOW_S).floor() as usize;
+    let mut windows = Vec::with_capacity(n);
+    let (mut t, mut y) = (Vec::new(), Vec::new());
+    let mut cov: Vec<(Covariate, Vec<f64>)> = [
+        Covariate::WheelSpeed,
+        Covariate::SinceCommand,
+        Covariate::Time,
+        Covariate::TurnRate,
+    ]
+    .into_iter()
+    .map(|c| (c, Vec::new()))
+    .collect();
+    let half_base = ctx.physics.declared().wheel_base_m / 2.0;
+    // Where the robot touches an obstacle its wheels' travel is the contact's doing (and the
+    // real run meets it a little earlier or later, or another simulator resolves it otherwise):
+    // those windows, with a margin, are not the drive's evidence.
+    let contacts = ctx.physics.drive_contacts(commands, ctx.end_s);
+    let touching = |a: f64, b: f64| {
+        contacts
+            .iter()
+            .any(|&(from, to)| a < to + CONTACT_MARGIN_S && b > from - CONTACT_MARGIN_S)
+    };
+    for k in 0..n {
+        let (a, b) = (k as f64 * DRIVE_WINDOW_S, (k + 1) as f64 * DRIVE_WINDOW_S);
+        if touching(a, b) {
+            continue;
+        }
+        windows.push((a, b));
+        let (wa, wb) = (tr.interpolate(&travel, a), tr.interpolate(&travel, b));
+        // The command in force at the window's start, and how long it has been.
+        let i = commands.partition_point(|c| c.t_s <= a + 1e-9);
+        let (cmd, since) = match i.checked_sub(1).map(|j| commands[j]) {
+            Some(c) => (c, a - c.t_s),
+            None => (
+                hilsim_recording::CommandSample {
+                    t_s: 0.0,
+                    left_mps: 0.0,
+                    right_mps: 0.0,
+                },
+                a,
+            ),
+        };
+        let turn = ((cmd.right_mps - cmd.left_mps) / (2.0 * half_base))
+            .abs()
+            .to_degrees();
+        for wheel in 0..2 {
+            t.push(a);
+            y.push(wb[wheel] - wa[wheel]);
+            let speed = if wheel == 0 {
+                cmd.left_mps
+            } else {
+                cmd.right_mps
+            };
+            let values = [speed, since, a, turn];
+            for ((_, col), v) in cov.iter_mut().zip(values) {
+                col.push(v);
+            }
+        }
+    }
+    if windows.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(SensorData {
+        sensor: Sensor::Drive,
+        heldout: t.iter().map(|&t| split(t)).collect(),
+        t,
+        y,
+        covariates: cov,
+        queries: Queries::Drive(windows),
+        epsilon: 1e-4,
+        outlier_density: 1e-4 / 0.5,
+        clusters: None,
+    }))
+}

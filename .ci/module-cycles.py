@@ -27,6 +27,8 @@ for c in sorted(crates):
     for m,text in mods.items():
         # strip test modules
         text=re.split(r'#\[cfg\(test\)\]\s*mod tests',text)[0]
+        # Comments (doc links included) are not dependencies.
+        text=re.sub(r'//[^\n]*','',text)
         for mt in re.finditer(r'\b(crate|super(?:::super)*)((?:::\w+)+)',text):
             head,rest=mt.group(1),mt.group(2).split('::')[1:]
             if head=='crate': base=[]

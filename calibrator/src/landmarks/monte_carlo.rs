@@ -7,6 +7,7 @@
 //! Each run draws its own landmarks and noise from its own seed, so a Monte Carlo is the same
 //! on one core or many.
 
+mod result;
 mod rng;
 mod run;
 mod setup;
@@ -14,7 +15,8 @@ mod simulate;
 mod summary;
 
 pub use rng::{run_seed, Xoshiro256pp};
-pub use run::{monte_carlo, run_one, MseRatios, RunResult};
+pub use result::{MseRatios, RunResult};
+pub use run::{monte_carlo, run_one};
 pub use setup::{paper_beta, Setup, PAPER_ALPHA};
 pub use simulate::{simulate, Trial};
 pub use summary::{summarise, PositionStats, Summary};

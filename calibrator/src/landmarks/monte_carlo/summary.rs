@@ -1,6 +1,6 @@
 //! Statistics over a Monte Carlo's runs.
 
-use super::run::{MseRatios, RunResult};
+use super::result::{MseRatios, RunResult};
 use super::setup::Setup;
 use crate::stats::median;
 

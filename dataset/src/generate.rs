@@ -55,6 +55,9 @@ impl Default for Options {
 /// its wall time.
 type Finished = (u64, Result<Result<RunContent, RunFailure>, Error>, Duration);
 
+/// Rewrites the manifest from the rows.
+type WriteManifest<'a> = dyn Fn(&BTreeMap<u64, Row>) -> Result<(), Error> + 'a;
+
 impl Dataset {
     /// Makes the dataset's runs in `dir`, or the share `options` selects, skipping those already
     /// made; see the crate docs for the layout.
@@ -79,19 +82,7 @@ impl Dataset {
         let start = Instant::now();
         let p = self.params();
         let shard = options.shard;
-        if let Some(r) = options.only {
-            if r >= p.runs {
-                return Err(Error::Parameter(format!(
-                    "--run {r}: the dataset's runs are 0 to {}",
-                    p.runs - 1
-                )));
-            }
-            if !shard.contains(r) {
-                return Err(Error::Parameter(format!(
-                    "--run {r} is not in shard {shard}"
-                )));
-            }
-        }
+        check_only(options, p)?;
         let pool = build_pool(options.jobs)?;
         let jobs = pool.current_num_threads();
         open_dir(dir, p)?;
@@ -102,20 +93,7 @@ impl Dataset {
             Leftover::File(name) => *name == manifest_file,
         })?;
 
-        // The runs made before, as their files say now.
-        let made: Vec<u64> = run_dirs(dir, p.runs)?
-            .into_iter()
-            .filter(|&r| shard.contains(r))
-            .collect();
-        let scanned: Vec<(u64, RunContent)> = pool.install(|| {
-            made.par_iter()
-                .map(|&r| scan_run(&dir.join(run_dir_name(r))).map(|c| (r, c)))
-                .collect::<Result<_, _>>()
-        })?;
-        let mut rows: BTreeMap<u64, Row> = scanned
-            .into_iter()
-            .map(|(r, c)| (r, self.row(r, Outcome::Made(c))))
-            .collect();
+        let mut rows = self.rows_made_before(dir, &pool, shard)?;
         let to_make: Vec<u64> = match options.only {
             Some(r) if rows.contains_key(&r) => Vec::new(),
             Some(r) => vec![r],
@@ -125,18 +103,7 @@ impl Dataset {
         };
         // Failures recorded before, of runs not tried again now (only with `only`).
         if let Some(only) = options.only {
-            if manifest_path.is_file() {
-                for e in manifest::read(&manifest_path)? {
-                    if e.sha256.is_none()
-                        && e.run != only
-                        && e.run < p.runs
-                        && shard.contains(e.run)
-                        && !rows.contains_key(&e.run)
-                    {
-                        rows.insert(e.run, self.row(e.run, Outcome::Failed(e.reason)));
-                    }
-                }
-            }
+            self.keep_failures_recorded(&manifest_path, shard, only, &mut rows)?;
         }
         let keys: Vec<&str> = p.varies.iter().map(|v| v.key()).collect();
         let write_manifest = |rows: &BTreeMap<u64, Row>| {
@@ -155,19 +122,88 @@ impl Dataset {
             to_make: to_make.len() as u64,
             jobs,
         });
+        let (made, failed) =
+            self.make_runs(dir, &pool, &to_make, &mut rows, &write_manifest, progress)?;
+        Ok(Summary {
+            share,
+            made,
+            skipped,
+            failed,
+            elapsed: start.elapsed(),
+            manifest: manifest_path,
+        })
+    }
 
+    /// The rows of the shard's runs made before, as their files say now (hashes recomputed).
+    fn rows_made_before(
+        &self,
+        dir: &Path,
+        pool: &rayon::ThreadPool,
+        shard: Shard,
+    ) -> Result<BTreeMap<u64, Row>, Error> {
+        let made: Vec<u64> = run_dirs(dir, self.params().runs)?
+            .into_iter()
+            .filter(|&r| shard.contains(r))
+            .collect();
+        let scanned: Vec<(u64, RunContent)> = pool.install(|| {
+            made.par_iter()
+                .map(|&r| scan_run(&dir.join(run_dir_name(r))).map(|c| (r, c)))
+                .collect::<Result<_, _>>()
+        })?;
+        Ok(scanned
+            .into_iter()
+            .map(|(r, c)| (r, self.row(r, Outcome::Made(c))))
+            .collect())
+    }
+
+    /// Adds to `rows` the failures the shard's manifest recorded, of runs other than `only` and
+    /// not made since.
+    fn keep_failures_recorded(
+        &self,
+        manifest_path: &Path,
+        shard: Shard,
+        only: u64,
+        rows: &mut BTreeMap<u64, Row>,
+    ) -> Result<(), Error> {
+        if !manifest_path.is_file() {
+            return Ok(());
+        }
+        for e in manifest::read(manifest_path)? {
+            if e.sha256.is_none()
+                && e.run != only
+                && e.run < self.params().runs
+                && shard.contains(e.run)
+                && !rows.contains_key(&e.run)
+            {
+                rows.insert(e.run, self.row(e.run, Outcome::Failed(e.reason)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Makes the runs `to_make` on the pool's threads in index order, adding their rows to
+    /// `rows` and rewriting the manifest as they complete and at the end. Returns the numbers of
+    /// runs made and failed; the first error stops the workers.
+    fn make_runs(
+        &self,
+        dir: &Path,
+        pool: &rayon::ThreadPool,
+        to_make: &[u64],
+        rows: &mut BTreeMap<u64, Row>,
+        write_manifest: &WriteManifest<'_>,
+        progress: &mut dyn Progress,
+    ) -> Result<(u64, u64), Error> {
+        let jobs = pool.current_num_threads();
         let next = AtomicUsize::new(0);
         let stop = AtomicBool::new(false);
         let (tx, rx) = mpsc::channel::<Finished>();
         let mut fatal: Option<Error> = None;
         let (mut made_now, mut failed_now) = (0, 0);
-        let mut last_write = Instant::now();
-        let mut write_cost = Duration::ZERO;
-        let mut dirty = false;
+        let mut pacer = ManifestPacer::new();
         pool.in_place_scope(|scope| {
             for _ in 0..jobs.min(to_make.len()) {
                 let tx = tx.clone();
-                let (next, stop, to_make) = (&next, &stop, &to_make);
+                let (next, stop) = (&next, &stop);
                 scope.spawn(move |_| {
                     while !stop.load(Ordering::Relaxed) {
                         let Some(&r) = to_make.get(next.fetch_add(1, Ordering::Relaxed)) else {
@@ -208,39 +244,23 @@ impl Dataset {
                     elapsed,
                 };
                 rows.insert(r, self.row(r, outcome));
-                dirty = true;
-                if last_write.elapsed() >= MANIFEST_INTERVAL.max(write_cost * 10) {
-                    let t = Instant::now();
-                    match write_manifest(&rows) {
-                        Ok(()) => dirty = false,
-                        Err(err) => {
-                            stop.store(true, Ordering::Relaxed);
-                            fatal.get_or_insert(err);
-                        }
-                    }
-                    write_cost = t.elapsed();
-                    last_write = Instant::now();
+                if let Err(err) = pacer.changed(rows, write_manifest) {
+                    stop.store(true, Ordering::Relaxed);
+                    fatal.get_or_insert(err);
                 }
                 progress.run_finished(&report);
             }
         });
-        if dirty {
-            let written = write_manifest(&rows);
+        if pacer.dirty {
+            let written = write_manifest(rows);
             if fatal.is_none() {
                 written?;
             }
         }
-        if let Some(err) = fatal {
-            return Err(err);
+        match fatal {
+            Some(err) => Err(err),
+            None => Ok((made_now, failed_now)),
         }
-        Ok(Summary {
-            share,
-            made: made_now,
-            skipped,
-            failed: failed_now,
-            elapsed: start.elapsed(),
-            manifest: manifest_path,
-        })
     }
 
     /// Run `run`'s recording and scenario file text, in memory (nothing is written).
@@ -295,6 +315,64 @@ impl Dataset {
             values: self.values(run),
             outcome,
         }
+    }
+}
+
+/// `options.only`, when given, must name a run of the dataset and of the shard.
+fn check_only(options: &Options, p: &Params) -> Result<(), Error> {
+    let shard = options.shard;
+    if let Some(r) = options.only {
+        if r >= p.runs {
+            return Err(Error::Parameter(format!(
+                "--run {r}: the dataset's runs are 0 to {}",
+                p.runs - 1
+            )));
+        }
+        if !shard.contains(r) {
+            return Err(Error::Parameter(format!(
+                "--run {r} is not in shard {shard}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// When to rewrite the manifest while runs complete: at most every [`MANIFEST_INTERVAL`], or
+/// ten times the last rewrite's cost when that is longer.
+struct ManifestPacer {
+    last_write: Instant,
+    write_cost: Duration,
+    /// Rows changed since the last rewrite.
+    dirty: bool,
+}
+
+impl ManifestPacer {
+    fn new() -> Self {
+        Self {
+            last_write: Instant::now(),
+            write_cost: Duration::ZERO,
+            dirty: false,
+        }
+    }
+
+    /// A row changed: rewrites the manifest if its time has come.
+    fn changed(
+        &mut self,
+        rows: &BTreeMap<u64, Row>,
+        write_manifest: &WriteManifest<'_>,
+    ) -> Result<(), Error> {
+        self.dirty = true;
+        if self.last_write.elapsed() < MANIFEST_INTERVAL.max(self.write_cost * 10) {
+            return Ok(());
+        }
+        let t = Instant::now();
+        let written = write_manifest(rows);
+        if written.is_ok() {
+            self.dirty = false;
+        }
+        self.write_cost = t.elapsed();
+        self.last_write = Instant::now();
+        written
     }
 }
 

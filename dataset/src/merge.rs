@@ -57,17 +57,7 @@ pub fn merge(
     jobs: Option<NonZeroUsize>,
 ) -> Result<MergeSummary, Error> {
     let out_is_dataset = out.join(DATASET_FILE).is_file();
-    let out_canon = fs::canonicalize(out).ok();
-    let mut others: Vec<PathBuf> = Vec::new();
-    let mut seen: Vec<PathBuf> = Vec::new();
-    for s in sources {
-        let canon = fs::canonicalize(s).map_err(|err| Error::io(s, err))?;
-        if Some(&canon) == out_canon.as_ref() || seen.contains(&canon) {
-            continue;
-        }
-        seen.push(canon);
-        others.push(s.clone());
-    }
+    let others = other_sources(out, sources)?;
     let mut all: Vec<PathBuf> = Vec::new();
     if out_is_dataset {
         all.push(out.to_path_buf());
@@ -81,25 +71,8 @@ pub fn merge(
         ));
     }
     let (reference_file, params) = same_dataset(&all)?;
-
     if !out_is_dataset {
-        if out.exists() {
-            let clutter = entries(out)?
-                .into_iter()
-                .filter(|(name, _)| leftover(name).is_none())
-                .count();
-            if clutter > 0 {
-                return Err(Error::mismatch(
-                    out,
-                    "exists and is not a dataset (no dataset.toml): choose a new or empty \
-                     directory",
-                ));
-            }
-        } else {
-            fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
-        }
-        let bytes = fs::read(&reference_file).map_err(|err| Error::io(&reference_file, err))?;
-        write_file_atomically(&out.join(DATASET_FILE), &bytes)?;
+        start_output(out, &reference_file)?;
     }
     remove_leftovers(out, |_| true)?;
 
@@ -132,7 +105,74 @@ pub fn merge(
             .collect::<Result<_, _>>()
     })?;
     let mut rows: BTreeMap<u64, Row> = BTreeMap::new();
-    let row = |r: u64, outcome: Outcome| Row {
+    for (r, c) in scanned {
+        rows.insert(r, row(&params, r, Outcome::Made(c)));
+    }
+    check_duplicates(out, &duplicates, &rows, &pool)?;
+    let failures = recorded_failures(out, &all, &params, &rows)?;
+    let failed = failures.len() as u64;
+    for (r, reason) in failures {
+        rows.insert(r, row(&params, r, Outcome::Failed(reason)));
+    }
+    let keys: Vec<&str> = params.varies.iter().map(|v| v.key()).collect();
+    let manifest_path = out.join(MANIFEST_FILE);
+    write_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
+    for (name, path) in entries(out)? {
+        if is_shard_manifest(&name) {
+            fs::remove_file(&path).map_err(|err| Error::io(&path, err))?;
+        }
+    }
+    Ok(MergeSummary {
+        runs: params.runs,
+        made: made.len() as u64,
+        failed,
+        missing: params.runs - rows.len() as u64,
+        copied: copies.len() as u64,
+        manifest: manifest_path,
+    })
+}
+
+/// The sources other than `out`, each once.
+fn other_sources(out: &Path, sources: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
+    let out_canon = fs::canonicalize(out).ok();
+    let mut others: Vec<PathBuf> = Vec::new();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for s in sources {
+        let canon = fs::canonicalize(s).map_err(|err| Error::io(s, err))?;
+        if Some(&canon) == out_canon.as_ref() || seen.contains(&canon) {
+            continue;
+        }
+        seen.push(canon);
+        others.push(s.clone());
+    }
+    Ok(others)
+}
+
+/// Makes `out`, new or empty, a dataset directory: a copy of `reference_file`.
+fn start_output(out: &Path, reference_file: &Path) -> Result<(), Error> {
+    if out.exists() {
+        let clutter = entries(out)?
+            .into_iter()
+            .filter(|(name, _)| leftover(name).is_none())
+            .count();
+        if clutter > 0 {
+            return Err(Error::mismatch(
+                out,
+                "exists and is not a dataset (no dataset.toml): choose a new or empty \
+                 directory",
+            ));
+        }
+    } else {
+        fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
+    }
+    let bytes = fs::read(reference_file).map_err(|err| Error::io(reference_file, err))?;
+    write_file_atomically(&out.join(DATASET_FILE), &bytes)?;
+    Ok(())
+}
+
+/// Run `r`'s manifest row in the dataset `params`.
+fn row(params: &Params, r: u64, outcome: Outcome) -> Row {
+    Row {
         run: r,
         seed: run_seed(params.seed, r),
         values: params
@@ -141,14 +181,24 @@ pub fn merge(
             .map(|v| draw(params.seed, r, v.key(), v.lo(), v.hi()))
             .collect(),
         outcome,
-    };
-    for (r, c) in scanned {
-        rows.insert(r, row(r, Outcome::Made(c)));
     }
-    let hash_of = |rows: &BTreeMap<u64, Row>, r: u64| match rows.get(&r).map(|row| &row.outcome) {
+}
+
+/// The content hash of run `r` when it was made.
+fn hash_of(rows: &BTreeMap<u64, Row>, r: u64) -> Option<String> {
+    match rows.get(&r).map(|row| &row.outcome) {
         Some(Outcome::Made(c)) => Some(c.sha256.clone()),
         _ => None,
-    };
+    }
+}
+
+/// Each run directory found in more than one place must hold what `out`'s does.
+fn check_duplicates(
+    out: &Path,
+    duplicates: &[(PathBuf, u64)],
+    rows: &BTreeMap<u64, Row>,
+    pool: &rayon::ThreadPool,
+) -> Result<(), Error> {
     let dup_hashes: Vec<(PathBuf, u64, RunContent)> = pool.install(|| {
         duplicates
             .par_iter()
@@ -156,20 +206,30 @@ pub fn merge(
             .collect::<Result<_, _>>()
     })?;
     for (src, r, c) in dup_hashes {
-        if hash_of(&rows, r).as_deref() != Some(c.sha256.as_str()) {
+        if hash_of(rows, r).as_deref() != Some(c.sha256.as_str()) {
             return Err(Error::mismatch(
                 &src,
                 format!(
                     "differs from {} (content hash {}): the same run made twice differently",
                     out.join(run_dir_name(r)).display(),
-                    hash_of(&rows, r).unwrap_or_default()
+                    hash_of(rows, r).unwrap_or_default()
                 ),
             ));
         }
     }
-    // The manifests: failures of runs made nowhere, and a check of every recorded hash.
+    Ok(())
+}
+
+/// The manifests of `dirs`: failures of runs made nowhere, and a check of every recorded hash
+/// against the run's directory in `out`.
+fn recorded_failures(
+    out: &Path,
+    dirs: &[PathBuf],
+    params: &Params,
+    rows: &BTreeMap<u64, Row>,
+) -> Result<BTreeMap<u64, String>, Error> {
     let mut failures: BTreeMap<u64, String> = BTreeMap::new();
-    for d in &all {
+    for d in dirs {
         for (name, path) in entries(d)? {
             if !is_manifest(&name) {
                 continue;
@@ -178,7 +238,7 @@ pub fn merge(
                 if e.run >= params.runs {
                     continue;
                 }
-                match (&e.sha256, hash_of(&rows, e.run)) {
+                match (&e.sha256, hash_of(rows, e.run)) {
                     (Some(recorded), Some(now)) if *recorded != now => {
                         return Err(Error::mismatch(
                             &path,
@@ -198,26 +258,7 @@ pub fn merge(
             }
         }
     }
-    let failed = failures.len() as u64;
-    for (r, reason) in failures {
-        rows.insert(r, row(r, Outcome::Failed(reason)));
-    }
-    let keys: Vec<&str> = params.varies.iter().map(|v| v.key()).collect();
-    let manifest_path = out.join(MANIFEST_FILE);
-    write_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
-    for (name, path) in entries(out)? {
-        if is_shard_manifest(&name) {
-            fs::remove_file(&path).map_err(|err| Error::io(&path, err))?;
-        }
-    }
-    Ok(MergeSummary {
-        runs: params.runs,
-        made: made.len() as u64,
-        failed,
-        missing: params.runs - rows.len() as u64,
-        copied: copies.len() as u64,
-        manifest: manifest_path,
-    })
+    Ok(failures)
 }
 
 /// Reads every directory's `dataset.toml`; all must define the same dataset. Returns the first

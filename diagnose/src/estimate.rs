@@ -17,6 +17,7 @@
 //! residuals are widened by it.
 
 use hilsim_recording::{LidarSample, Recording, TruthSample};
+use nalgebra::Matrix3;
 
 use crate::error::MismatchError;
 use crate::physics::{Hypothesis, LidarQuery, Physics};
@@ -158,12 +159,40 @@ pub(crate) fn estimate_trajectory(
         ));
     };
     let base = dead_reckoning(physics, recording, end_s)?;
-    let period = physics
-        .declared()
-        .lidar
-        .map_or(1.0 / 1800.0, |l| 60.0 / (l.rpm * 360.0));
-    let snapshot = physics.declared().lidar.is_some_and(|l| l.snapshot);
-    // The revolutions, in order.
+    let matcher = Matcher {
+        physics,
+        base: &base,
+        hypothesis,
+        period: physics
+            .declared()
+            .lidar
+            .map_or(1.0 / 1800.0, |l| 60.0 / (l.rpm * 360.0)),
+        snapshot: physics.declared().lidar.is_some_and(|l| l.snapshot),
+    };
+    let revs = revolutions(lidar);
+    let mut knots: Vec<Knot> = Vec::with_capacity(revs.len());
+    let mut variances = Vec::new();
+    let mut correction = [0.0; 3];
+    for rows in &revs {
+        if let Some((knot, variance)) = matcher.revolution(rows, &mut correction) {
+            knots.push(knot);
+            variances.push(variance);
+        }
+    }
+    let (knots, variances) = smooth_corrections(&base, &knots, &variances);
+    if knots.is_empty() {
+        return Err(MismatchError::Refused(
+            "the recording has no truth.csv and too few valid lidar readings to estimate its \
+             trajectory"
+                .into(),
+        ));
+    }
+    let samples = corrected(&base, &knots);
+    Ok((Trajectory::new(&samples)?, uncertainty(&variances)))
+}
+
+/// The lidar's readings grouped by revolution, in order.
+fn revolutions(lidar: &[LidarSample]) -> Vec<Vec<&LidarSample>> {
     let mut revs: Vec<(u64, Vec<&LidarSample>)> = Vec::new();
     for s in lidar {
         match revs.last_mut() {
@@ -171,17 +200,45 @@ pub(crate) fn estimate_trajectory(
             _ => revs.push((s.rev, vec![s])),
         }
     }
-    let mut knots: Vec<(f64, [f64; 3])> = Vec::with_capacity(revs.len());
-    let mut variances = Vec::new();
-    let mut correction = [0.0; 3];
-    for (_, rows) in &revs {
-        let start = rows[0].t_s - f64::from(rows[0].angle_deg) * period;
+    revs.into_iter().map(|(_, rows)| rows).collect()
+}
+
+/// Matches revolutions' readings to the world along the dead reckoning.
+struct Matcher<'a> {
+    physics: &'a dyn Physics,
+    base: &'a Trajectory,
+    hypothesis: &'a Hypothesis,
+    /// Seconds per degree of the lidar's rotation.
+    period: f64,
+    /// Whether the lidar takes a revolution's geometry at one instant.
+    snapshot: bool,
+}
+
+/// One revolution's readings to match: their queries, ranges and the piece of trajectory
+/// (`t0`, `t1`) they need.
+struct Scan {
+    queries: Vec<LidarQuery>,
+    y: Vec<f64>,
+    t0: f64,
+    t1: f64,
+}
+
+impl Matcher<'_> {
+    /// One revolution's correction, refined from `correction` (which it updates), as a knot with
+    /// the variances of its coordinates; `None` when it has too few valid readings or its
+    /// geometry pins no coordinate (a corridor's length: it is left to the others).
+    fn revolution(
+        &self,
+        rows: &[&LidarSample],
+        correction: &mut [f64; 3],
+    ) -> Option<(Knot, [f64; 3])> {
+        let start = rows[0].t_s - f64::from(rows[0].angle_deg) * self.period;
         let valid: Vec<&&LidarSample> = rows
             .iter()
             .filter(|s| !s.invalid && s.range_m > 0.0)
             .collect();
         if valid.len() < 12 {
-            continue;
+            return None;
         }
         let stride = valid.len().div_ceil(READINGS_PER_REV).max(1);
         let used: Vec<&&LidarSample> = valid.into_iter().step_by(stride).collect();
@@ -199,64 +256,10 @@ pub(crate) fn estimate_trajectory(
             start.min(used[0].t_s) - 0.01,
             used[used.len() - 1].t_s + 0.01,
         );
-        let steps = [0.001, 0.001, 0.001];
+        let scan = Scan { queries, y, t0, t1 };
         let mut info = [[0.0; 3]; 3];
         for _ in 0..ITERATIONS {
-            let r0 = residuals(
-                physics,
-                &shifted(&base, t0, t1, correction),
-                &queries,
-                &y,
-                hypothesis,
-            );
-            // Central differences of the residuals along each coordinate.
-            let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; y.len()];
-            let mut usable = vec![true; y.len()];
-            for k in 0..3 {
-                let mut up = correction;
-                let mut down = correction;
-                up[k] += steps[k];
-                down[k] -= steps[k];
-                let ru = residuals(
-                    physics,
-                    &shifted(&base, t0, t1, up),
-                    &queries,
-                    &y,
-                    hypothesis,
-                );
-                let rd = residuals(
-                    physics,
-                    &shifted(&base, t0, t1, down),
-                    &queries,
-                    &y,
-                    hypothesis,
-                );
-                for i in 0..y.len() {
-                    match (ru[i], rd[i]) {
-                        (Some(a), Some(b)) => jac[i][k] = (a - b) / (2.0 * steps[k]),
-                        _ => usable[i] = false,
-                    }
-                }
-            }
-            // Weighted normal equations J'WJ δ = −J'W r.
-            let mut a = [[0.0; 3]; 3];
-            let mut g = [0.0; 3];
-            for i in 0..y.len() {
-                let Some(r) = r0[i].filter(|_| usable[i]) else {
-                    continue;
-                };
-                let w = if r.abs() <= HUBER_K {
-                    1.0
-                } else {
-                    HUBER_K / r.abs()
-                };
-                for p in 0..3 {
-                    g[p] -= w * jac[i][p] * r;
-                    for q in 0..3 {
-                        a[p][q] += w * jac[i][p] * jac[i][q];
-                    }
-                }
-            }
+            let (a, g) = self.normal_equations(&scan, *correction);
             info = a;
             let Some(delta) = solve3(a, g) else {
                 break;
@@ -274,28 +277,73 @@ pub(crate) fn estimate_trajectory(
         }
         // The correction holds where the readings' geometry was taken: at the revolution's
         // start for a lidar that takes it at one instant, else around its middle.
-        let knot = if snapshot {
+        let knot = if self.snapshot {
             start
         } else {
-            start + 0.5 * 360.0 * period
+            start + 0.5 * 360.0 * self.period
         };
-        // A revolution whose geometry pins no coordinate (a corridor's length) is left to the
-        // others.
-        let Some(inv) = invert3(info) else {
-            continue;
+        let inv = invert3(info)?;
+        Some(((knot, *correction), [inv[(0, 0)], inv[(1, 1)], inv[(2, 2)]]))
+    }
+
+    /// The Huber-weighted normal equations `J'WJ δ = −J'W r` of `scan` at `correction`: the
+    /// matrix `J'WJ` and the right-hand side, the Jacobian by central differences.
+    fn normal_equations(&self, scan: &Scan, correction: [f64; 3]) -> ([[f64; 3]; 3], [f64; 3]) {
+        let residuals_at = |c: [f64; 3]| {
+            residuals(
+                self.physics,
+                &shifted(self.base, scan.t0, scan.t1, c),
+                &scan.queries,
+                &scan.y,
+                self.hypothesis,
+            )
         };
-        knots.push((knot, correction));
-        variances.push([inv[0][0], inv[1][1], inv[2][2]]);
+        let n = scan.y.len();
+        let steps = [0.001, 0.001, 0.001];
+        let r0 = residuals_at(correction);
+        // Central differences of the residuals along each coordinate.
+        let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; n];
+        let mut usable = vec![true; n];
+        for k in 0..3 {
+            let mut up = correction;
+            let mut down = correction;
+            up[k] += steps[k];
+            down[k] -= steps[k];
+            let ru = residuals_at(up);
+            let rd = residuals_at(down);
+            for i in 0..n {
+                match (ru[i], rd[i]) {
+                    (Some(a), Some(b)) => jac[i][k] = (a - b) / (2.0 * steps[k]),
+                    _ => usable[i] = false,
+                }
+            }
+        }
+        // Weighted normal equations J'WJ δ = −J'W r.
+        let mut a = [[0.0; 3]; 3];
+        let mut g = [0.0; 3];
+        for i in 0..n {
+            let Some(r) = r0[i].filter(|_| usable[i]) else {
+                continue;
+            };
+            let w = if r.abs() <= HUBER_K {
+                1.0
+            } else {
+                HUBER_K / r.abs()
+            };
+            for p in 0..3 {
+                g[p] -= w * jac[i][p] * r;
+                for q in 0..3 {
+                    a[p][q] += w * jac[i][p] * jac[i][q];
+                }
+            }
+        }
+        (a, g)
     }
-    let (knots, variances) = smooth_corrections(&base, &knots, &variances);
-    if knots.is_empty() {
-        return Err(MismatchError::Refused(
-            "the recording has no truth.csv and too few valid lidar readings to estimate its \
-             trajectory"
-                .into(),
-        ));
-    }
-    // Dead reckoning plus the correction, interpolated between revolutions.
+}
+
+/// Dead reckoning plus the smoothed corrections `knots`, interpolated linearly between
+/// revolutions.
+fn corrected(base: &Trajectory, knots: &[Knot]) -> Vec<TruthSample> {
     let at = |t: f64| -> [f64; 3] {
         let i = knots.partition_point(|k| k.0 <= t);
         match (i.checked_sub(1).map(|j| knots[j]), knots.get(i)) {
@@ -308,8 +356,7 @@ pub(crate) fn estimate_trajectory(
             (None, None) => [0.0; 3],
         }
     };
-    let samples: Vec<TruthSample> = base
-        .times()
+    base.times()
         .iter()
         .zip(base.poses())
         .map(|(&t, p)| {
@@ -321,20 +368,23 @@ pub(crate) fn estimate_trajectory(
                 yaw_rad: wrap(p.yaw + c[2]),
             }
         })
-        .collect();
-    // The median revolution's smoothed standard errors, doubled (and floored at 3 mm and
-    // 1 mrad): the curvature of the fits leaves out the interpolation between revolutions.
+        .collect()
+}
+
+/// The estimate's uncertainty from the revolutions' smoothed variances: the median
+/// revolution's standard errors, doubled (and floored at 3 mm and 1 mrad): the curvature of
+/// the fits leaves out the interpolation between revolutions.
+fn uncertainty(variances: &[[f64; 3]]) -> Uncertainty {
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
     let pos = median(variances.iter().map(|v| (v[0] + v[1]) / 2.0).collect());
     let yaw = median(variances.iter().map(|v| v[2]).collect());
-    let sd = Uncertainty {
+    Uncertainty {
         position_m: (2.0 * pos.max(0.0).sqrt()).max(0.003),
         yaw_rad: (2.0 * yaw.max(0.0).sqrt()).max(0.001),
-    };
-    Ok((Trajectory::new(&samples)?, sd))
+    }
 }
 
 /// A revolution's time and its correction `(dx, dy, dθ)`.
@@ -414,38 +464,20 @@ fn smooth_corrections(
     (out, out_var)
 }
 
-/// Solves the 3×3 system `a x = b` (Cramer's rule); `None` when singular.
+/// Solves the 3×3 system `a x = b` by its inverse; `None` when singular.
 fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     let inv = invert3(a)?;
-    Some([0, 1, 2].map(|i| (0..3).map(|j| inv[i][j] * b[j]).sum()))
+    Some([0, 1, 2].map(|i| (0..3).map(|j| inv[(i, j)] * b[j]).sum()))
 }
 
-/// The inverse of a 3×3 matrix; `None` when singular.
-fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    let scale = m.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+/// The inverse of a 3×3 matrix; `None` when singular: its determinant not finite or at most
+/// 1e-12 of its largest element cubed.
+fn invert3(m: [[f64; 3]; 3]) -> Option<Matrix3<f64>> {
+    let m = Matrix3::from_fn(|r, c| m[r][c]);
+    let det = m.determinant();
+    let scale = m.iter().fold(0.0f64, |s, v| s.max(v.abs()));
     if !det.is_finite() || det.abs() <= 1e-12 * scale.powi(3) {
         return None;
     }
-    let c =
-        |r0: usize, r1: usize, c0: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
-    Some([
-        [
-            c(1, 2, 1, 2) / det,
-            -c(0, 2, 1, 2) / det,
-            c(0, 1, 1, 2) / det,
-        ],
-        [
-            -c(1, 2, 0, 2) / det,
-            c(0, 2, 0, 2) / det,
-            -c(0, 1, 0, 2) / det,
-        ],
-        [
-            c(1, 2, 0, 1) / det,
-            -c(0, 2, 0, 1) / det,
-            c(0, 1, 0, 1) / det,
-        ],
-    ])
+    m.try_inverse()
 }

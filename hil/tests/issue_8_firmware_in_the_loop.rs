@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use hilsim_hil::hil_run::{run, Ending, HilConfig, HilPorts, HilWorld};
+use hilsim_hil::hil_run::{run, Ending, HilConfig, HilPorts, HilReport, HilWorld};
 use hilsim_lidar_emulator::neato_packet::{Decoder, DecoderStats};
 use hilsim_sim::Scenario;
 
@@ -74,28 +74,40 @@ fn a_client_on_the_ports_drives_the_robot_and_reads_its_sensors_in_real_time() {
             )
         })
     };
-    // The lidar port, read as a driver would, until the harness closes it.
-    let lidar = thread::spawn(move || -> DecoderStats {
-        let mut port = serialport::new(&lidar_path, 115_200)
-            .timeout(Duration::from_millis(200))
-            .open()
-            .unwrap();
-        let mut decoder = Decoder::new();
-        let mut buf = [0u8; 4096];
-        loop {
-            match port.read(&mut buf) {
-                Ok(n) => decoder.feed(&buf[..n]).for_each(drop),
-                Err(e) if e.kind() == ErrorKind::TimedOut => {}
-                Err(_) => return decoder.finish(),
-            }
-        }
-    });
+    let lidar = thread::spawn(move || read_lidar_port(&lidar_path));
     let mut robot = serialport::new(&robot_path, 115_200)
         .timeout(Duration::from_millis(100))
         .open()
         .unwrap();
     let robot = robot.as_mut();
 
+    converse(robot);
+
+    let report = harness.join().unwrap().unwrap();
+    let decoded = lidar.join().unwrap();
+    check_report(&report, &decoded);
+}
+
+/// The lidar port, read as a driver would, until the harness closes it.
+fn read_lidar_port(path: &str) -> DecoderStats {
+    let mut port = serialport::new(path, 115_200)
+        .timeout(Duration::from_millis(200))
+        .open()
+        .unwrap();
+    let mut decoder = Decoder::new();
+    let mut buf = [0u8; 4096];
+    loop {
+        match port.read(&mut buf) {
+            Ok(n) => decoder.feed(&buf[..n]).for_each(drop),
+            Err(e) if e.kind() == ErrorKind::TimedOut => {}
+            Err(_) => return decoder.finish(),
+        }
+    }
+}
+
+/// The client's conversation on the robot port: it drives 300 mm with `SetMotor` and reads
+/// the encoders, the sonar and the lidar.
+fn converse(robot: &mut dyn serialport::SerialPort) {
     // 2.5 m from the board: the sonar reads 0.021 + 1.028 d (± 8 mm noise, 15° cone).
     let sonar_before = value(&request(robot, "GetSonar"), "Sonar_DistInMM");
     assert!((2540..2640).contains(&sonar_before), "{sonar_before}");
@@ -139,9 +151,11 @@ fn a_client_on_the_ports_drives_the_robot_and_reads_its_sensors_in_real_time() {
     let ahead: i64 = lines[1].split(',').nth(1).unwrap().parse().unwrap();
     assert!((2180..=2380).contains(&ahead), "{}", lines[1]);
     assert!(request(robot, "Dance").starts_with("Unknown Cmd: Dance"));
+}
 
-    let report = harness.join().unwrap().unwrap();
-    let decoded = lidar.join().unwrap();
+/// What the run did: the robot moved as commanded, every request was counted, and the lidar
+/// client got the whole stream.
+fn check_report(report: &HilReport, decoded: &DecoderStats) {
     assert_eq!(report.ending, Ending::TimeUp);
     assert!(report.firmware.is_none());
     let truth = report.run.recording.truth.as_ref().unwrap();

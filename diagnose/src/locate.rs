@@ -175,39 +175,89 @@ pub(crate) fn locate(
     names: &dyn Fn(u32) -> String,
     whiteness: bool,
 ) -> Vec<Evidence> {
-    let sensor = data.sensor;
-    let mut out = Vec::new();
     let n = rows.len();
     if n < 2 * MIN_BIN {
-        return out;
+        return Vec::new();
     }
-    // Position of each data row in `rows`.
-    let mut pos = vec![usize::MAX; data.len()];
-    for (k, &i) in rows.iter().enumerate() {
-        pos[i] = k;
+    let scores = Scores::new(data, rows, fits);
+    let mut out = scores.overall().to_vec();
+    for (c, values) in &data.covariates {
+        if let Some(against) = scores.against(*c, values, names) {
+            out.extend(against);
+        }
     }
-    let z: Vec<f64> = fits.iter().map(|f| f.z).collect();
-    // Readings that share an error (of an estimated trajectory) are not independent: the tests'
-    // variances are then the larger of the independent and the cluster-robust one.
-    let cluster: Option<Vec<u32>> = data
-        .clusters
-        .as_ref()
-        .map(|c| rows.iter().map(|&i| c[i]).collect());
-    let robust = |ks: &[usize], dev: &dyn Fn(usize) -> f64, independent: f64| match &cluster {
-        Some(c) => independent.max(clustered_sum_var(ks, dev, c)),
-        None => independent,
-    };
-    let (mean, sample_var) = moments(&z);
-    // Normal scores have variance 1 when the prediction is right. Every test below measures
-    // departures on that scale, or on the sample's when it is wider: residuals far smaller than
-    // the declared noise (a simulation that reproduces the data better than its noise model
-    // says) are no mismatch, however their tiny values are patterned.
-    let var = sample_var.max(1.0);
-    let residual_of = |k: usize| fits[k].residual;
-    let mean_residual = |ks: &[usize]| {
+    if whiteness {
+        out.extend(scores.whiteness());
+    }
+    out
+}
+
+/// One sensor's normal scores and what every test needs of them.
+struct Scores<'a> {
+    data: &'a SensorData,
+    rows: &'a [usize],
+    fits: &'a [Fit],
+    /// Position of each data row in `rows`.
+    pos: Vec<usize>,
+    /// The normal scores, by position in `rows`.
+    z: Vec<f64>,
+    /// The cluster of each position, when readings share errors.
+    cluster: Option<Vec<u32>>,
+    /// Their mean.
+    mean: f64,
+    /// Their variance, at least 1.
+    var: f64,
+    /// Their sum of squares.
+    ss: f64,
+}
+
+impl<'a> Scores<'a> {
+    fn new(data: &'a SensorData, rows: &'a [usize], fits: &'a [Fit]) -> Self {
+        let mut pos = vec![usize::MAX; data.len()];
+        for (k, &i) in rows.iter().enumerate() {
+            pos[i] = k;
+        }
+        let z: Vec<f64> = fits.iter().map(|f| f.z).collect();
+        // Readings that share an error (of an estimated trajectory) are not independent: the
+        // tests' variances are then the larger of the independent and the cluster-robust one.
+        let cluster: Option<Vec<u32>> = data
+            .clusters
+            .as_ref()
+            .map(|c| rows.iter().map(|&i| c[i]).collect());
+        let (mean, sample_var) = moments(&z);
+        // Normal scores have variance 1 when the prediction is right. Every test below measures
+        // departures on that scale, or on the sample's when it is wider: residuals far smaller
+        // than the declared noise (a simulation that reproduces the data better than its noise
+        // model says) are no mismatch, however their tiny values are patterned.
+        let var = sample_var.max(1.0);
+        let ss: f64 = z.iter().map(|v| v * v).sum();
+        Self {
+            data,
+            rows,
+            fits,
+            pos,
+            z,
+            cluster,
+            mean,
+            var,
+            ss,
+        }
+    }
+
+    /// The variance of a sum of deviations `dev` over `ks`: `independent`, or the
+    /// cluster-robust one when larger.
+    fn robust(&self, ks: &[usize], dev: &dyn Fn(usize) -> f64, independent: f64) -> f64 {
+        match &self.cluster {
+            Some(c) => independent.max(clustered_sum_var(ks, dev, c)),
+            None => independent,
+        }
+    }
+
+    /// The mean residual (metres) of the positions `ks` that have one.
+    fn mean_residual(&self, ks: &[usize]) -> f64 {
         let r: Vec<f64> = ks
             .iter()
-            .map(|&k| residual_of(k))
+            .map(|&k| self.fits[k].residual)
             .filter(|r| r.is_finite())
             .collect();
         if r.is_empty() {
@@ -215,41 +265,61 @@ pub(crate) fn locate(
         } else {
             r.iter().sum::<f64>() / r.len() as f64
         }
-    };
-    let all: Vec<usize> = (0..n).collect();
-    // Overall bias: a t statistic of the scores.
-    let t = mean * n as f64 / robust(&all, &|k| z[k], var * n as f64).sqrt();
-    out.push(Evidence {
-        sensor,
-        test: TestKind::Bias,
-        covariate: None,
-        score: two_sided(t),
-        place: format!("all {sensor} readings"),
-        detail: format!(
-            "mean normal score {mean:+.2} (mean residual {:+.1} mm) over {n} readings",
-            mean_residual(&all) * 1000.0
-        ),
-        range: None,
-    });
-    // Overall spread: Σ z² against its χ²_n null, as a normal score.
-    let ss: f64 = z.iter().map(|v| v * v).sum();
-    out.push(Evidence {
-        sensor,
-        test: TestKind::Spread,
-        covariate: None,
-        score: (ss - n as f64) / robust(&all, &|k| z[k] * z[k] - 1.0, 2.0 * n as f64).sqrt(),
-        // (the mean square is tested against the declared 1, upwards only)
-        place: format!("all {sensor} readings"),
-        detail: format!(
-            "mean squared normal score {:.2} (1 for noise) over {n} readings",
-            ss / n as f64
-        ),
-        range: None,
-    });
-    for (c, values) in &data.covariates {
-        let groups = bins(values, rows, c.categorical());
+    }
+
+    /// The overall bias (a t statistic of the scores) and spread (Σ z² against its χ²_n null,
+    /// as a normal score).
+    fn overall(&self) -> [Evidence; 2] {
+        let (sensor, z, mean, ss) = (self.data.sensor, &self.z, self.mean, self.ss);
+        let n = self.rows.len();
+        let all: Vec<usize> = (0..n).collect();
+        let t = mean * n as f64 / self.robust(&all, &|k| z[k], self.var * n as f64).sqrt();
+        let spread = (ss - n as f64)
+            / self
+                .robust(&all, &|k| z[k] * z[k] - 1.0, 2.0 * n as f64)
+                .sqrt();
+        [
+            Evidence {
+                sensor,
+                test: TestKind::Bias,
+                covariate: None,
+                score: two_sided(t),
+                place: format!("all {sensor} readings"),
+                detail: format!(
+                    "mean normal score {mean:+.2} (mean residual {:+.1} mm) over {n} readings",
+                    self.mean_residual(&all) * 1000.0
+                ),
+                range: None,
+            },
+            Evidence {
+                sensor,
+                test: TestKind::Spread,
+                covariate: None,
+                score: spread,
+                // (the mean square is tested against the declared 1, upwards only)
+                place: format!("all {sensor} readings"),
+                detail: format!(
+                    "mean squared normal score {:.2} (1 for noise) over {n} readings",
+                    ss / n as f64
+                ),
+                range: None,
+            },
+        ]
+    }
+
+    /// Bias and spread against covariate `c` (its `values` by data row): the bins' means about
+    /// the overall mean and their mean squares about the overall one, each a χ²_{B−1};
+    /// `None` with fewer than two bins.
+    fn against(
+        &self,
+        c: Covariate,
+        values: &[f64],
+        names: &dyn Fn(u32) -> String,
+    ) -> Option<[Evidence; 2]> {
+        let (sensor, z, mean, var) = (self.data.sensor, &self.z, self.mean, self.var);
+        let groups = bins(values, self.rows, c.categorical());
         if groups.len() < 2 {
-            continue;
+            return None;
         }
         let b = groups.len();
         // Bias against the variable: the bins' means about the overall mean, χ²_{B−1}.
@@ -258,21 +328,22 @@ pub(crate) fn locate(
         let mut best_bias = (0.0f64, 0usize);
         let mut best_spread = (0.0f64, 0usize);
         let mut stats = Vec::with_capacity(b);
-        let msq_all = (ss / n as f64).max(1.0);
+        let msq_all = (self.ss / self.rows.len() as f64).max(1.0);
         for (g, (_, group)) in groups.iter().enumerate() {
-            let ks: Vec<usize> = group.iter().map(|&i| pos[i]).collect();
+            let ks: Vec<usize> = group.iter().map(|&i| self.pos[i]).collect();
             let nb = ks.len() as f64;
             let mb = ks.iter().map(|&k| z[k]).sum::<f64>() / nb;
             let vb = ks.iter().map(|&k| z[k] * z[k]).sum::<f64>() / nb;
-            let zb = (mb - mean) * nb / robust(&ks, &|k| z[k] - mean, var * nb).sqrt();
+            let zb = (mb - mean) * nb / self.robust(&ks, &|k| z[k] - mean, var * nb).sqrt();
             // The mean square of a bin of normal scores has variance 2 msq² / n_b.
             let sb = (vb - msq_all) * nb
-                / robust(
-                    &ks,
-                    &|k| z[k] * z[k] - msq_all,
-                    2.0 * msq_all * msq_all * nb,
-                )
-                .sqrt();
+                / self
+                    .robust(
+                        &ks,
+                        &|k| z[k] * z[k] - msq_all,
+                        2.0 * msq_all * msq_all * nb,
+                    )
+                    .sqrt();
             chi_bias += zb * zb;
             // Only an excess counts (a mismatch adds spread), so the sum is stochastically
             // below its χ²_{B−1} reference: conservative.
@@ -288,48 +359,51 @@ pub(crate) fn locate(
         let (zb, g) = best_bias;
         let (lim, _) = &groups[g];
         let (mb, _, ks) = &stats[g];
-        out.push(Evidence {
+        let bias = Evidence {
             sensor,
             test: TestKind::BiasAgainst,
-            covariate: Some(*c),
+            covariate: Some(c),
             score: chi2_score(chi_bias, b - 1),
-            place: place(*c, *lim, names),
+            place: place(c, *lim, names),
             detail: format!(
                 "mean normal score {mb:+.2} (mean residual {:+.1} mm, {zb:+.1}σ) over {} readings at {}, against {mean:+.2} overall; χ² {chi_bias:.0} on {} dof across {b} bins of {}",
-                mean_residual(ks) * 1000.0,
+                self.mean_residual(ks) * 1000.0,
                 ks.len(),
-                place(*c, *lim, names),
+                place(c, *lim, names),
                 b - 1,
                 c.name()
             ),
             range: (!c.categorical()).then_some(*lim),
-        });
+        };
         let (sb, g) = best_spread;
         let (lim, _) = &groups[g];
         let (_, vb, ks) = &stats[g];
-        out.push(Evidence {
+        let spread = Evidence {
             sensor,
             test: TestKind::SpreadAgainst,
-            covariate: Some(*c),
+            covariate: Some(c),
             score: chi2_score(chi_spread, b - 1),
-            place: place(*c, *lim, names),
+            place: place(c, *lim, names),
             detail: format!(
                 "mean squared normal score {vb:.2} ({sb:+.1}σ) over {} readings at {}, against {msq_all:.2} overall; χ² {chi_spread:.0} on {} dof across {b} bins of {}",
                 ks.len(),
-                place(*c, *lim, names),
+                place(c, *lim, names),
                 b - 1,
                 c.name()
             ),
             range: (!c.categorical()).then_some(*lim),
-        });
+        };
+        Some([bias, spread])
     }
-    // Whiteness: the scores in time order.
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| data.t[rows[a]].total_cmp(&data.t[rows[b]]));
-    let series: Vec<f64> = order.iter().map(|&k| z[k]).collect();
-    let (q, k) = ljung_box(&series, LAGS, 1.0);
-    if k > 0 && whiteness {
-        out.push(Evidence {
+
+    /// Whiteness: the scores in time order (Ljung–Box), when there are lags to test.
+    fn whiteness(&self) -> Option<Evidence> {
+        let (data, rows, sensor) = (self.data, self.rows, self.data.sensor);
+        let mut order: Vec<usize> = (0..rows.len()).collect();
+        order.sort_by(|&a, &b| data.t[rows[a]].total_cmp(&data.t[rows[b]]));
+        let series: Vec<f64> = order.iter().map(|&k| self.z[k]).collect();
+        let (q, k) = ljung_box(&series, LAGS, 1.0);
+        (k > 0).then(|| Evidence {
             sensor,
             test: TestKind::Whiteness,
             covariate: Some(Covariate::Time),
@@ -337,9 +411,8 @@ pub(crate) fn locate(
             place: format!("{sensor} readings in time order"),
             detail: format!("Ljung–Box Q {q:.0} on {k} lags (white noise: {k})"),
             range: None,
-        });
+        })
     }
-    out
 }
 
 /// The score a test must reach to count, for `tests` tests at family-wise level `alpha`

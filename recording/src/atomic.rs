@@ -1,4 +1,8 @@
 //! Writes that never leave a half-written file where a good one stood.
+//!
+//! Not `tempfile`: its files are created `0600` with random names, while these keep the
+//! umask's permissions and the `.NAME.tmp.PID` / `.NAME.old.PID` names that `hilsim-dataset`
+//! recognises as leftovers of an interrupted write and removes.
 
 use std::fs;
 use std::io::Write;

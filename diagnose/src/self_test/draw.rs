@@ -58,8 +58,31 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
     // 0: none; 1..=9: the catalogue in order.
     let k = only.unwrap_or(drawn_class);
     let mut effects = nominal.effects.clone();
-    let s = strength;
-    let (effect, truth, params): (Option<Effect>, Option<f64>, Vec<(String, f64)>) = match k {
+    let (effect, truth, params) = if (1..=5).contains(&k) {
+        draw_lidar(k, d, strength, nominal, &mut effects)
+    } else {
+        draw_other(k, d, strength, &mut effects)
+    };
+    Drawn {
+        effect,
+        effects,
+        truth,
+        params,
+    }
+}
+
+/// The concealed effect, its scored parameter's true value and every parameter drawn.
+type Concealed = (Option<Effect>, Option<f64>, Vec<(String, f64)>);
+
+/// Draws lidar effect `k` (1..=5, the catalogue's order) into `effects`.
+fn draw_lidar(
+    k: usize,
+    d: &mut Draws,
+    s: f64,
+    nominal: &Scenario,
+    effects: &mut Effects,
+) -> Concealed {
+    match k {
         1 => {
             let v = d.sign() * d.between(0.01, 0.03) * s;
             effects.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: v });
@@ -116,6 +139,13 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
                 ],
             )
         }
+        _ => (None, None, Vec::new()),
+    }
+}
+
+/// Draws effect `k` (6..=9, the catalogue's order; anything else: none) into `effects`.
+fn draw_other(k: usize, d: &mut Draws, s: f64, effects: &mut Effects) -> Concealed {
+    match k {
         6 => {
             let v = (d.between(8.0, 20.0) * s).min(60.0);
             effects.sonar_beam_width = Some(scenario::SonarBeamWidth { half_angle_deg: v });
@@ -158,12 +188,6 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
             )
         }
         _ => (None, None, Vec::new()),
-    };
-    Drawn {
-        effect,
-        effects,
-        truth,
-        params,
     }
 }
 

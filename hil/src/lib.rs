@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod command_port;
+pub mod decode;
 mod device;
 pub mod firmware;
 pub mod hil_run;

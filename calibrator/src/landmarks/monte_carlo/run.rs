@@ -3,10 +3,10 @@
 use rand::RngCore;
 use rayon::prelude::*;
 
+use super::result::{MseRatios, RunResult};
 use super::rng::{run_seed, Xoshiro256pp};
 use super::setup::Setup;
 use super::simulate::{normal, simulate, Trial};
-use super::result::{MseRatios, RunResult};
 use super::summary::{summarise, Summary};
 use crate::landmarks::estimate::{estimate, Estimate};
 use crate::landmarks::inversion::Inverse;

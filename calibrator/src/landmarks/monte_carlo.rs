@@ -14,8 +14,8 @@ mod setup;
 mod simulate;
 mod summary;
 
-pub use rng::{run_seed, Xoshiro256pp};
 pub use result::{MseRatios, RunResult};
+pub use rng::{run_seed, Xoshiro256pp};
 pub use run::{monte_carlo, run_one};
 pub use setup::{paper_beta, Setup, PAPER_ALPHA};
 pub use simulate::{simulate, Trial};

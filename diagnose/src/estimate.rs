@@ -16,11 +16,8 @@
 //! still show. The estimate's own uncertainty is reported, and the drive's and the encoders'
 //! residuals are widened by it.
 
-use hilsim_calibrator::kalman_smoother::{
-    Gaussian as KalmanGaussian, Observation, Observations, RtsSmoother, StateSpaceModel, Transition,
-};
 use hilsim_recording::{LidarSample, Recording, TruthSample};
-use nalgebra::{Matrix1, Matrix3, Vector1};
+use nalgebra::Matrix3;
 
 use crate::error::MismatchError;
 use crate::physics::{Hypothesis, LidarQuery, Physics};
@@ -407,8 +404,7 @@ const STILL_DRIFT_RAD: f64 = 0.0005;
 /// The revolutions' corrections smoothed over time, with their variances: each coordinate a
 /// random walk whose steps grow with the distance and the turn the dead reckoning covers
 /// between two revolutions, observed by each revolution's scan match with the variance its fit
-/// gives (Rauch–Tung–Striebel smoother, the calibrator's `kalman_smoother`; Shumway & Stoffer,
-/// §6.2). One revolution's match uses
+/// gives (Rauch–Tung–Striebel smoother; Shumway & Stoffer, §6.2). One revolution's match uses
 /// a few dozen readings and errs by centimetres in a sparse world; while the robot stands, the
 /// smoother averages every revolution of the stop.
 fn smooth_corrections(
@@ -436,69 +432,36 @@ fn smooth_corrections(
         .collect();
     let mut out = knots.to_vec();
     let mut out_var = variances.to_vec();
-    let mut smoother = RtsSmoother::<1>::new();
     for c in 0..3 {
-        let walk = Walk {
-            knots,
-            variances,
-            q: &q,
-            c,
-        };
-        // The model's noise is positive by construction: a failure is a non-finite input,
-        // which then reaches the trajectory as NaN (and is refused there).
-        let ok = smoother.run(&walk).is_ok();
-        for (k, (knot, knot_var)) in out.iter_mut().zip(out_var.iter_mut()).enumerate() {
-            let (mean, var) = if ok {
-                (
-                    smoother.smoothed_means()[k][0],
-                    smoother.smoothed_covs()[k][(0, 0)],
-                )
-            } else {
-                (f64::NAN, f64::NAN)
+        // Forward filter: predicted (m⁻, p⁻) and filtered (m, p) at each knot.
+        let mut pred = Vec::with_capacity(n);
+        let mut filt: Vec<(f64, f64)> = Vec::with_capacity(n);
+        for k in 0..n {
+            let (mp, pp) = match filt.last() {
+                Some(&(m, p)) => (m, p + q[k][c]),
+                // The first revolution: a diffuse prior.
+                None => (0.0, 1e6),
             };
-            knot.1[c] = mean;
-            knot_var[c] = var.max(0.0);
+            pred.push((mp, pp));
+            let (y, r) = (knots[k].1[c], variances[k][c].max(1e-12));
+            let gain = pp / (pp + r);
+            filt.push((mp + gain * (y - mp), (1.0 - gain) * pp));
+        }
+        // Backward pass.
+        let mut smooth = filt.clone();
+        for k in (0..n - 1).rev() {
+            let g = filt[k].1 / pred[k + 1].1;
+            smooth[k] = (
+                filt[k].0 + g * (smooth[k + 1].0 - pred[k + 1].0),
+                filt[k].1 + g * g * (smooth[k + 1].1 - pred[k + 1].1),
+            );
+        }
+        for k in 0..n {
+            out[k].1[c] = smooth[k].0;
+            out_var[k][c] = smooth[k].1.max(0.0);
         }
     }
     (out, out_var)
-}
-
-/// One coordinate `c` of the revolutions' corrections as the smoother sees it: a random walk
-/// (process variance `q[k + 1][c]` from knot `k` to `k + 1`) from a diffuse prior, observed
-/// directly at each knot with the variance its scan match gives.
-struct Walk<'a> {
-    knots: &'a [Knot],
-    variances: &'a [[f64; 3]],
-    q: &'a [[f64; 3]],
-    c: usize,
-}
-
-impl StateSpaceModel<1> for Walk<'_> {
-    fn steps(&self) -> usize {
-        self.knots.len()
-    }
-
-    fn prior(&self) -> KalmanGaussian<1> {
-        // The first revolution: a diffuse prior.
-        KalmanGaussian::new(Vector1::new(0.0), Matrix1::new(1e6))
-    }
-
-    fn transition(&self, k: usize) -> Transition<1> {
-        Transition {
-            a: Matrix1::new(1.0),
-            b: Vector1::new(0.0),
-            q: Matrix1::new(self.q[k + 1][self.c]),
-        }
-    }
-
-    fn observations(&self, k: usize, out: &mut Observations<1>) {
-        out.push(Observation {
-            y: self.knots[k].1[self.c],
-            offset: 0.0,
-            h: Vector1::new(1.0),
-            r: self.variances[k][self.c].max(1e-12),
-        });
-    }
 }
 
 /// Solves the 3×3 system `a x = b` by its inverse; `None` when singular.

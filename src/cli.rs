@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use hilsim_recording::Method;
 
 /// hilsim: robot distance sensors in the loop without the hardware.
 ///
@@ -116,8 +117,8 @@ pub struct CalibrateArgs {
     /// A recording directory.
     pub recording: PathBuf,
     /// The calibration method.
-    #[arg(long, value_enum)]
-    pub method: MethodArg,
+    #[arg(long, value_parser = method_parser())]
+    pub method: Method,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -129,14 +130,15 @@ pub struct CalibrateArgs {
     pub start_distance: Option<f64>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Ground-truth-less EM with a Kalman smoother.
-    Em,
-    /// Cylinders in unknown positions.
-    Landmarks,
-    /// Fit against truth.csv.
-    Groundtruth,
+/// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.
+fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new([
+        PossibleValue::new(Method::Em.name()).help("Ground-truth-less EM with a Kalman smoother"),
+        PossibleValue::new(Method::Landmarks.name()).help("Cylinders in unknown positions"),
+        PossibleValue::new(Method::Groundtruth.name()).help("Fit against truth.csv"),
+    ])
+    .try_map(|name| Method::from_name(&name).ok_or("not a method"))
 }
 
 #[derive(Debug, clap::Args)]

@@ -5,41 +5,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-/// A calibration method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// Ground-truth-less EM with a Kalman/RTS smoother (Alhashimi et al., IEEE Sensors J. 2017).
-    Em,
-    /// Landmarks in unknown positions (Alhashimi et al., Sensors 2021).
-    Landmarks,
-    /// Maximum-likelihood fit against the true pose (Alhashimi et al., ICINCO 2016).
-    Groundtruth,
-}
-
-impl Method {
-    /// The method's name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Em => "em",
-            Method::Landmarks => "landmarks",
-            Method::Groundtruth => "groundtruth",
-        }
-    }
-}
-
-/// Which sensor a model belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Sensor {
-    /// The lidar.
-    Lidar,
-    /// The sonar.
-    Sonar,
-    /// The wheel odometer.
-    Odometer,
-}
+/// The calibration methods and the sensors they calibrate (one definition each, shared with
+/// the scenario files: `hilsim_recording::names`).
+pub use hilsim_recording::{Method, Sensor};
 
 /// The fitted model of one sensor, eq. (2) of both papers:
 /// `reading = Σ alpha_i d^i + (Σ beta_i d^i) e`, lowest order first, metres.

@@ -1,29 +1,18 @@
 //! The robot's trajectory: poses at increasing times, interpolated linearly between them (the
 //! heading along the shorter arc), as the simulator interpolates within a physics step.
 
-use hilsim_recording::TruthSample;
+use hilsim_recording::{Pose, TruthSample};
 
 use crate::error::MismatchError;
 
-/// A planar pose: metres and radians (counter-clockwise from the world x axis).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Pose2 {
-    /// x, metres.
-    pub x: f64,
-    /// y, metres.
-    pub y: f64,
-    /// Heading, radians.
-    pub yaw: f64,
-}
-
-/// Wraps an angle into (−π, π] (the landmark calibrator's, shared).
-pub use hilsim_calibrator::landmarks::pose::wrap;
+/// Wraps an angle into (−π, π] (the one definition, `hilsim_recording::pose`).
+pub use hilsim_recording::pose::wrap_angle as wrap;
 
 /// Poses at increasing times.
 ///
 /// ```
 /// use hilsim_diagnose::Trajectory;
-/// use hilsim_recording::TruthSample;
+/// use hilsim_recording::{Pose, TruthSample};
 /// let t = Trajectory::new(&[
 ///     TruthSample { t_s: 0.0, x_m: 0.0, y_m: 0.0, yaw_rad: 3.1 },
 ///     TruthSample { t_s: 1.0, x_m: 1.0, y_m: 0.0, yaw_rad: -3.1 },
@@ -36,7 +25,7 @@ pub use hilsim_calibrator::landmarks::pose::wrap;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
     t: Vec<f64>,
-    poses: Vec<Pose2>,
+    poses: Vec<Pose>,
 }
 
 impl Trajectory {
@@ -72,7 +61,7 @@ impl Trajectory {
                 }
             }
             t.push(s.t_s);
-            poses.push(Pose2 {
+            poses.push(Pose {
                 x: s.x_m,
                 y: s.y_m,
                 yaw: s.yaw_rad,
@@ -89,7 +78,7 @@ impl Trajectory {
 
     /// The sample poses.
     #[must_use]
-    pub fn poses(&self) -> &[Pose2] {
+    pub fn poses(&self) -> &[Pose] {
         &self.poses
     }
 
@@ -111,7 +100,7 @@ impl Trajectory {
 
     /// The pose at `t`, interpolated (held constant beyond the ends).
     #[must_use]
-    pub fn pose_at(&self, t: f64) -> Pose2 {
+    pub fn pose_at(&self, t: f64) -> Pose {
         let n = self.t.len();
         if n == 1 || t <= self.t[0] {
             return self.poses[0];
@@ -122,7 +111,7 @@ impl Trajectory {
         let k = self.interval(t);
         let (p, q) = (self.poses[k], self.poses[k + 1]);
         let u = (t - self.t[k]) / (self.t[k + 1] - self.t[k]);
-        Pose2 {
+        Pose {
             x: p.x + (q.x - p.x) * u,
             y: p.y + (q.y - p.y) * u,
             yaw: wrap(p.yaw + wrap(q.yaw - p.yaw) * u),

@@ -8,7 +8,7 @@
 
 use hilsim_diagnose::{
     diagnose, show, Declared, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
-    LidarQuery, MismatchError, OdometryPrediction, Options, Physics, Pose2, SonarPrediction,
+    LidarQuery, MismatchError, OdometryPrediction, Options, Physics, Pose, SonarPrediction,
     Trajectory, Verdict,
 };
 use hilsim_recording::{CommandSample, LidarSample, Meta, Recording, TruthSample};
@@ -23,7 +23,7 @@ const BEAMS: u16 = 36;
 const REV_HZ: f64 = 5.0;
 
 /// Range from `p` along `heading` to the box's walls, and the cosine of the incidence.
-fn cast(p: Pose2, heading: f64) -> (f64, f64) {
+fn cast(p: Pose, heading: f64) -> (f64, f64) {
     let (dx, dy) = (heading.cos(), heading.sin());
     let mut best = (f64::INFINITY, 1.0);
     for (wall, along_x) in [
@@ -58,7 +58,7 @@ impl Corridor {
         Self {
             declared: Declared {
                 scenario: "corridor".into(),
-                start: Pose2::default(),
+                start: Pose::default(),
                 wheel_base_m: 0.23,
                 lidar: Some(DeclaredLidar {
                     snapshot: false,
@@ -74,7 +74,7 @@ impl Corridor {
 
     /// The expected reading of beam `angle_deg` from pose `p`, under incidence coefficient
     /// `kappa`, plus the wave.
-    fn mean(p: Pose2, angle_deg: f64, kappa: f64, wave: f64) -> (f64, f64) {
+    fn mean(p: Pose, angle_deg: f64, kappa: f64, wave: f64) -> (f64, f64) {
         let (d, cos) = cast(p, p.yaw + angle_deg.to_radians());
         let tan = cos.acos().min(80f64.to_radians()).tan();
         (
@@ -133,9 +133,9 @@ impl Physics for Corridor {
 
 /// A "real" run: `seconds` driving along x at 0.2 m/s while turning at 0.3 rad/s from `start`,
 /// with the lidar's readings drawn with incidence coefficient `kappa` and wave amplitude `wave`.
-fn recording(seconds: f64, start: Pose2, kappa: f64, wave: f64, seed: u64) -> Recording {
+fn recording(seconds: f64, start: Pose, kappa: f64, wave: f64, seed: u64) -> Recording {
     let mut rng = hilsim_sim::rng::stream(seed, "issue-7-corridor");
-    let pose = |t: f64| Pose2 {
+    let pose = |t: f64| Pose {
         x: start.x + 0.2 * t,
         y: start.y + 0.1 * (0.3 * t).sin(),
         yaw: start.yaw + 0.4 * (0.3 * t).sin(),
@@ -192,7 +192,7 @@ fn lidar_only() -> Options {
 
 #[test]
 fn a_run_without_the_effect_is_none() {
-    let rec = recording(20.0, Pose2::default(), 0.0, 0.0, 1);
+    let rec = recording(20.0, Pose::default(), 0.0, 0.0, 1);
     let d = diagnose(&Corridor::new(), &rec, &lidar_only()).unwrap();
     assert_eq!(d.verdict, Verdict::None, "{}", show::summary(&d));
     // Fitting κ to pure noise gains nothing on the held-out half: the gain of one fitted
@@ -206,7 +206,7 @@ fn a_run_without_the_effect_is_none() {
 #[test]
 fn a_concealed_incidence_effect_is_named_and_fitted() {
     let kappa = 0.01;
-    let rec = recording(20.0, Pose2::default(), kappa, 0.0, 2);
+    let rec = recording(20.0, Pose::default(), kappa, 0.0, 2);
     let d = diagnose(&Corridor::new(), &rec, &lidar_only()).unwrap();
     assert_eq!(
         d.verdict,
@@ -255,7 +255,7 @@ fn a_concealed_incidence_effect_is_named_and_fitted() {
 fn a_mismatch_outside_the_catalogue_is_unexplained() {
     // A range error of ±3 cm varying as sin(3 × bearing): three times the noise, in no effect's
     // shape. κ absorbs a little of it, leaving most of the located structure.
-    let rec = recording(20.0, Pose2::default(), 0.0, 0.03, 3);
+    let rec = recording(20.0, Pose::default(), 0.0, 0.03, 3);
     let d = diagnose(&Corridor::new(), &rec, &lidar_only()).unwrap();
     assert_eq!(d.verdict, Verdict::Unexplained, "{}", show::summary(&d));
     assert!(d.located.is_some());
@@ -266,14 +266,14 @@ fn a_mismatch_outside_the_catalogue_is_unexplained() {
 #[test]
 fn recordings_that_are_not_runs_of_the_scenario_are_refused() {
     // Too short: 5 s.
-    let short = recording(5.0, Pose2::default(), 0.0, 0.0, 4);
+    let short = recording(5.0, Pose::default(), 0.0, 0.0, 4);
     let err = diagnose(&Corridor::new(), &short, &lidar_only()).unwrap_err();
     assert!(
         matches!(err, MismatchError::Refused(ref m) if m.contains("too short")),
         "{err}"
     );
     // Starting 1 m from the scenario's start.
-    let elsewhere = Pose2 {
+    let elsewhere = Pose {
         x: 1.0,
         y: 0.0,
         yaw: 0.0,
@@ -285,7 +285,7 @@ fn recordings_that_are_not_runs_of_the_scenario_are_refused() {
         "{err}"
     );
     // No sensor in common and no truth.
-    let mut bare = recording(20.0, Pose2::default(), 0.0, 0.0, 6);
+    let mut bare = recording(20.0, Pose::default(), 0.0, 0.0, 6);
     bare.lidar = None;
     bare.truth = None;
     bare.commands = vec![CommandSample {
@@ -303,7 +303,7 @@ fn recordings_that_are_not_runs_of_the_scenario_are_refused() {
 fn a_recording_of_another_world_does_not_align() {
     // The truth says the robot is where the scenario starts, but the ranges are another room's:
     // every reading 2 m off.
-    let mut rec = recording(20.0, Pose2::default(), 0.0, 0.0, 7);
+    let mut rec = recording(20.0, Pose::default(), 0.0, 0.0, 7);
     for s in rec.lidar.as_mut().unwrap() {
         s.range_m += 2.0;
     }

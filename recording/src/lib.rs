@@ -21,12 +21,16 @@ mod atomic;
 mod csv;
 mod error;
 mod meta;
+mod names;
+pub mod pose;
 mod read;
 mod samples;
 mod write;
 
 pub use atomic::{replace_dir_atomically, write_file_atomically};
 pub use error::{Error, ErrorKind};
+pub use names::{Method, Sensor};
+pub use pose::{wrap_angle, Pose};
 pub use meta::{LidarMount, Meta, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use samples::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
 

@@ -1,8 +1,7 @@
 //! One scenario end to end: emulate, calibrate with its methods, measure, check.
 
-use hilsim_calibrator::{Calibration, Method, TargetOptions};
+use hilsim_calibrator::{Calibration, TargetOptions};
 use hilsim_lidar_emulator::{Emulation, Run};
-use hilsim_sim::scenario;
 use hilsim_sim::Scenario;
 
 use crate::metrics::{self, Metrics, Outcome};
@@ -71,15 +70,6 @@ impl Report {
     }
 }
 
-/// The calibrator's method for a scenario's `[calibration] methods` entry.
-fn method(m: scenario::Method) -> Method {
-    match m {
-        scenario::Method::Em => Method::Em,
-        scenario::Method::Landmarks => Method::Landmarks,
-        scenario::Method::Groundtruth => Method::Groundtruth,
-    }
-}
-
 /// Simulates, emulates the sensors, calibrates, computes the metrics and checks the
 /// assertions; with [`Via::Serial`] the lidar data reaches the metrics through a pty and the
 /// decoder. `origin` names the scenario in errors.
@@ -102,8 +92,7 @@ pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report, Run
     };
     let mut metrics = metrics::of_run(&run);
     let mut calibrations = Vec::new();
-    for &m in &scenario.calibration.methods {
-        let method = method(m);
+    for &method in &scenario.calibration.methods {
         let calibration =
             hilsim_calibrator::calibrate(&run.recording, method, TargetOptions::default())
                 .map_err(|e| RunError::Calibration {

@@ -1,6 +1,6 @@
 //! The differential drive's kinematics: what the wheels did when the body moved.
 
-use crate::pose::{wrap_angle, Pose};
+use hilsim_recording::pose::{wrap_angle, Pose};
 
 /// The wheels' cumulative travel after the robot moved from `p0` to `p1`, starting from `prev`:
 /// the body's forward displacement (along the mean heading) and its turn, split onto wheels

@@ -27,7 +27,6 @@ mod actuation;
 pub mod drive;
 mod kinematics;
 mod motor_lag;
-pub mod pose;
 pub mod replay;
 pub mod rng;
 pub mod scenario;
@@ -36,7 +35,7 @@ pub mod world;
 
 pub use drive::{DriveProgram, WheelCommand};
 pub use motor_lag::MotorLag;
-pub use pose::Pose;
+pub use hilsim_recording::pose::{self, Pose};
 pub use scenario::{Scenario, ScenarioError};
 pub use simulation::{Collision, Simulation, StepState};
 pub use world::{Obstacle, RayHit, World};

@@ -8,7 +8,7 @@ use rapier2d::prelude::*;
 use crate::actuation::ActuationError;
 use crate::drive::{DriveProgram, WheelCommand};
 use crate::motor_lag::MotorLag;
-use crate::pose::Pose;
+use hilsim_recording::pose::Pose;
 use crate::scenario::Scenario;
 use crate::world::{Obstacle, World};
 

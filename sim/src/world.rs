@@ -5,7 +5,7 @@
 
 use rapier2d::prelude::*;
 
-use crate::pose::Pose;
+use hilsim_recording::pose::Pose;
 use crate::scenario::Scenario;
 
 /// What a collider is, so a sensor can ask what it hit.

@@ -7,25 +7,15 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::smoothing;
-use hilsim_calibrator::{Calibration, Method, TargetOptions};
+use hilsim_calibrator::{Calibration, TargetOptions};
 use hilsim_recording::{write_file_atomically, Recording};
 
-use crate::cli::{CalibrateArgs, MethodArg, SmoothArgs};
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Self {
-        match m {
-            MethodArg::Em => Method::Em,
-            MethodArg::Landmarks => Method::Landmarks,
-            MethodArg::Groundtruth => Method::Groundtruth,
-        }
-    }
-}
+use crate::cli::{CalibrateArgs, SmoothArgs};
 
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<()> {
     let target = target_options(args.beam, args.start_distance)?;
     let rec = Recording::read_dir(&args.recording)?;
-    let method = Method::from(args.method);
+    let method = args.method;
     let calibration = hilsim_calibrator::calibrate(&rec, method, target)
         .with_context(|| format!("{}: {}", args.recording.display(), method.name()))?;
     if args.json {

@@ -5,6 +5,9 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+/// A calibration method (the one definition: `hilsim_recording::Method`).
+pub use hilsim_recording::Method;
+
 /// A whole scenario file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -430,30 +433,6 @@ pub struct Calibration {
     /// Methods `hilsim run` applies: `em`, `landmarks`, `groundtruth`.
     #[serde(default)]
     pub methods: Vec<Method>,
-}
-
-/// A calibration method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// Ground-truth-less EM (the EM paper).
-    Em,
-    /// Landmarks in unknown positions (the landmark paper).
-    Landmarks,
-    /// Fit against the true pose.
-    Groundtruth,
-}
-
-impl Method {
-    /// The method's name as written in files and on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Em => "em",
-            Method::Landmarks => "landmarks",
-            Method::Groundtruth => "groundtruth",
-        }
-    }
 }
 
 /// An `[[expect]]` assertion on a named metric.

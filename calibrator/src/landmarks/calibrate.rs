@@ -1,24 +1,25 @@
 //! The landmark calibrator on a recording: stops → averaged scans → cylinders → tracks →
 //! observations → the estimator → a [`Calibration`].
 
+mod model;
+mod truth;
+
 use std::collections::BTreeMap;
 
-use hilsim_recording::Recording;
+use hilsim_recording::{LidarSample, Recording};
 use rayon::prelude::*;
 
+use self::model::{check_model, choose_model, run_estimator};
+use self::truth::{score_against_truth, Seen};
 use super::association::{associate, place, Track};
 use super::detection::{candidate_radii, detect, Detection, Rejections};
-use super::estimate::{
-    estimate, Estimate, EstimateError, EstimatorConfig, JointRejection, Observation, ObservationSet,
-};
-use super::inversion::Inverse;
-use super::options::{Estimator, Options, OrderSelection};
+use super::estimate::{Estimate, Observation, ObservationSet};
+use super::options::Options;
 use super::pose::Pose2;
-use super::positions::{intersect, BearingLine, PositionError, Weights, MIN_BEARING_SPREAD_RAD};
-use super::scan::average_stop;
+use super::scan::{average_stop, StopScan};
 use super::stops::{find_stops, Stop};
 use crate::stats::median;
-use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
+use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
 
 /// Standard deviation given to the stops before the robot first moved: they are at the start
 /// pose by definition (0.1 mm: exact to the model, finite for the solver).
@@ -77,6 +78,61 @@ pub struct Analysis {
 /// As [`calibrate`].
 pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationError> {
     opts.validate()?;
+    let lidar = check_lidar(rec)?;
+    let mut notes = Vec::new();
+    let stops = stand_still_stops(rec, opts, &mut notes)?;
+    let scans = average_scans(lidar, &stops, opts);
+    let radius = landmark_radius(rec, opts, &scans, &mut notes)?;
+    let sensors = sensor_poses(rec, &stops);
+    let (dets, rejected) = detect_landmarks(&scans, radius, opts, &mut notes)?;
+    let kept = keep_tracks(&dets, &sensors, radius, opts, &mut notes)?;
+    let set = build_observations(&stops, &sensors, &dets, &kept, radius);
+    let est = run_estimator(&set, opts, &mut notes)?;
+    let model = choose_model(&est, opts, &mut notes);
+    check_model(&model, opts, &mut notes)?;
+    let seen = Seen {
+        stops: &stops,
+        sensors: &sensors,
+        radius,
+        dets: &dets,
+        tracks: &kept,
+        set: &set,
+    };
+    let (metrics, truth) = score_against_truth(rec, opts, &seen, &est, &model, &mut notes)?;
+    let mut sensors_out = BTreeMap::new();
+    sensors_out.insert(
+        Sensor::Lidar,
+        SensorModel {
+            alpha: model.alpha,
+            beta: model.beta,
+        },
+    );
+    let calibration = Calibration {
+        method: Method::Landmarks,
+        sensors: sensors_out,
+        iterations: model.iterations,
+        converged: model.converged,
+        metrics,
+        order: Some(model.order),
+        landmarks: Some(model.positions.into_iter().flatten().collect()),
+        notes,
+    };
+    Ok(Analysis {
+        stops,
+        sensors,
+        radius_m: radius,
+        detections: dets,
+        rejected,
+        tracks: kept,
+        observations: set,
+        estimate: est,
+        truth_distances: truth,
+        calibration,
+    })
+}
+
+/// Check the lidar: readings present and in time order.
+fn check_lidar(rec: &Recording) -> Result<&[LidarSample], CalibrationError> {
     let lidar = rec
         .lidar
         .as_deref()
@@ -89,7 +145,15 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             "landmarks: lidar.csv rows go back in time".into(),
         ));
     }
-    let mut notes = Vec::new();
+    Ok(lidar)
+}
+
+/// Find the stops: the stand-still intervals, at least two of them.
+fn stand_still_stops(
+    rec: &Recording,
+    opts: &Options,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Stop>, CalibrationError> {
     let (stops, report) = find_stops(rec, &opts.stops)?;
     for (t, v) in &report.moving {
         notes.push(format!(
@@ -110,14 +174,28 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             opts.stops.min_stop_s
         )));
     }
-    let scans: Vec<_> = stops
+    Ok(stops)
+}
+
+/// Average each stop's revolutions beam by beam.
+fn average_scans(lidar: &[LidarSample], stops: &[Stop], opts: &Options) -> Vec<StopScan> {
+    stops
         .par_iter()
         .map(|s| average_stop(lidar, s, &opts.detection))
-        .collect();
-    let radius = match opts.landmark_radius_m.or(rec.meta.world.landmark_radius_m) {
+        .collect()
+}
+
+/// The landmark radius: given (option or `meta.toml`), else the median of free circle fits.
+fn landmark_radius(
+    rec: &Recording,
+    opts: &Options,
+    scans: &[StopScan],
+    notes: &mut Vec<String>,
+) -> Result<f64, CalibrationError> {
+    match opts.landmark_radius_m.or(rec.meta.world.landmark_radius_m) {
         Some(r) => {
             notes.push(format!("landmark radius {r:.3} m (given)"));
-            r
+            Ok(r)
         }
         None => {
             let mut radii: Vec<f64> = scans
@@ -137,11 +215,15 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
                  reading space)",
                 radii.len()
             ));
-            r
+            Ok(r)
         }
-    };
+    }
+}
+
+/// Each stop's nominal sensor (lidar) pose: the stop's pose composed with the lidar mount.
+fn sensor_poses(rec: &Recording, stops: &[Stop]) -> Vec<Pose2> {
     let mount = rec.meta.lidar.as_ref();
-    let sensors: Vec<Pose2> = stops
+    stops
         .iter()
         .map(|s| {
             s.pose.compose(
@@ -150,7 +232,16 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
                 mount.map_or(0.0, |m| m.yaw_deg.to_radians()),
             )
         })
-        .collect();
+        .collect()
+}
+
+/// Detect the cylinders in every stop's scan, counting the segments rejected.
+fn detect_landmarks(
+    scans: &[StopScan],
+    radius: f64,
+    opts: &Options,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Detection>, Rejections), CalibrationError> {
     let mut rejected = Rejections::default();
     let mut dets: Vec<Detection> = Vec::new();
     for (k, scan) in scans.iter().enumerate() {
@@ -176,7 +267,7 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         .collect();
     notes.push(format!(
         "{} stops, {} landmark detections; segments rejected: {}",
-        stops.len(),
+        scans.len(),
         dets.len(),
         if reasons.is_empty() {
             "none".to_string()
@@ -188,10 +279,22 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         return Err(CalibrationError::TooFewSamples(format!(
             "landmarks: no landmark (cylinder of radius {radius:.3} m) detected in any of the {} \
              stops",
-            stops.len()
+            scans.len()
         )));
     }
-    let tracks = associate(&dets, &sensors, radius, &opts.association);
+    Ok((dets, rejected))
+}
+
+/// Keep the tracks: associate the detections across stops and keep the landmarks seen from
+/// enough stops.
+fn keep_tracks(
+    dets: &[Detection],
+    sensors: &[Pose2],
+    radius: f64,
+    opts: &Options,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Track>, CalibrationError> {
+    let tracks = associate(dets, sensors, radius, &opts.association);
     let mut kept = Vec::new();
     for t in tracks {
         let seen_from = t.len();
@@ -214,7 +317,18 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             opts.association.min_stops
         )));
     }
-    let set = ObservationSet {
+    Ok(kept)
+}
+
+/// Build the observations: the estimator's input, one per detection of a kept track.
+fn build_observations(
+    stops: &[Stop],
+    sensors: &[Pose2],
+    dets: &[Detection],
+    kept: &[Track],
+    radius: f64,
+) -> ObservationSet {
+    ObservationSet {
         stops: sensors.iter().map(|p| [p.x, p.y]).collect(),
         stop_sd_m: stops
             .iter()
@@ -226,8 +340,6 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             .iter()
             .enumerate()
             .flat_map(|(l, t)| {
-                let dets = &dets;
-                let sensors = &sensors;
                 t.iter().map(move |&i| {
                     let d = &dets[i];
                     Observation {
@@ -241,286 +353,5 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
                 })
             })
             .collect(),
-    };
-    let obs_dets: Vec<&Detection> = kept
-        .iter()
-        .flat_map(|t| t.iter().map(|&i| &dets[i]))
-        .collect();
-    let cfg = EstimatorConfig::from(opts);
-    let est = estimate(&set, &cfg).map_err(|e| match e {
-        EstimateError::NoLandmarks(d) => CalibrationError::Unidentifiable(format!(
-            "landmarks: no landmark's position can be estimated: {}",
-            describe_drops(&d)
-        )),
-        EstimateError::TooFewObservations(n) => CalibrationError::TooFewSamples(format!(
-            "landmarks: {n} landmark observation(s) are too few to fit a range model"
-        )),
-    })?;
-    for (l, e) in &est.dropped {
-        notes.push(format!(
-            "warning: landmark {} dropped: {}",
-            l + 1,
-            describe_drop(*e)
-        ));
     }
-    let scan = &est.paper.scan;
-    notes.push(format!(
-        "paper estimator (eq. 23, OLS eq. 28): AIC picks order {}, cross-validation picks {}; \
-         alpha {:?}; AIC by order {:?}; PRESS by order {:?}",
-        scan.aic_order,
-        scan.cv_order,
-        round(&est.paper.alpha),
-        round(&scan.fits.iter().map(|f| f.aic).collect::<Vec<_>>()),
-        round(&scan.fits.iter().map(|f| f.press).collect::<Vec<_>>()),
-    ));
-    let (order, alpha, beta, positions, distances, iterations, converged) = match &est.refined {
-        Some(r) if opts.estimator == Estimator::Refined => {
-            notes.push(format!(
-                "refined (eq. 23 with residual-variance weights, WLS): AIC picks order {}, \
-                 cross-validation picks {}; sigma_s {:.4} m, sigma_theta {:.3} deg from the \
-                 residuals of eq. 24",
-                r.wls.scan.aic_order,
-                r.wls.scan.cv_order,
-                r.sigma_s_m,
-                r.sigma_theta_rad.to_degrees()
-            ));
-            let (it, conv) = match &r.joint {
-                Some(j) => {
-                    notes.push(format!(
-                        "joint refinement: {} iterations, cost {:.1} -> {:.1}, converged {}",
-                        j.iterations, j.cost.0, j.cost.1, j.converged
-                    ));
-                    (j.iterations, j.converged)
-                }
-                None => {
-                    notes.push(match r.rejected {
-                        Some(JointRejection::Chi2(c)) => format!(
-                            "warning: joint refinement set aside: its residuals contradict its \
-                             weights (chi2/dof {c:.1}); the WLS stage stands"
-                        ),
-                        Some(JointRejection::Moved(k)) => format!(
-                            "warning: joint refinement set aside: it moved a landmark {k:.1} \
-                             standard deviations from the WLS estimate; the WLS stage stands"
-                        ),
-                        None => "warning: the joint refinement could not start; the WLS stage \
-                                 stands"
-                            .into(),
-                    });
-                    (1, false)
-                }
-            };
-            (
-                r.wls.order,
-                r.alpha().to_vec(),
-                r.beta.clone(),
-                r.positions(),
-                r.distances.clone(),
-                it,
-                conv,
-            )
-        }
-        _ => (
-            est.paper.order,
-            est.paper.alpha.clone(),
-            est.paper.beta.clone(),
-            est.paper.positions.clone(),
-            est.paper.distances.clone(),
-            1,
-            true,
-        ),
-    };
-    let selection = match opts.order_selection {
-        OrderSelection::Aic => "AIC".to_string(),
-        OrderSelection::CrossValidation => "cross-validation".to_string(),
-        OrderSelection::Fixed(n) => format!("fixed at {n}"),
-    };
-    notes.push(format!("reported order {order} ({selection})"));
-    if order == 0 {
-        return Err(CalibrationError::Unidentifiable(
-            "landmarks: the selected range model is constant (order 0): the readings do not \
-             follow the distances; check the landmark detections"
-                .into(),
-        ));
-    }
-    let finite = alpha.iter().chain(&beta).all(|v| v.is_finite())
-        && positions
-            .iter()
-            .flatten()
-            .all(|p| p[0].is_finite() && p[1].is_finite());
-    if !finite {
-        return Err(CalibrationError::Diverged(
-            "landmarks: the estimate is not finite".into(),
-        ));
-    }
-    let dmax = distances.iter().copied().fold(0.0f64, f64::max).max(0.5);
-    let inverse = Inverse::new(&alpha, [0.0, 1.5 * dmax])?;
-    let used_dets: Vec<&Detection> = est.used.iter().map(|&i| obs_dets[i]).collect();
-    let used_obs: Vec<&Observation> = est.used.iter().map(|&i| &set.observations[i]).collect();
-    let truth = truth_distances(rec, &stops, &used_dets, &used_obs, &sensors, radius);
-    let metrics = truth.as_ref().map(|(d, how)| {
-        notes.push(format!("truth distances: {how}"));
-        let raw: Vec<f64> = used_obs.iter().map(|o| o.range_m).collect();
-        let m = metrics(
-            &raw,
-            &raw.iter().map(|r| inverse.distance(*r)).collect::<Vec<_>>(),
-            d,
-        );
-        if let (Some(_), Estimator::Refined) = (&est.refined, opts.estimator) {
-            if let Ok(p) = Inverse::new(&est.paper.alpha, [0.0, 1.5 * dmax]) {
-                let mp = metrics(
-                    &raw,
-                    &raw.iter().map(|r| p.distance(*r)).collect::<Vec<_>>(),
-                    d,
-                );
-                notes.push(format!(
-                    "MSE ratio (eq. 31): paper estimator {:.2}, refined {:.2}",
-                    mp.mse_ratio(),
-                    m.mse_ratio()
-                ));
-            }
-        }
-        m
-    });
-    let mut sensors_out = BTreeMap::new();
-    sensors_out.insert(Sensor::Lidar, SensorModel { alpha, beta });
-    let calibration = Calibration {
-        method: Method::Landmarks,
-        sensors: sensors_out,
-        iterations,
-        converged,
-        metrics,
-        order: Some(order),
-        landmarks: Some(positions.into_iter().flatten().collect()),
-        notes,
-    };
-    Ok(Analysis {
-        stops,
-        sensors,
-        radius_m: radius,
-        detections: dets,
-        rejected,
-        tracks: kept,
-        observations: set,
-        estimate: est,
-        truth_distances: truth.map(|(d, _)| d),
-        calibration,
-    })
-}
-
-fn describe_drop(e: PositionError) -> String {
-    match e {
-        PositionError::TooFewBearings => "seen from fewer than two stops".into(),
-        PositionError::Colinear(s) => format!(
-            "its bearings are colinear (spread {:.2} deg, at least {:.2} deg is needed)",
-            s.to_degrees(),
-            MIN_BEARING_SPREAD_RAD.to_degrees()
-        ),
-        PositionError::Behind => "its bearings meet behind the sensor".into(),
-    }
-}
-
-fn describe_drops(d: &[(usize, PositionError)]) -> String {
-    d.iter()
-        .map(|(l, e)| format!("landmark {}: {}", l + 1, describe_drop(*e)))
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
-fn round(v: &[f64]) -> Vec<f64> {
-    v.iter().map(|x| (x * 1e5).round() / 1e5).collect()
-}
-
-/// MSE of raw and calibrated distances against the truth.
-fn metrics(raw: &[f64], calibrated: &[f64], truth: &[f64]) -> Metrics {
-    let n = truth.len().max(1) as f64;
-    let mse = |x: &[f64]| {
-        x.iter()
-            .zip(truth)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            / n
-    };
-    let norm = truth.iter().map(|d| d * d).sum::<f64>() / n;
-    let (r, c) = (mse(raw), mse(calibrated));
-    Metrics {
-        mse_raw: r,
-        mse_calibrated: c,
-        nmse_raw: r / norm,
-        nmse_calibrated: c / norm,
-    }
-}
-
-/// The true distance of each used observation: the range estimator applied to the simulator's
-/// true ranges when every reading has one; else, with `truth.csv`, the landmarks placed by the
-/// paper's eq. (20) from the true stop positions (Aitken's estimator with the sensor positions
-/// known) and d = |c − s| − R.
-fn truth_distances(
-    rec: &Recording,
-    stops: &[Stop],
-    dets: &[&Detection],
-    obs: &[&Observation],
-    nominal: &[Pose2],
-    radius: f64,
-) -> Option<(Vec<f64>, &'static str)> {
-    let mount = rec.meta.lidar.as_ref();
-    let landmarks = obs.iter().map(|o| o.landmark + 1).max().unwrap_or(0);
-    if let Some(d) = dets
-        .iter()
-        .map(|d| d.true_range_m)
-        .collect::<Option<Vec<f64>>>()
-    {
-        return Some((
-            d,
-            "the range estimator applied to lidar.csv's true_range_m of the same readings",
-        ));
-    }
-    let truth = rec.truth.as_deref().filter(|t| !t.is_empty())?;
-    let start = Pose2::new(truth[0].x_m, truth[0].y_m, truth[0].yaw_rad);
-    let true_sensor: Vec<Option<Pose2>> = stops
-        .iter()
-        .map(|s| {
-            let w: Vec<_> = truth
-                .iter()
-                .filter(|t| t.t_s >= s.t_start_s && t.t_s <= s.t_end_s)
-                .collect();
-            let t = w.get(w.len() / 2)?;
-            let p = Pose2::new(t.x_m, t.y_m, t.yaw_rad).relative_to(&start);
-            Some(p.compose(
-                mount.map_or(0.0, |m| m.x_m),
-                mount.map_or(0.0, |m| m.y_m),
-                mount.map_or(0.0, |m| m.yaw_deg.to_radians()),
-            ))
-        })
-        .collect();
-    let mut centres = vec![None; landmarks];
-    for (l, c) in centres.iter_mut().enumerate() {
-        let lines: Vec<BearingLine> = obs
-            .iter()
-            .filter(|o| o.landmark == l)
-            .filter_map(|o| {
-                let s = true_sensor[o.stop]?;
-                Some(BearingLine {
-                    sensor: [s.x, s.y],
-                    // The bearing measured in the lidar frame, turned by the true heading.
-                    bearing_rad: o.bearing_rad - nominal[o.stop].yaw + s.yaw,
-                    range_m: o.range_m,
-                })
-            })
-            .collect();
-        *c = intersect(&lines, Weights::Paper).ok().map(|p| p.centre);
-    }
-    let d: Option<Vec<f64>> = obs
-        .iter()
-        .map(|o| {
-            let c = centres[o.landmark]?;
-            let s = true_sensor[o.stop]?;
-            Some((c[0] - s.x).hypot(c[1] - s.y) - radius)
-        })
-        .collect();
-    d.map(|d| {
-        (
-            d,
-            "landmarks placed by eq. (20) from the true stop poses of truth.csv",
-        )
-    })
 }

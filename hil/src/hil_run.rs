@@ -29,6 +29,7 @@ mod report;
 mod sensors;
 mod session;
 mod setup;
+mod summary;
 
 pub use config::{FloodLimits, HilConfig, DEFAULT_FIRMWARE_GRACE, DEFAULT_WATCHDOG};
 pub use report::{Ending, Fault, HilReport};

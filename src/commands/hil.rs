@@ -13,8 +13,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
-use hilsim_hil::firmware::{describe_status, split_command_line, Ended, Firmware};
-use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilReport, HilWorld};
+use hilsim_hil::firmware::{split_command_line, Firmware};
+use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
 use hilsim_sim::Scenario;
 
 /// The longest run or watchdog accepted, seconds (a day: anything longer is a typo).
@@ -112,7 +112,7 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     out.flush()?;
     let report = hil_run::run(world, ports, Some(firmware), &config, &stop)
         .context("firmware in the loop")?;
-    summarise(&report, out)?;
+    out.write_all(report.summary().as_bytes())?;
     if let Some(dir) = &args.out {
         report.run.recording.write_dir(dir)?;
         writeln!(out, "wrote {}", dir.display())?;
@@ -121,108 +121,4 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
         Ending::TimeUp | Ending::FirmwareExited => ExitCode::SUCCESS,
         Ending::Fault(_) | Ending::Stopped => ExitCode::from(1),
     })
-}
-
-fn summarise(report: &HilReport, out: &mut dyn Write) -> Result<()> {
-    let at = report.ended_at_s;
-    match &report.ending {
-        Ending::TimeUp => writeln!(out, "ended: the run's time was up at {at:.2} s")?,
-        Ending::FirmwareExited => {
-            writeln!(out, "ended: the firmware exited with status 0 at {at:.2} s")?
-        }
-        Ending::Fault(fault) => writeln!(out, "FAULT at {at:.2} s: {fault}")?,
-        Ending::Stopped => writeln!(out, "interrupted at {at:.2} s: the run did not finish")?,
-    }
-    let rec = &report.run.recording;
-    if let Some(truth) = &rec.truth {
-        if let (Some(first), Some(last)) = (truth.first(), truth.last()) {
-            let path: f64 = truth
-                .windows(2)
-                .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
-                .sum();
-            writeln!(
-                out,
-                "robot: drove {path:.3} m in {:.2} s simulated, from ({:.3}, {:.3}) to ({:.3}, {:.3}) \
-                 heading {:.1}°; {} collision(s)",
-                report.simulated_s,
-                first.x_m,
-                first.y_m,
-                last.x_m,
-                last.y_m,
-                last.yaw_rad.to_degrees(),
-                report.run.collisions.len()
-            )?;
-        }
-    }
-    for c in &report.run.collisions {
-        writeln!(
-            out,
-            "  collision at t = {:.2} s with {:?}",
-            c.t_s, c.obstacle
-        )?;
-    }
-    let c = &report.commands;
-    writeln!(
-        out,
-        "requests: {} (TestMode {}, SetMotor {}, GetMotors {}, GetLDSScan {}, GetSonar {}), \
-         {} error(s), {} bytes",
-        c.requests,
-        c.test_mode,
-        c.set_motor,
-        c.get_motors,
-        c.get_lds_scan,
-        c.get_sonar,
-        c.errors,
-        c.bytes
-    )?;
-    for error in &c.first_errors {
-        writeln!(out, "  error: {error}")?;
-    }
-    if report.replies_dropped > 0 {
-        writeln!(
-            out,
-            "  {} replies dropped: the firmware did not read the robot port",
-            report.replies_dropped
-        )?;
-    }
-    if let Some(read) = report.lidar_bytes_read {
-        let s = &report.stream;
-        write!(
-            out,
-            "lidar: {} revolutions sent, {} dropped; the firmware read {read} of {} bytes",
-            s.revolutions_sent, s.revolutions_dropped, s.bytes_written
-        )?;
-        if let Some(lateness) = s.lateness_summary() {
-            write!(out, "; {lateness}")?;
-        }
-        writeln!(out)?;
-    }
-    writeln!(
-        out,
-        "real time: physics steps computed at most {:.1} ms late",
-        report.max_step_lateness.as_secs_f64() * 1e3
-    )?;
-    let mut failed = report.fault().is_some();
-    if let Some(exit) = report.firmware {
-        let how = match exit.ended {
-            Ended::ByItself => "exited by itself",
-            Ended::Terminated => "left on SIGTERM once the run was over",
-            Ended::Killed => "ignored SIGTERM and was killed",
-        };
-        writeln!(out, "firmware: {how}: {}", describe_status(exit.status))?;
-        failed |= exit.ended == Ended::ByItself && !exit.status.success();
-    }
-    let tail = &report.stderr;
-    if failed && !tail.lines.is_empty() {
-        writeln!(
-            out,
-            "firmware stderr (last {} of {} lines):",
-            tail.lines.len(),
-            tail.total
-        )?;
-        for line in &tail.lines {
-            writeln!(out, "  | {line}")?;
-        }
-    }
-    Ok(())
 }

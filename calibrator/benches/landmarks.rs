@@ -21,8 +21,7 @@ use hilsim_calibrator::landmarks::estimate::EstimatorConfig;
 use hilsim_calibrator::landmarks::monte_carlo::{monte_carlo, Setup};
 use hilsim_calibrator::landmarks::{calibrate, Options};
 
-mod support;
-use support::cpu_time;
+use cpu_time::ProcessTime;
 
 /// Runs of one Monte Carlo point, as in the paper ("each point is the average of 1000
 /// simulations").
@@ -89,7 +88,8 @@ fn benches(c: &mut Criterion) {
 /// threads): CPU over wall time is the number of cores actually obtained, below the thread count
 /// when other processes hold cores.
 fn median_time(reps: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
-    let c0 = cpu_time();
+    // CPU time of the whole process (all threads), from the OS clock.
+    let c0 = ProcessTime::try_now().ok();
     let mut t: Vec<f64> = (0..reps)
         .map(|_| {
             let s = Instant::now();
@@ -97,7 +97,7 @@ fn median_time(reps: usize, mut f: impl FnMut()) -> (f64, Option<f64>) {
             s.elapsed().as_secs_f64()
         })
         .collect();
-    let cpu = c0.zip(cpu_time()).map(|(a, b)| (b - a) / reps as f64);
+    let cpu = c0.map(|c| c.elapsed().as_secs_f64() / reps as f64);
     t.sort_by(f64::total_cmp);
     (t[t.len() / 2], cpu)
 }

@@ -106,48 +106,53 @@ fn read_meta(path: &Path) -> Result<Meta, Error> {
     Ok(meta)
 }
 
-fn read_commands(path: &Path, text: &str) -> Result<Vec<CommandSample>, Error> {
+/// A time-ordered table of numbers: `t_s` and then `columns`, each row made into a sample by
+/// `sample(t_s, values)` (columns looked up, and cells parsed, in that order).
+fn read_numbers<T, const N: usize>(
+    path: &Path,
+    text: &str,
+    columns: [&str; N],
+    sample: impl Fn(f64, [f64; N]) -> T,
+) -> Result<Vec<T>, Error> {
     let table = Table::parse(path, text)?;
-    let (t, l, r) = (
-        table.column("t_s")?,
-        table.column("left_mps")?,
-        table.column("right_mps")?,
-    );
+    let t = table.column("t_s")?;
+    let mut indices = [0; N];
+    for (index, name) in indices.iter_mut().zip(columns) {
+        *index = table.column(name)?;
+    }
     let mut prev = None;
     table
         .rows()
         .map(|row| {
             let t_s = row.f64(t)?;
             row.check_time(t_s, &mut prev)?;
-            Ok(CommandSample {
-                t_s,
-                left_mps: row.f64(l)?,
-                right_mps: row.f64(r)?,
-            })
+            let mut values = [0.0; N];
+            for (value, &index) in values.iter_mut().zip(&indices) {
+                *value = row.f64(index)?;
+            }
+            Ok(sample(t_s, values))
         })
         .collect()
 }
 
+fn read_commands(path: &Path, text: &str) -> Result<Vec<CommandSample>, Error> {
+    read_numbers(path, text, ["left_mps", "right_mps"], |t_s, [l, r]| {
+        CommandSample {
+            t_s,
+            left_mps: l,
+            right_mps: r,
+        }
+    })
+}
+
 fn read_odometry(path: &Path, text: &str) -> Result<Vec<OdometrySample>, Error> {
-    let table = Table::parse(path, text)?;
-    let (t, l, r) = (
-        table.column("t_s")?,
-        table.column("left_m")?,
-        table.column("right_m")?,
-    );
-    let mut prev = None;
-    table
-        .rows()
-        .map(|row| {
-            let t_s = row.f64(t)?;
-            row.check_time(t_s, &mut prev)?;
-            Ok(OdometrySample {
-                t_s,
-                left_m: row.f64(l)?,
-                right_m: row.f64(r)?,
-            })
-        })
-        .collect()
+    read_numbers(path, text, ["left_m", "right_m"], |t_s, [l, r]| {
+        OdometrySample {
+            t_s,
+            left_m: l,
+            right_m: r,
+        }
+    })
 }
 
 fn read_lidar(path: &Path, text: &str) -> Result<Vec<LidarSample>, Error> {
@@ -216,27 +221,14 @@ fn read_sonar(path: &Path, text: &str) -> Result<Vec<SonarSample>, Error> {
 }
 
 fn read_truth(path: &Path, text: &str) -> Result<Vec<TruthSample>, Error> {
-    let table = Table::parse(path, text)?;
-    let (t, x, y, yaw) = (
-        table.column("t_s")?,
-        table.column("x_m")?,
-        table.column("y_m")?,
-        table.column("yaw_rad")?,
-    );
-    let mut prev = None;
-    table
-        .rows()
-        .map(|row| {
-            let t_s = row.f64(t)?;
-            row.check_time(t_s, &mut prev)?;
-            Ok(TruthSample {
-                t_s,
-                x_m: row.f64(x)?,
-                y_m: row.f64(y)?,
-                yaw_rad: row.f64(yaw)?,
-            })
-        })
-        .collect()
+    read_numbers(path, text, ["x_m", "y_m", "yaw_rad"], |t_s, [x, y, yaw]| {
+        TruthSample {
+            t_s,
+            x_m: x,
+            y_m: y,
+            yaw_rad: yaw,
+        }
+    })
 }
 
 #[cfg(test)]

@@ -29,9 +29,9 @@ mod write;
 
 pub use atomic::{replace_dir_atomically, write_file_atomically};
 pub use error::{Error, ErrorKind};
+pub use meta::{LidarMount, Meta, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
-pub use meta::{LidarMount, Meta, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use samples::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
 
 /// A whole recording: the metadata and one table per sensor.

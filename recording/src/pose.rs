@@ -63,7 +63,10 @@ impl Pose {
     #[must_use]
     pub fn transform(&self, p: [f64; 2]) -> [f64; 2] {
         let (sin, cos) = self.yaw.sin_cos();
-        [self.x + cos * p[0] - sin * p[1], self.y + sin * p[0] + cos * p[1]]
+        [
+            self.x + cos * p[0] - sin * p[1],
+            self.y + sin * p[0] + cos * p[1],
+        ]
     }
 
     /// A point given in the parent frame, expressed in this pose's frame.

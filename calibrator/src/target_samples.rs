@@ -29,8 +29,13 @@
 //! The start distance (lidar to target at t = 0) comes from the caller or
 //! `meta.world.target_start_distance_m`.
 
-use hilsim_recording::{OdometrySample, Recording, SonarSample, TruthSample};
+mod align;
+#[cfg(test)]
+mod tests;
 
+use hilsim_recording::{LidarMount, LidarSample, Recording};
+
+use self::align::{commanded_forward, interpolate_odometry, nearest_sonar, truth_distances};
 use crate::{CalibrationError, Metrics};
 
 /// Which beam to follow and what is known of the start.
@@ -133,29 +138,8 @@ impl TargetSamples {
 ///   or start distance, or a beam that never returns a valid reading (it never sees a target);
 /// - [`CalibrationError::Unidentifiable`]: the beam is perpendicular to the motion.
 pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, CalibrationError> {
-    if !opts.beam_deg.is_finite() {
-        return Err(CalibrationError::Invalid(format!(
-            "beam angle must be finite, got {}",
-            opts.beam_deg
-        )));
-    }
-    let beam_index = opts.beam_deg.round().rem_euclid(360.0) as u16;
-    // meta.toml's start distance is the frontal target's (interfaces.md): it says nothing about
-    // what another beam sees, so another beam needs its own start distance.
-    let meta_start = rec
-        .meta
-        .world
-        .target_start_distance_m
-        .filter(|_| beam_index == 0);
-    let start = match opts.start_distance_m.or(meta_start) {
-        Some(d) if d.is_finite() && d > 0.0 => Some(d),
-        Some(d) => {
-            return Err(CalibrationError::Invalid(format!(
-                "start distance must be a positive number of metres, got {d}"
-            )))
-        }
-        None => None,
-    };
+    let beam_index = beam_index(opts)?;
+    let start = start_distance(rec, opts, beam_index)?;
     let Some(lidar) = rec.lidar.as_ref() else {
         return Err(CalibrationError::Missing(
             "the recording has no lidar.csv: the EM paper's calibration follows a lidar beam"
@@ -168,15 +152,90 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
         ));
     }
     check_finite_commands(rec)?;
-    let mount = rec
+    let (mount, phi) = beam_direction(rec, beam_index)?;
+    let beam_cos = phi.cos();
+    let (t_s, lidar_m) = beam_readings(lidar, beam_index)?;
+
+    let forward = commanded_forward(rec, &t_s);
+    let commanded_m: Vec<f64> = forward.iter().map(|f| -beam_cos * f).collect();
+    let odometer_travel_m = rec
+        .odometry
+        .as_deref()
+        .map(|odo| interpolate_odometry(odo, &t_s, beam_cos))
+        .transpose()?;
+    let sonar_m = rec
+        .sonar
+        .as_deref()
+        .map(|sonar| nearest_sonar(sonar, &t_s))
+        .transpose()?;
+    let truth_m = match (rec.truth.as_deref(), start) {
+        (Some(truth), Some(d0)) if !truth.is_empty() => Some(truth_distances(
+            truth,
+            &t_s,
+            d0,
+            [mount.x_m, mount.y_m],
+            phi,
+        )?),
+        _ => None,
+    };
+    let turns = rec
+        .commands
+        .iter()
+        .any(|c| (c.left_mps - c.right_mps).abs() > 1e-9);
+    Ok(TargetSamples {
+        t_s,
+        commanded_m,
+        lidar_m,
+        odometer_travel_m,
+        sonar_m,
+        truth_m,
+        start_distance_m: start,
+        beam_cos,
+        turns,
+    })
+}
+
+/// The beam's index in the lidar table: `beam_deg` rounded to a whole degree in 0..360.
+fn beam_index(opts: &SampleOptions) -> Result<u16, CalibrationError> {
+    if !opts.beam_deg.is_finite() {
+        return Err(CalibrationError::Invalid(format!(
+            "beam angle must be finite, got {}",
+            opts.beam_deg
+        )));
+    }
+    Ok(opts.beam_deg.round().rem_euclid(360.0) as u16)
+}
+
+/// The start distance: the caller's, else meta.toml's for the beam straight ahead.
+fn start_distance(
+    rec: &Recording,
+    opts: &SampleOptions,
+    beam_index: u16,
+) -> Result<Option<f64>, CalibrationError> {
+    // meta.toml's start distance is the frontal target's (interfaces.md): it says nothing about
+    // what another beam sees, so another beam needs its own start distance.
+    let meta_start = rec
         .meta
-        .lidar
-        .clone()
-        .unwrap_or(hilsim_recording::LidarMount {
-            x_m: 0.0,
-            y_m: 0.0,
-            yaw_deg: 0.0,
-        });
+        .world
+        .target_start_distance_m
+        .filter(|_| beam_index == 0);
+    match opts.start_distance_m.or(meta_start) {
+        Some(d) if d.is_finite() && d > 0.0 => Ok(Some(d)),
+        Some(d) => Err(CalibrationError::Invalid(format!(
+            "start distance must be a positive number of metres, got {d}"
+        ))),
+        None => Ok(None),
+    }
+}
+
+/// The lidar mount and the beam's direction φ from the robot's forward axis, radians; a beam
+/// (nearly) perpendicular to the motion is an error.
+fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(LidarMount, f64), CalibrationError> {
+    let mount = rec.meta.lidar.clone().unwrap_or(LidarMount {
+        x_m: 0.0,
+        y_m: 0.0,
+        yaw_deg: 0.0,
+    });
     if ![mount.x_m, mount.y_m, mount.yaw_deg]
         .iter()
         .all(|v| v.is_finite())
@@ -196,7 +255,15 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
             mount.yaw_deg
         )));
     }
+    Ok((mount, phi))
+}
 
+/// The beam's reading in each revolution (its instant, and its range or `None` when invalid);
+/// a beam that never, or only in a minority of revolutions, returns a valid reading is an error.
+fn beam_readings(
+    lidar: &[LidarSample],
+    beam_index: u16,
+) -> Result<(Vec<f64>, Vec<Option<f64>>), CalibrationError> {
     let mut t_s = Vec::new();
     let mut lidar_m = Vec::new();
     let mut last_t = f64::NEG_INFINITY;
@@ -246,44 +313,7 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
             t_s.len()
         )));
     }
-
-    let forward = commanded_forward(rec, &t_s);
-    let commanded_m: Vec<f64> = forward.iter().map(|f| -beam_cos * f).collect();
-    let odometer_travel_m = rec
-        .odometry
-        .as_deref()
-        .map(|odo| interpolate_odometry(odo, &t_s, beam_cos))
-        .transpose()?;
-    let sonar_m = rec
-        .sonar
-        .as_deref()
-        .map(|sonar| nearest_sonar(sonar, &t_s))
-        .transpose()?;
-    let truth_m = match (rec.truth.as_deref(), start) {
-        (Some(truth), Some(d0)) if !truth.is_empty() => Some(truth_distances(
-            truth,
-            &t_s,
-            d0,
-            [mount.x_m, mount.y_m],
-            phi,
-        )?),
-        _ => None,
-    };
-    let turns = rec
-        .commands
-        .iter()
-        .any(|c| (c.left_mps - c.right_mps).abs() > 1e-9);
-    Ok(TargetSamples {
-        t_s,
-        commanded_m,
-        lidar_m,
-        odometer_travel_m,
-        sonar_m,
-        truth_m,
-        start_distance_m: start,
-        beam_cos,
-        turns,
-    })
+    Ok((t_s, lidar_m))
 }
 
 fn check_finite_commands(rec: &Recording) -> Result<(), CalibrationError> {
@@ -302,172 +332,6 @@ fn check_finite_commands(rec: &Recording) -> Result<(), CalibrationError> {
         }
     }
     Ok(())
-}
-
-/// `F(t) = ∫_0^t (left + right)/2 dt` at each (sorted) instant, with each command held until
-/// the next and the robot still before the first.
-fn commanded_forward(rec: &Recording, times: &[f64]) -> Vec<f64> {
-    let cmds = &rec.commands;
-    let mut out = Vec::with_capacity(times.len());
-    // Integral up to cmds[i].t_s, advanced lazily.
-    let mut i = 0usize;
-    let mut integral_at_i = 0.0;
-    for &t in times {
-        while i + 1 < cmds.len() && cmds[i + 1].t_s <= t {
-            let v = (cmds[i].left_mps + cmds[i].right_mps) / 2.0;
-            integral_at_i += v * (cmds[i + 1].t_s - cmds[i].t_s);
-            i += 1;
-        }
-        let f = if t <= cmds[0].t_s {
-            0.0
-        } else {
-            let v = (cmds[i].left_mps + cmds[i].right_mps) / 2.0;
-            integral_at_i + v * (t - cmds[i].t_s)
-        };
-        out.push(f);
-    }
-    out
-}
-
-/// Encoder travel along the beam, linearly interpolated at each instant; `None` outside the
-/// encoder log (no extrapolation).
-fn interpolate_odometry(
-    odo: &[OdometrySample],
-    times: &[f64],
-    beam_cos: f64,
-) -> Result<Vec<Option<f64>>, CalibrationError> {
-    for (i, o) in odo.iter().enumerate() {
-        if !(o.t_s.is_finite() && o.left_m.is_finite() && o.right_m.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "odometry.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && o.t_s < odo[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "odometry.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
-    let travel = |o: &OdometrySample| -beam_cos * (o.left_m + o.right_m) / 2.0;
-    let mut j = 0usize;
-    Ok(times
-        .iter()
-        .map(|&t| {
-            let (first, last) = (odo.first()?, odo.last()?);
-            if t < first.t_s || t > last.t_s {
-                return None;
-            }
-            while j + 1 < odo.len() && odo[j + 1].t_s <= t {
-                j += 1;
-            }
-            let a = &odo[j];
-            match odo.get(j + 1) {
-                Some(b) if b.t_s > a.t_s => {
-                    let w = (t - a.t_s) / (b.t_s - a.t_s);
-                    Some(travel(a) + w * (travel(b) - travel(a)))
-                }
-                _ => Some(travel(a)),
-            }
-        })
-        .collect())
-}
-
-/// The sonar ping nearest each instant, if within half the median ping spacing (so that one
-/// ping serves at most the samples around it; a missed echo leaves a gap, not a stale value).
-fn nearest_sonar(
-    sonar: &[SonarSample],
-    times: &[f64],
-) -> Result<Vec<Option<f64>>, CalibrationError> {
-    for (i, s) in sonar.iter().enumerate() {
-        if !(s.t_s.is_finite() && s.range_m.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "sonar.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && s.t_s < sonar[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "sonar.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
-    if sonar.is_empty() {
-        return Ok(vec![None; times.len()]);
-    }
-    let mut gaps: Vec<f64> = sonar.windows(2).map(|w| w[1].t_s - w[0].t_s).collect();
-    gaps.sort_by(f64::total_cmp);
-    // With a single ping there is no spacing to measure; 0.05 s is half the 10 Hz of an
-    // HC-SR04-class sonar.
-    let tolerance = gaps
-        .get(gaps.len() / 2)
-        .map_or(0.05, |g| (g / 2.0).max(1e-6));
-    let mut j = 0usize;
-    Ok(times
-        .iter()
-        .map(|&t| {
-            while j + 1 < sonar.len() && (sonar[j + 1].t_s - t).abs() <= (sonar[j].t_s - t).abs() {
-                j += 1;
-            }
-            let s = &sonar[j];
-            ((s.t_s - t).abs() <= tolerance && s.range_m > 0.0).then_some(s.range_m)
-        })
-        .collect())
-}
-
-/// True distance along the initial beam at each instant (module docs).
-fn truth_distances(
-    truth: &[TruthSample],
-    times: &[f64],
-    start_distance: f64,
-    mount_xy: [f64; 2],
-    phi: f64,
-) -> Result<Vec<f64>, CalibrationError> {
-    for (i, s) in truth.iter().enumerate() {
-        if !(s.t_s.is_finite() && s.x_m.is_finite() && s.y_m.is_finite() && s.yaw_rad.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "truth.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && s.t_s < truth[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "truth.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
-    let lidar_at = |s: &TruthSample| {
-        let (sin, cos) = s.yaw_rad.sin_cos();
-        [
-            s.x_m + cos * mount_xy[0] - sin * mount_xy[1],
-            s.y_m + sin * mount_xy[0] + cos * mount_xy[1],
-        ]
-    };
-    let first = truth[0];
-    let p0 = lidar_at(&first);
-    let e0 = [(first.yaw_rad + phi).cos(), (first.yaw_rad + phi).sin()];
-    let mut j = 0usize;
-    Ok(times
-        .iter()
-        .map(|&t| {
-            while j + 1 < truth.len() && truth[j + 1].t_s <= t {
-                j += 1;
-            }
-            let a = lidar_at(&truth[j]);
-            let p = match truth.get(j + 1) {
-                Some(next) if next.t_s > truth[j].t_s && t > truth[j].t_s => {
-                    let b = lidar_at(next);
-                    let w = (t - truth[j].t_s) / (next.t_s - truth[j].t_s);
-                    [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1])]
-                }
-                _ => a,
-            };
-            start_distance - ((p[0] - p0[0]) * e0[0] + (p[1] - p0[1]) * e0[1])
-        })
-        .collect())
 }
 
 /// MSE and the EM paper's NMSE (Sec. VI: `NMSE = (1/N) Σ (d̂_k − d_k)² / d_k²`) of raw readings
@@ -504,71 +368,4 @@ pub fn distance_metrics(
             nmse_calibrated: nmse_cal / n,
         }
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use hilsim_recording::{CommandSample, LidarSample, Meta};
-
-    fn rec_with(commands: Vec<CommandSample>, revs: u64) -> Recording {
-        let mut rec = Recording::new(Meta::default());
-        rec.meta.world.target_start_distance_m = Some(0.5);
-        rec.commands = commands;
-        rec.lidar = Some(
-            (0..revs)
-                .map(|r| LidarSample {
-                    t_s: r as f64 * 0.2,
-                    rev: r,
-                    angle_deg: 0,
-                    range_m: 1.0,
-                    strength: 100,
-                    invalid: r == 1,
-                    warning: false,
-                    true_range_m: None,
-                })
-                .collect(),
-        );
-        rec
-    }
-
-    #[test]
-    fn reversing_increases_the_distance_and_commands_hold_until_the_next() {
-        let cmds = vec![
-            CommandSample {
-                t_s: 0.1,
-                left_mps: -0.1,
-                right_mps: -0.1,
-            },
-            CommandSample {
-                t_s: 0.5,
-                left_mps: 0.0,
-                right_mps: 0.0,
-            },
-        ];
-        let s = extract(&rec_with(cmds, 5), &SampleOptions::default()).unwrap();
-        // Moving at -0.1 m/s from 0.1 s to 0.5 s: +0.04 m in total, 0.01 m by t = 0.2 s.
-        let expect = [0.0, 0.01, 0.03, 0.04, 0.04];
-        for (c, e) in s.commanded_m.iter().zip(expect) {
-            assert!((c - e).abs() < 1e-12, "{c} vs {e}");
-        }
-        assert_eq!(
-            s.lidar_m[1], None,
-            "an invalid reading is missing, not zero"
-        );
-        assert!((s.u(0) - 0.01).abs() < 1e-12);
-        assert_eq!(s.dead_reckoning(4), Some(0.54));
-    }
-
-    #[test]
-    fn metrics_follow_the_papers_nmse() {
-        let m = distance_metrics(
-            &[1.0, 2.0],
-            &[Some(1.1), Some(2.0)],
-            &[Some(1.0), Some(2.2)],
-        )
-        .unwrap();
-        assert!((m.mse_raw - 0.005).abs() < 1e-12);
-        assert!((m.nmse_calibrated - 0.5 * 0.04 / 4.0).abs() < 1e-12);
-    }
 }

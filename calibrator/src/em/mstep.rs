@@ -17,7 +17,7 @@
 
 use nalgebra::{Cholesky, Matrix2, Matrix3, Vector2, Vector3};
 
-use super::model::{moment, Data, Lin, Params, FLOOR_D_M, SENSORS};
+use super::model::{moment, Data, Lin, Params, SensorParams, StepData, FLOOR_D_M, SENSORS};
 use crate::CalibrationError;
 
 /// Sensor names for messages, by slot.
@@ -44,105 +44,161 @@ pub(crate) fn m_step(
     estimate_q: bool,
 ) -> Result<Params, CalibrationError> {
     let mut next = *params;
-    // One pass over the steps for every sensor: S_φφ (full 3×3, of which each sensor uses its
-    // n_alpha block), S_yφ, Σ w y², N.
-    let mut sxx = [Matrix3::<f64>::zeros(); SENSORS];
-    let mut sxy = [Vector3::<f64>::zeros(); SENSORS];
-    let mut syy = [0.0; SENSORS];
-    let mut count = [0usize; SENSORS];
-    let active = params.sensors.map(|s| s.active);
-    let power = params.sensors.map(|s| s.power as i32);
-    for (k, step) in data.steps.iter().enumerate() {
-        let (m, cov) = (post.means[k], post.covs[k]);
-        if second_order {
-            // E[d^j] for j = −4..=4 (index j + 4) under the smoothed Gaussian of d.
-            let v = cov[(0, 0)].max(0.0);
-            let mut e = [0.0; 9];
-            for (i, e) in e.iter_mut().enumerate() {
-                *e = moment(m[0], v, i as i32 - 4);
-            }
-            for slot in 0..SENSORS {
-                if !(active[slot] && step.has[slot]) {
-                    continue;
-                }
-                let y = step.y[slot];
-                // E[w φ_i φ_j] = E[d^(i + j − 2p)].
-                let base = (4 - 2 * power[slot]) as usize;
-                for i in 0..3 {
-                    for j in 0..3 {
-                        sxx[slot][(i, j)] += e[base + i + j];
-                    }
-                    sxy[slot][i] += y * e[base + i];
-                }
-                syy[slot] += y * y * e[base];
-                count[slot] += 1;
-            }
-        } else {
-            let phi = Vector3::new(1.0, m[0], m[1]);
-            let mut e = phi * phi.transpose();
-            e[(1, 1)] += cov[(0, 0)];
-            e[(1, 2)] += cov[(0, 1)];
-            e[(2, 1)] += cov[(1, 0)];
-            e[(2, 2)] += cov[(1, 1)];
-            for slot in 0..SENSORS {
-                if !(active[slot] && step.has[slot]) {
-                    continue;
-                }
-                let y = step.y[slot];
-                // The paper's weight: the noise shape at the previous smoothed state.
-                let shape = match power[slot] {
-                    0 => 1.0,
-                    1 => lin[k].m * lin[k].m,
-                    _ => lin[k].d2 * lin[k].d2,
-                };
-                let w = 1.0 / shape;
-                sxx[slot] += w * e;
-                sxy[slot] += (w * y) * phi;
-                syy[slot] += w * y * y;
-                count[slot] += 1;
-            }
-        }
-    }
+    let sums = Sums::over(data, params, post, lin, second_order);
     for (slot, sensor) in next.sensors.iter_mut().enumerate() {
         if !sensor.active {
             continue;
         }
-        let (n_alpha, n, name) = (sensor.n_alpha, count[slot], NAMES[slot]);
-        if n <= n_alpha {
-            return Err(CalibrationError::TooFewSamples(format!(
-                "{n} {name} readings cannot fit {n_alpha} bias coefficients and a noise level"
-            )));
-        }
-        let (mut a, mut b) = (sxx[slot], sxy[slot]);
-        // An affine sensor: pin the unused d² coefficient to 0 with an identity row.
-        for i in n_alpha..3 {
-            for j in 0..3 {
-                a[(i, j)] = 0.0;
-                a[(j, i)] = 0.0;
-            }
-            a[(i, i)] = 1.0;
-            b[i] = 0.0;
-        }
-        let alpha = Cholesky::new(a).map(|c| c.solve(&b)).ok_or_else(|| {
-            CalibrationError::Diverged(format!(
-                "the {name} normal equations are singular (the distances do not vary enough to \
-                 separate the bias coefficients)"
-            ))
-        })?;
-        let beta2 = (syy[slot] - alpha.dot(&b)) / n as f64;
-        if !(beta2 > 0.0 && beta2.is_finite() && alpha.iter().all(|a| a.is_finite())) {
-            return Err(CalibrationError::Diverged(format!(
-                "the {name} noise variance came out {beta2:e} (non-positive or non-finite)"
-            )));
-        }
-        sensor.alpha = [alpha[0], alpha[1], alpha[2]];
-        sensor.beta = [0.0; 3];
-        sensor.beta[sensor.power] = beta2.sqrt();
+        fit_sensor(sensor, slot, &sums)?;
     }
     if estimate_q {
         next.q_rel = q_step(data, post, params.q_rel)?;
     }
     Ok(next)
+}
+
+/// The sums of the closed forms, per sensor slot: S_φφ (full 3×3, of which each sensor uses its
+/// n_alpha block), S_yφ, Σ w y², N.
+struct Sums {
+    sxx: [Matrix3<f64>; SENSORS],
+    sxy: [Vector3<f64>; SENSORS],
+    syy: [f64; SENSORS],
+    count: [usize; SENSORS],
+}
+
+impl Sums {
+    /// One pass over the steps for every sensor.
+    fn over(
+        data: &Data,
+        params: &Params,
+        post: &Posterior<'_>,
+        lin: &[Lin],
+        second_order: bool,
+    ) -> Self {
+        let mut sums = Self {
+            sxx: [Matrix3::<f64>::zeros(); SENSORS],
+            sxy: [Vector3::<f64>::zeros(); SENSORS],
+            syy: [0.0; SENSORS],
+            count: [0usize; SENSORS],
+        };
+        let active = params.sensors.map(|s| s.active);
+        let power = params.sensors.map(|s| s.power as i32);
+        for (k, step) in data.steps.iter().enumerate() {
+            let (m, cov) = (post.means[k], post.covs[k]);
+            if second_order {
+                sums.add_second_order(step, m, cov, active, power);
+            } else {
+                sums.add_paper(step, m, cov, &lin[k], active, power);
+            }
+        }
+        sums
+    }
+
+    /// A step's terms with the expectations under the smoothed Gaussian of `d`, `w` included.
+    fn add_second_order(
+        &mut self,
+        step: &StepData,
+        m: Vector2<f64>,
+        cov: Matrix2<f64>,
+        active: [bool; SENSORS],
+        power: [i32; SENSORS],
+    ) {
+        // E[d^j] for j = −4..=4 (index j + 4) under the smoothed Gaussian of d.
+        let v = cov[(0, 0)].max(0.0);
+        let mut e = [0.0; 9];
+        for (i, e) in e.iter_mut().enumerate() {
+            *e = moment(m[0], v, i as i32 - 4);
+        }
+        for slot in 0..SENSORS {
+            if !(active[slot] && step.has[slot]) {
+                continue;
+            }
+            let y = step.y[slot];
+            // E[w φ_i φ_j] = E[d^(i + j − 2p)].
+            let base = (4 - 2 * power[slot]) as usize;
+            for i in 0..3 {
+                for j in 0..3 {
+                    self.sxx[slot][(i, j)] += e[base + i + j];
+                }
+                self.sxy[slot][i] += y * e[base + i];
+            }
+            self.syy[slot] += y * y * e[base];
+            self.count[slot] += 1;
+        }
+    }
+
+    /// A step's terms as the paper takes them: `w` frozen at the linearisation point,
+    /// `E[φ φᵀ] = x̂ x̂ᵀ + P`.
+    fn add_paper(
+        &mut self,
+        step: &StepData,
+        m: Vector2<f64>,
+        cov: Matrix2<f64>,
+        lin: &Lin,
+        active: [bool; SENSORS],
+        power: [i32; SENSORS],
+    ) {
+        let phi = Vector3::new(1.0, m[0], m[1]);
+        let mut e = phi * phi.transpose();
+        e[(1, 1)] += cov[(0, 0)];
+        e[(1, 2)] += cov[(0, 1)];
+        e[(2, 1)] += cov[(1, 0)];
+        e[(2, 2)] += cov[(1, 1)];
+        for slot in 0..SENSORS {
+            if !(active[slot] && step.has[slot]) {
+                continue;
+            }
+            let y = step.y[slot];
+            // The paper's weight: the noise shape at the previous smoothed state.
+            let shape = match power[slot] {
+                0 => 1.0,
+                1 => lin.m * lin.m,
+                _ => lin.d2 * lin.d2,
+            };
+            let w = 1.0 / shape;
+            self.sxx[slot] += w * e;
+            self.sxy[slot] += (w * y) * phi;
+            self.syy[slot] += w * y * y;
+            self.count[slot] += 1;
+        }
+    }
+}
+
+/// One sensor's α and β from the sums: `α = S_yφ S_φφ⁻¹` (an affine sensor's d² coefficient
+/// pinned to 0), `β² = (Σ y² E[w] − α · S_yφ) / N`.
+fn fit_sensor(sensor: &mut SensorParams, slot: usize, sums: &Sums) -> Result<(), CalibrationError> {
+    let (n_alpha, n, name) = (sensor.n_alpha, sums.count[slot], NAMES[slot]);
+    if n <= n_alpha {
+        return Err(CalibrationError::TooFewSamples(format!(
+            "{n} {name} readings cannot fit {n_alpha} bias coefficients and a noise level"
+        )));
+    }
+    let (mut a, mut b) = (sums.sxx[slot], sums.sxy[slot]);
+    // An affine sensor: pin the unused d² coefficient to 0 with an identity row.
+    for i in n_alpha..3 {
+        for j in 0..3 {
+            a[(i, j)] = 0.0;
+            a[(j, i)] = 0.0;
+        }
+        a[(i, i)] = 1.0;
+        b[i] = 0.0;
+    }
+    let alpha = Cholesky::new(a).map(|c| c.solve(&b)).ok_or_else(|| {
+        CalibrationError::Diverged(format!(
+            "the {name} normal equations are singular (the distances do not vary enough to \
+             separate the bias coefficients)"
+        ))
+    })?;
+    let beta2 = (sums.syy[slot] - alpha.dot(&b)) / n as f64;
+    if !(beta2 > 0.0 && beta2.is_finite() && alpha.iter().all(|a| a.is_finite())) {
+        return Err(CalibrationError::Diverged(format!(
+            "the {name} noise variance came out {beta2:e} (non-positive or non-finite)"
+        )));
+    }
+    sensor.alpha = [alpha[0], alpha[1], alpha[2]];
+    sensor.beta = [0.0; 3];
+    sensor.beta[sensor.power] = beta2.sqrt();
+    Ok(())
 }
 
 /// The M-step for `q` in `σ_k = q |u_k|` (Shumway–Stoffer's `Q` update, restricted to this

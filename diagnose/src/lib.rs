@@ -40,6 +40,7 @@ pub use catalogue::{Effect, ParamSpec, Sensor};
 pub use diagnosis::diagnose;
 pub use error::MismatchError;
 pub use explain::CandidateFit;
+pub use hilsim_recording::Pose;
 pub use locate::{Evidence, TestKind};
 pub use outcome::{Diagnosis, Options, SensorSummary, Verdict};
 pub use physics::{
@@ -49,4 +50,4 @@ pub use physics::{
 pub use plot::PlotData;
 pub use residuals::Covariate;
 pub use sim_physics::SimPhysics;
-pub use trajectory::{wrap, Pose2, Trajectory};
+pub use trajectory::{wrap, Trajectory};

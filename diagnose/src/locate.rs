@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 
 use crate::catalogue::Sensor;
 use crate::residuals::{Covariate, Fit, SensorData};
-use crate::stats::{chi2_score, ljung_box, normal_quantile, normal_sf};
+use crate::stats::{chi2_score, ljung_box};
+use hilsim_lidar_emulator::normal;
 
 /// Readings a bin needs to be tested.
 const MIN_BIN: usize = 30;
@@ -54,11 +55,11 @@ pub struct Evidence {
 
 /// A two-sided normal statistic as a one-sided score (the same tail probability).
 fn two_sided(t: f64) -> f64 {
-    let p = 2.0 * normal_sf(t.abs());
+    let p = 2.0 * normal::sf(t.abs());
     if p < 1e-300 {
         t.abs()
     } else {
-        -normal_quantile(p.min(1.0))
+        -normal::quantile(p.min(1.0))
     }
 }
 
@@ -419,5 +420,5 @@ impl<'a> Scores<'a> {
 /// (Bonferroni).
 #[must_use]
 pub fn threshold(alpha: f64, tests: usize) -> f64 {
-    -normal_quantile(alpha / tests.max(1) as f64)
+    -normal::quantile(alpha / tests.max(1) as f64)
 }

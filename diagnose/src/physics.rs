@@ -1,14 +1,17 @@
 //! The physics the diagnosis asks about, behind a small trait: what the scenario's sensors
 //! should read from a trajectory, and where its robot goes under recorded commands — nominally,
-//! or with one catalogued effect switched on with given parameters. `hilsim` implements it from
-//! the simulator (`hilsim-sim`, `hilsim-lidar-emulator`); this crate never depends on them (or on
-//! rapier), so the statistics here would work with any simulator that implements the trait.
+//! or with one catalogued effect switched on with given parameters. [`crate::SimPhysics`]
+//! implements it from the simulator (`hilsim-sim`, `hilsim-lidar-emulator`); the trait itself
+//! speaks only in the recording's samples and the normal distribution's [`Gaussian`], so the
+//! statistics here would work with any simulator that implements it.
 
+pub use hilsim_lidar_emulator::normal::Gaussian;
 use hilsim_recording::{CommandSample, TruthSample};
 
 use crate::catalogue::Effect;
-use crate::stats::{ln_normal_pdf, normal_cdf, normal_sf};
-use crate::trajectory::{Pose2, Trajectory};
+use hilsim_recording::Pose;
+
+use crate::trajectory::Trajectory;
 
 /// A model to predict with: the nominal one, or the nominal one with one effect switched on
 /// with `params` (in the order of [`Effect::params`]).
@@ -54,7 +57,7 @@ pub struct Declared {
     /// The scenario's name.
     pub scenario: String,
     /// The robot's start pose.
-    pub start: Pose2,
+    pub start: Pose,
     /// The distance between the wheels, metres.
     pub wheel_base_m: f64,
     /// The lidar, when the robot has one.
@@ -88,126 +91,6 @@ pub struct DeclaredLidar {
     pub rpm: f64,
     /// The farthest valid range, metres.
     pub max_range_m: f64,
-}
-
-/// One component of a predictive mixture: a normal distribution, truncated to the interval in
-/// which the sensor reports a reading at all (a lidar's range limits: a reading beyond them is
-/// reported invalid, so a valid one near a limit comes from the part of the normal inside it).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gaussian {
-    /// Weight (a prediction's weights sum to 1).
-    pub weight: f64,
-    /// Mean of the untruncated normal, metres.
-    pub mean_m: f64,
-    /// Standard deviation of the untruncated normal, metres (> 0).
-    pub sd_m: f64,
-    /// The smallest reading reported (−∞: no limit).
-    pub lower_m: f64,
-    /// The largest reading reported (+∞: no limit).
-    pub upper_m: f64,
-}
-
-impl Gaussian {
-    /// An untruncated normal with weight `weight`.
-    #[must_use]
-    pub fn new(weight: f64, mean_m: f64, sd_m: f64) -> Self {
-        Self {
-            weight,
-            mean_m,
-            sd_m,
-            lower_m: f64::NEG_INFINITY,
-            upper_m: f64::INFINITY,
-        }
-    }
-
-    /// The same normal truncated to `[lower_m, upper_m]`.
-    #[must_use]
-    pub fn truncated(self, lower_m: f64, upper_m: f64) -> Self {
-        Self {
-            lower_m,
-            upper_m,
-            ..self
-        }
-    }
-
-    fn bounds(&self) -> (f64, f64) {
-        (
-            (self.lower_m - self.mean_m) / self.sd_m,
-            (self.upper_m - self.mean_m) / self.sd_m,
-        )
-    }
-
-    /// The probability the untruncated normal puts inside the interval (computed on the side of
-    /// the median that keeps its precision).
-    fn mass(&self) -> f64 {
-        let (a, b) = self.bounds();
-        if a > 0.0 {
-            normal_sf(a) - normal_sf(b)
-        } else {
-            normal_cdf(b) - normal_cdf(a)
-        }
-        .max(f64::MIN_POSITIVE)
-    }
-
-    /// `ln` of the density at `y` (−∞ outside the interval).
-    #[must_use]
-    pub fn ln_density(&self, y: f64) -> f64 {
-        if y < self.lower_m || y > self.upper_m {
-            return f64::NEG_INFINITY;
-        }
-        let z = (y - self.mean_m) / self.sd_m;
-        ln_normal_pdf(z) - self.sd_m.ln() - self.truncation_ln_mass()
-    }
-
-    fn truncation_ln_mass(&self) -> f64 {
-        if self.lower_m == f64::NEG_INFINITY && self.upper_m == f64::INFINITY {
-            0.0
-        } else {
-            self.mass().ln()
-        }
-    }
-
-    /// The distribution function at `y`.
-    #[must_use]
-    pub fn cdf(&self, y: f64) -> f64 {
-        if self.lower_m == f64::NEG_INFINITY && self.upper_m == f64::INFINITY {
-            return normal_cdf((y - self.mean_m) / self.sd_m);
-        }
-        let (a, _) = self.bounds();
-        let z = (y - self.mean_m) / self.sd_m;
-        let below = if a > 0.0 {
-            normal_sf(a) - normal_sf(z)
-        } else {
-            normal_cdf(z) - normal_cdf(a)
-        };
-        (below / self.mass()).clamp(0.0, 1.0)
-    }
-
-    /// The mean and the standard deviation of the truncated distribution (the standard
-    /// truncated-normal moments: Johnson, Kotz & Balakrishnan, *Continuous Univariate
-    /// Distributions* 1, §10.1).
-    #[must_use]
-    pub fn moments(&self) -> (f64, f64) {
-        if self.lower_m == f64::NEG_INFINITY && self.upper_m == f64::INFINITY {
-            return (self.mean_m, self.sd_m);
-        }
-        let (a, b) = self.bounds();
-        let z = self.mass();
-        let pdf = |x: f64| {
-            if x.is_finite() {
-                ln_normal_pdf(x).exp()
-            } else {
-                0.0
-            }
-        };
-        let x_pdf = |x: f64| if x.is_finite() { x * pdf(x) } else { 0.0 };
-        let shift = (pdf(a) - pdf(b)) / z;
-        let var = 1.0 + (x_pdf(a) - x_pdf(b)) / z - shift * shift;
-        (
-            self.mean_m + self.sd_m * shift,
-            self.sd_m * var.max(1e-12).sqrt(),
-        )
-    }
 }
 
 /// One lidar reading to predict.
@@ -297,7 +180,7 @@ pub struct OdometryPrediction {
 ///     }
 /// }
 /// let physics = Corridor(Declared {
-///     scenario: "corridor".into(), start: Pose2::default(), wheel_base_m: 0.23,
+///     scenario: "corridor".into(), start: Pose::default(), wheel_base_m: 0.23,
 ///     lidar: Some(DeclaredLidar { snapshot: false, rpm: 300.0, max_range_m: 6.0 }),
 ///     sonar_half_angle_deg: None, odometer: false,
 ///     actuation: Default::default(),
@@ -358,52 +241,4 @@ pub trait Physics: Sync {
         times: &[f64],
         hypothesis: &Hypothesis,
     ) -> Vec<OdometryPrediction>;
-}
-
-#[cfg(test)]
-mod tests {
-    use super::Gaussian;
-
-    /// The truncated component against a midpoint-rule integration of the normal density over
-    /// the interval (10⁵ steps: the rule's error is ~1e-10 here, far below the tolerances).
-    #[test]
-    fn a_truncated_component_is_the_normal_renormalised_inside_its_interval() {
-        let g = Gaussian::new(1.0, 5.9, 0.1).truncated(0.2, 6.0);
-        let (lo, hi, steps) = (0.2_f64, 6.0_f64, 100_000);
-        let dx = (hi - lo) / f64::from(steps);
-        let (mut mass, mut first, mut second, mut below) = (0.0, 0.0, 0.0, 0.0);
-        for i in 0..steps {
-            let x = lo + (f64::from(i) + 0.5) * dx;
-            let p = g.ln_density(x).exp() * dx;
-            mass += p;
-            first += x * p;
-            second += x * x * p;
-            if i < 98_276 {
-                below += p;
-            }
-        }
-        assert!((mass - 1.0).abs() < 1e-6, "density integrates to {mass}");
-        let (mean, sd) = g.moments();
-        assert!((mean - first).abs() < 1e-6, "{mean} vs {first}");
-        // Central, normalised: Σx²p − (Σxp)² would multiply the mass's rounding by ~34 m².
-        let numeric_sd = (second / mass - (first / mass).powi(2)).sqrt();
-        assert!((sd - numeric_sd).abs() < 1e-6, "{sd} vs {numeric_sd}");
-        // Cut at 1 σ above the mean: the valid readings' mean is 0.29 σ below it.
-        assert!((5.9 - mean - 0.1 * 0.2876).abs() < 1e-4, "{mean}");
-        // At the cell edge nearest the normal's mean (5.9 m).
-        let edge = lo + 98_276.0 * dx;
-        assert!(
-            (g.cdf(edge) - below).abs() < 1e-6,
-            "{} vs {below}",
-            g.cdf(edge)
-        );
-        assert_eq!(g.cdf(6.0), 1.0);
-        assert_eq!(g.cdf(0.1), 0.0);
-        assert_eq!(g.ln_density(6.001), f64::NEG_INFINITY);
-        // Untruncated: the plain normal.
-        let n = Gaussian::new(1.0, 1.0, 0.5);
-        assert_eq!(n.moments(), (1.0, 0.5));
-        // (`normal_cdf` is good to 1.2e-7.)
-        assert!((n.cdf(1.0) - 0.5).abs() < 2e-7);
-    }
 }

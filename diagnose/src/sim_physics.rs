@@ -5,11 +5,11 @@
 
 use crate::{
     Declared, DeclaredActuation, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
-    LidarQuery, MismatchError, OdometryPrediction, Physics, Pose2, SonarPrediction, Trajectory,
+    LidarQuery, MismatchError, OdometryPrediction, Physics, SonarPrediction, Trajectory,
 };
 use hilsim_lidar_emulator::effects::LidarEffects;
 use hilsim_lidar_emulator::prediction::{
-    BeamNodes, Component, LidarPredictor, OdometerPredictor, SonarPredictor,
+    BeamNodes, LidarPredictor, OdometerPredictor, SonarPredictor,
 };
 use hilsim_recording::{CommandSample, TruthSample};
 use hilsim_sim::scenario::{self, Effects, LidarTiming};
@@ -43,11 +43,8 @@ pub struct SimPhysics {
     clear: RwLock<HashMap<BeamKey, bool>>,
 }
 
-fn gaussian(c: Component) -> Gaussian {
-    Gaussian::new(c.weight, c.mean_m, c.sd_m)
-}
-
-fn pose(p: Pose2) -> Pose {
+/// `p` with its heading wrapped as the simulator keeps every pose.
+fn pose(p: Pose) -> Pose {
     Pose::new(p.x, p.y, p.yaw)
 }
 
@@ -91,7 +88,7 @@ impl SimPhysics {
             world: World::new(scenario),
             declared: Declared {
                 scenario: s.name.clone(),
-                start: Pose2 {
+                start: Pose {
                     x: s.robot.start.x,
                     y: s.robot.start.y,
                     yaw: hilsim_sim::pose::wrap_angle(s.robot.start.yaw_deg.to_radians()),
@@ -305,11 +302,7 @@ impl Physics for SimPhysics {
                         }
                     };
                     LidarPrediction {
-                        components: e
-                            .components
-                            .into_iter()
-                            .map(|c| gaussian(c).truncated(e.valid_range_m.0, e.valid_range_m.1))
-                            .collect(),
+                        components: e.components,
                         true_range_m: e.true_range_m,
                         incidence_deg: e.cos_incidence.clamp(0.0, 1.0).acos().to_degrees(),
                         object: e.obstacle.map(|o| self.object_id(o)),
@@ -353,7 +346,7 @@ impl Physics for SimPhysics {
                 let robot = pose(trajectory.pose_at(t));
                 let p = predictor.predict(&self.world, &robot);
                 SonarPrediction {
-                    reading: p.map(|p| gaussian(p.reading)),
+                    reading: p.map(|p| p.reading),
                     true_range_m: p.map(|p| p.true_range_m),
                     wide_cone_m: wide
                         .as_ref()
@@ -407,7 +400,7 @@ impl Physics for SimPhysics {
                     _ => [0.0; 2],
                 };
                 OdometryPrediction {
-                    wheels: [0, 1].map(|w| gaussian(predictor.predict(at[w], speed[w]))),
+                    wheels: [0, 1].map(|w| predictor.predict(at[w], speed[w])),
                     speed_mps: speed,
                 }
             })

@@ -8,6 +8,7 @@ mod emulation;
 pub mod lidar;
 mod mount;
 pub mod neato_packet;
+pub mod normal;
 mod odometer;
 pub mod prediction;
 mod range_model;

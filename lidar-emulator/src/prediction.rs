@@ -19,25 +19,9 @@ use hilsim_sim::{scenario, Obstacle, Pose, World};
 use crate::effects::{BeamReturn, LidarEffects};
 use crate::mount::Mount;
 use crate::neato_packet::MAX_DISTANCE_MM;
+use crate::normal::Gaussian;
 use crate::range_model::{ModelError, RangeModel};
 use crate::sonar::Sonar;
-
-/// `P(Z ≤ z)` for a standard normal Z (Abramowitz & Stegun 7.1.26 for erf: absolute error
-/// below 1.5e-7, ample for a weight).
-fn normal_cdf(z: f64) -> f64 {
-    let x = z.abs() / std::f64::consts::SQRT_2;
-    let t = 1.0 / (1.0 + 0.327_591_1 * x);
-    let poly = t
-        * (0.254_829_592
-            + t * (-0.284_496_736
-                + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
-    let erf = 1.0 - poly * (-x * x).exp();
-    if z >= 0.0 {
-        0.5 * (1.0 + erf)
-    } else {
-        0.5 * (1.0 - erf)
-    }
-}
 
 /// Variance of rounding to whole millimetres, m².
 const ROUNDING_VAR_M2: f64 = 1e-6 / 12.0;
@@ -68,24 +52,14 @@ const GH_WEIGHTS: [f64; 7] = [
 const DENSE_NODES: usize = 15;
 const DENSE_SPACING: f64 = 0.5;
 
-/// One Gaussian of a predictive mixture.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Component {
-    /// Its weight; a prediction's weights sum to 1.
-    pub weight: f64,
-    /// The expected reading, metres.
-    pub mean_m: f64,
-    /// The reading's standard deviation, metres.
-    pub sd_m: f64,
-}
-
 /// The predictive distribution of one lidar reading, and the beam's geometry.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExpectedLidar {
     /// The mixture a valid reading is drawn from: one Gaussian per surface the beam's direction
-    /// noise can land on; empty when no valid reading is expected (nothing hit, or out of
-    /// range).
-    pub components: Vec<Component>,
+    /// noise can land on, truncated to the readings reported valid (a reading beyond a range
+    /// limit is reported invalid instead); empty when no valid reading is expected (nothing
+    /// hit, or out of range).
+    pub components: Vec<Gaussian>,
     /// The centre ray's true range, when it hit something.
     pub true_range_m: Option<f64>,
     /// `|cos θ|` of the centre ray on its surface.
@@ -96,9 +70,6 @@ pub struct ExpectedLidar {
     pub reflectivity: f64,
     /// Whether the beam's direction noise (or its footprint) reaches another surface.
     pub near_edge: bool,
-    /// The readings reported valid, `[min, max]` metres: each component is the part of its
-    /// Gaussian inside (a reading beyond a limit is reported invalid instead).
-    pub valid_range_m: (f64, f64),
 }
 
 /// What a beam's quadrature directions see: the geometry of one reading, before any range
@@ -252,7 +223,6 @@ impl LidarPredictor {
             obstacle: centre.map(|c| c.hit.obstacle),
             reflectivity: centre.map_or(0.0, |c| c.hit.reflectivity),
             near_edge: false,
-            valid_range_m: (self.min_m, self.max_m),
         };
         // (weight × chance of a valid reading, mean, variance, surface, weight) per node whose
         // reading can be valid.
@@ -271,8 +241,7 @@ impl LidarPredictor {
             let var = sd * sd + ROUNDING_VAR_M2;
             // A reading outside [min, max] is reported invalid: a valid one comes from the part
             // of each node's distribution inside (its weight the probability of landing there).
-            let valid = normal_cdf((self.max_m - mean) / var.sqrt())
-                - normal_cdf((self.min_m - mean) / var.sqrt());
+            let valid = self.limited(Gaussian::new(1.0, mean, var.sqrt())).mass();
             nodes.push((valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle, *w)));
         }
         if beam.dense {
@@ -298,19 +267,18 @@ impl LidarPredictor {
                 } else {
                     steps.iter().sum::<f64>() / steps.len() as f64
                 };
-                out.components.push(Component {
-                    weight: w,
-                    mean_m: mean,
-                    sd_m: (var + spread * spread / 12.0).sqrt(),
-                });
+                out.components.push(self.limited(Gaussian::new(
+                    w,
+                    mean,
+                    (var + spread * spread / 12.0).sqrt(),
+                )));
             }
         } else {
             // One surface: the quadrature's mean and variance of the reading over the direction
             // noise, one Gaussian per surface (a single one unless a node fell off the range).
             // The moments are of the reading before the range limits (weights: the directions'
-            // own), so that the limits, applied once to the surface's Gaussian
-            // (`valid_range_m`), are not applied twice; its weight is its chance of a valid
-            // reading.
+            // own), so that the limits, applied once to the surface's Gaussian (its
+            // truncation), are not applied twice; its weight is its chance of a valid reading.
             let mut groups: Vec<(Obstacle, f64, f64, f64, f64)> = Vec::with_capacity(1);
             for (wv, mean, var, what, w) in nodes.into_iter().flatten() {
                 match groups.iter_mut().find(|g| g.0 == what) {
@@ -327,11 +295,8 @@ impl LidarPredictor {
             for (_, wv, sm, ss, w) in groups {
                 let mean = sm / w;
                 let var = (ss / w - mean * mean).max(ROUNDING_VAR_M2);
-                out.components.push(Component {
-                    weight: wv,
-                    mean_m: mean,
-                    sd_m: var.sqrt(),
-                });
+                out.components
+                    .push(self.limited(Gaussian::new(wv, mean, var.sqrt())));
             }
         }
         let total: f64 = out.components.iter().map(|c| c.weight).sum();
@@ -341,6 +306,11 @@ impl LidarPredictor {
             }
         }
         out
+    }
+
+    /// `g` truncated to the readings reported valid.
+    fn limited(&self, g: Gaussian) -> Gaussian {
+        g.truncated(self.min_m, self.max_m)
     }
 
     /// The reading at `angle_deg` (lidar frame) when the robot is at `robot`, `t_s` seconds
@@ -355,7 +325,7 @@ impl LidarPredictor {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExpectedSonar {
     /// The expected reading and its spread.
-    pub reading: Component,
+    pub reading: Gaussian,
     /// The nearest echo's true range, metres.
     pub true_range_m: f64,
 }
@@ -384,11 +354,7 @@ impl SonarPredictor {
         let mean = self.sonar.mean_reading_m(d);
         let sd = self.sonar.reading_sd_m(d);
         Some(ExpectedSonar {
-            reading: Component {
-                weight: 1.0,
-                mean_m: mean,
-                sd_m: (sd * sd + ROUNDING_VAR_M2).sqrt(),
-            },
+            reading: Gaussian::new(1.0, mean, (sd * sd + ROUNDING_VAR_M2).sqrt()),
             true_range_m: d,
         })
     }
@@ -417,14 +383,10 @@ impl OdometerPredictor {
     /// The expected reading of one wheel whose true cumulative travel is `travel_m` while it
     /// turns at `speed_mps` (its speed during the physics step), and the reading's spread.
     #[must_use]
-    pub fn predict(&self, travel_m: f64, speed_mps: f64) -> Component {
+    pub fn predict(&self, travel_m: f64, speed_mps: f64) -> Gaussian {
         let slip = self
             .slip_gain_s
             .map_or(0.0, |g| crate::effects::slip_travel_m(g, speed_mps));
-        Component {
-            weight: 1.0,
-            mean_m: (travel_m + slip) * self.scale,
-            sd_m: self.sd_m,
-        }
+        Gaussian::new(1.0, (travel_m + slip) * self.scale, self.sd_m)
     }
 }

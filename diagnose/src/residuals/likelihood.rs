@@ -3,7 +3,7 @@
 
 use super::data::{Predictive, SensorData, Z_CLIP};
 use crate::physics::Gaussian;
-use crate::stats::normal_quantile;
+use hilsim_lidar_emulator::normal;
 
 /// How well one prediction fits one reading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,7 +58,7 @@ pub(crate) fn fit(y: f64, pred: &[Gaussian], epsilon: f64, outlier_density: f64)
     let (mean, sd) = pred[best.1].moments();
     Fit {
         ll,
-        z: normal_quantile(u).clamp(-Z_CLIP, Z_CLIP),
+        z: normal::quantile(u).clamp(-Z_CLIP, Z_CLIP),
         residual: y - mean,
         sd,
         outlier: outlier_density > (1.0 - epsilon) * density,

@@ -6,7 +6,8 @@ use std::sync::OnceLock;
 
 use hilsim_calibrator::landmarks::monte_carlo::PAPER_ALPHA;
 use hilsim_calibrator::landmarks::regression::horner;
-use hilsim_calibrator::landmarks::{analyse, pose::Pose2, Analysis, Nominal, Options};
+use hilsim_calibrator::landmarks::{analyse, Analysis, Nominal, Options};
+use hilsim_recording::Pose;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
@@ -37,7 +38,7 @@ fn analysis() -> &'static Analysis {
 /// The scenario's cylinders in the frame of the robot's start pose.
 fn true_landmarks() -> Vec<[f64; 2]> {
     let s = scenario();
-    let start = Pose2::new(
+    let start = Pose::new(
         s.robot.start.x,
         s.robot.start.y,
         s.robot.start.yaw_deg.to_radians(),
@@ -51,14 +52,14 @@ fn true_landmarks() -> Vec<[f64; 2]> {
 
 /// The true pose of the lidar during a stop, start-pose frame (the mount is at the robot's
 /// centre in landmarks-5).
-fn true_pose(rec: &Recording, t0: f64) -> Pose2 {
+fn true_pose(rec: &Recording, t0: f64) -> Pose {
     let truth = rec.truth.as_ref().expect("the emulator records truth");
-    let first = Pose2::new(truth[0].x_m, truth[0].y_m, truth[0].yaw_rad);
+    let first = Pose::new(truth[0].x_m, truth[0].y_m, truth[0].yaw_rad);
     let t = truth
         .iter()
         .find(|t| t.t_s >= t0)
         .expect("truth covers the stop");
-    Pose2::new(t.x_m, t.y_m, t.yaw_rad).relative_to(&first)
+    Pose::new(t.x_m, t.y_m, t.yaw_rad).relative_to(&first)
 }
 
 #[test]
@@ -76,8 +77,7 @@ fn detects_exactly_the_five_cylinders_and_no_wall() {
             .iter()
             .map(|c| {
                 let (dx, dy) = (c[0] - p.x, c[1] - p.y);
-                let b =
-                    hilsim_calibrator::landmarks::pose::wrap(dy.atan2(dx) - p.yaw - d.bearing_rad);
+                let b = hilsim_recording::wrap_angle(dy.atan2(dx) - p.yaw - d.bearing_rad);
                 (b.abs(), dx.hypot(dy) - a.radius_m)
             })
             .min_by(|x, y| x.0.total_cmp(&y.0))
@@ -288,7 +288,7 @@ fn walls_boards_poles_and_columns_are_not_landmarks() {
         let p = true_pose(&rec, a.stops[d.stop].t_start_s);
         let near = landmarks.iter().any(|c| {
             let b = (c.center[1] - p.y).atan2(c.center[0] - p.x);
-            hilsim_calibrator::landmarks::pose::wrap(b - d.bearing_rad).abs() < 2f64.to_radians()
+            hilsim_recording::wrap_angle(b - d.bearing_rad).abs() < 2f64.to_radians()
         });
         assert!(
             near,

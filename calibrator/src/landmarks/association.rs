@@ -10,14 +10,14 @@
 
 use super::detection::Detection;
 use super::options::AssociationOptions;
-use super::pose::Pose2;
+use hilsim_recording::Pose;
 
 /// A landmark's detections: indices into the detection list, one per stop at most.
 pub type Track = Vec<usize>;
 
 /// Where a detection puts the landmark's centre, start-pose frame.
 #[must_use]
-pub fn place(det: &Detection, sensor: &Pose2, radius_m: f64) -> [f64; 2] {
+pub fn place(det: &Detection, sensor: &Pose, radius_m: f64) -> [f64; 2] {
     let a = sensor.yaw + det.bearing_rad;
     let r = det.range_m + radius_m;
     [sensor.x + r * a.cos(), sensor.y + r * a.sin()]
@@ -27,7 +27,7 @@ pub fn place(det: &Detection, sensor: &Pose2, radius_m: f64) -> [f64; 2] {
 #[must_use]
 pub fn associate(
     dets: &[Detection],
-    sensors: &[Pose2],
+    sensors: &[Pose],
     radius_m: f64,
     opts: &AssociationOptions,
 ) -> Vec<Track> {

@@ -15,11 +15,11 @@ use super::association::{associate, place, Track};
 use super::detection::{candidate_radii, detect, Detection, Rejections};
 use super::estimate::{Estimate, Observation, ObservationSet};
 use super::options::Options;
-use super::pose::Pose2;
 use super::scan::{average_stop, StopScan};
 use super::stops::{find_stops, Stop};
 use crate::stats::median;
 use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
+use hilsim_recording::Pose;
 
 /// Standard deviation given to the stops before the robot first moved: they are at the start
 /// pose by definition (0.1 mm: exact to the model, finite for the solver).
@@ -53,7 +53,7 @@ pub struct Analysis {
     /// The stand-still stops.
     pub stops: Vec<Stop>,
     /// Each stop's nominal sensor (lidar) pose, start-pose frame.
-    pub sensors: Vec<Pose2>,
+    pub sensors: Vec<Pose>,
     /// The landmark radius used, metres.
     pub radius_m: f64,
     /// Every detection, all stops.
@@ -221,7 +221,7 @@ fn landmark_radius(
 }
 
 /// Each stop's nominal sensor (lidar) pose: the stop's pose composed with the lidar mount.
-fn sensor_poses(rec: &Recording, stops: &[Stop]) -> Vec<Pose2> {
+fn sensor_poses(rec: &Recording, stops: &[Stop]) -> Vec<Pose> {
     let mount = rec.meta.lidar.as_ref();
     stops
         .iter()
@@ -289,7 +289,7 @@ fn detect_landmarks(
 /// enough stops.
 fn keep_tracks(
     dets: &[Detection],
-    sensors: &[Pose2],
+    sensors: &[Pose],
     radius: f64,
     opts: &Options,
     notes: &mut Vec<String>,
@@ -323,7 +323,7 @@ fn keep_tracks(
 /// Build the observations: the estimator's input, one per detection of a kept track.
 fn build_observations(
     stops: &[Stop],
-    sensors: &[Pose2],
+    sensors: &[Pose],
     dets: &[Detection],
     kept: &[Track],
     radius: f64,

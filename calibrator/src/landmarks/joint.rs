@@ -20,8 +20,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::pose::wrap;
 use super::regression::{horner, horner_derivative};
+use hilsim_recording::wrap_angle;
 
 /// One bearing-and-range observation for the refinement.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,7 +110,7 @@ impl JointProblem {
             let rho2 = (dx * dx + dy * dy).max(1e-12);
             let rho = rho2.sqrt();
             let sb = self.bearing_sd_rad;
-            r[2 * o] = wrap(ob.bearing_rad - dy.atan2(dx)) / sb;
+            r[2 * o] = wrap_angle(ob.bearing_rad - dy.atan2(dx)) / sb;
             let d = rho - self.radius_m;
             let sr = ob.range_sd_m;
             r[2 * o + 1] = (ob.range_m - horner(&a, d)) / sr;

@@ -33,7 +33,6 @@ pub mod inversion;
 pub mod joint;
 pub mod monte_carlo;
 pub mod options;
-pub mod pose;
 pub mod positions;
 pub mod regression;
 pub mod scan;

@@ -10,8 +10,8 @@
 use hilsim_recording::{CommandSample, OdometrySample, Recording};
 
 use super::options::{Nominal, StopOptions};
-use super::pose::{wrap, Pose2};
 use crate::CalibrationError;
+use hilsim_recording::{wrap_angle, Pose};
 
 /// One stand-still stop.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,7 +21,7 @@ pub struct Stop {
     /// End of the window, seconds.
     pub t_end_s: f64,
     /// The robot's nominal pose during the stop, start-pose frame.
-    pub pose: Pose2,
+    pub pose: Pose,
     /// Whether the robot was commanded to move before this stop: the stops before the first
     /// motion are at the start pose by definition, whatever the actuation error.
     pub moved_before: bool,
@@ -188,8 +188,8 @@ fn odometry_speed(odo: &[OdometrySample], a: f64, b: f64) -> f64 {
 /// The pose reached at `t` by integrating the commanded wheel speeds from the start pose, each
 /// command held until the next (exact arcs of constant twist).
 #[must_use]
-pub fn command_pose(commands: &[CommandSample], t: f64, wheel_base_m: f64) -> Pose2 {
-    let mut pose = Pose2::default();
+pub fn command_pose(commands: &[CommandSample], t: f64, wheel_base_m: f64) -> Pose {
+    let mut pose = Pose::default();
     for (i, c) in commands.iter().enumerate() {
         if c.t_s >= t {
             break;
@@ -207,18 +207,18 @@ pub fn command_pose(commands: &[CommandSample], t: f64, wheel_base_m: f64) -> Po
 }
 
 /// Constant forward speed `v` and turn rate `omega` for `dt`.
-fn advance(p: Pose2, v: f64, omega: f64, dt: f64) -> Pose2 {
+fn advance(p: Pose, v: f64, omega: f64, dt: f64) -> Pose {
     let dyaw = omega * dt;
     if dyaw.abs() < 1e-9 {
         let yaw = p.yaw + dyaw / 2.0;
-        Pose2::new(
+        Pose::new(
             p.x + v * dt * yaw.cos(),
             p.y + v * dt * yaw.sin(),
             p.yaw + dyaw,
         )
     } else {
         let r = v / omega;
-        Pose2::new(
+        Pose::new(
             p.x + r * ((p.yaw + dyaw).sin() - p.yaw.sin()),
             p.y - r * ((p.yaw + dyaw).cos() - p.yaw.cos()),
             p.yaw + dyaw,
@@ -233,7 +233,7 @@ fn advance(p: Pose2, v: f64, omega: f64, dt: f64) -> Pose2 {
 /// before `t_ref` (the robot standing at the start): referencing one reading would carry its
 /// noise into every later heading (2 mm on each wheel is 0.5° over a 0.23 m base, 5 mm sideways
 /// after 0.6 m).
-fn odometry_pose(odo: &[OdometrySample], a: f64, b: f64, t_ref: f64, wheel_base_m: f64) -> Pose2 {
+fn odometry_pose(odo: &[OdometrySample], a: f64, b: f64, t_ref: f64, wheel_base_m: f64) -> Pose {
     let reference: Vec<&OdometrySample> = odo.iter().take_while(|s| s.t_s <= t_ref).collect();
     let reference = if reference.is_empty() {
         vec![&odo[0]]
@@ -246,13 +246,13 @@ fn odometry_pose(odo: &[OdometrySample], a: f64, b: f64, t_ref: f64, wheel_base_
     let heading = |s: &OdometrySample| ((s.right_m - r0) - (s.left_m - l0)) / wheel_base_m;
     // Dead-reckon every reading, then shift so that the reference readings average the origin.
     let mut poses = Vec::with_capacity(odo.len());
-    let mut pose = Pose2::new(0.0, 0.0, heading(&odo[0]));
+    let mut pose = Pose::new(0.0, 0.0, heading(&odo[0]));
     poses.push(pose);
     for w in odo.windows(2) {
         let ds = ((w[1].left_m - w[0].left_m) + (w[1].right_m - w[0].right_m)) / 2.0;
         let (h0, h1) = (heading(&w[0]), heading(&w[1]));
-        let mid = h0 + wrap(h1 - h0) / 2.0;
-        pose = Pose2::new(pose.x + ds * mid.cos(), pose.y + ds * mid.sin(), h1);
+        let mid = h0 + wrap_angle(h1 - h0) / 2.0;
+        pose = Pose::new(pose.x + ds * mid.cos(), pose.y + ds * mid.sin(), h1);
         poses.push(pose);
     }
     let mean = |sel: &dyn Fn(&OdometrySample) -> bool| {
@@ -266,11 +266,11 @@ fn odometry_pose(odo: &[OdometrySample], a: f64, b: f64, t_ref: f64, wheel_base_
                 n += 1.0;
             }
         }
-        (n > 0.0).then(|| Pose2::new(sx / n, sy / n, wrap(ss.atan2(sc))))
+        (n > 0.0).then(|| Pose::new(sx / n, sy / n, wrap_angle(ss.atan2(sc))))
     };
     let origin = mean(&|s| s.t_s <= t_ref.max(odo[0].t_s)).unwrap_or_default();
     let at = mean(&|s| s.t_s >= a && s.t_s <= b).unwrap_or(poses[poses.len() - 1]);
-    Pose2::new(at.x - origin.x, at.y - origin.y, at.yaw)
+    Pose::new(at.x - origin.x, at.y - origin.y, at.yaw)
 }
 
 #[cfg(test)]

@@ -9,17 +9,17 @@ use crate::landmarks::detection::Detection;
 use crate::landmarks::estimate::{Estimate, Observation, ObservationSet};
 use crate::landmarks::inversion::Inverse;
 use crate::landmarks::options::{Estimator, Options};
-use crate::landmarks::pose::Pose2;
 use crate::landmarks::positions::{intersect, BearingLine, Weights};
 use crate::landmarks::stops::Stop;
 use crate::{CalibrationError, Metrics};
+use hilsim_recording::Pose;
 
 /// What the stages before the estimator found, as the scoring needs it.
 pub(super) struct Seen<'a> {
     /// The stand-still stops.
     pub stops: &'a [Stop],
     /// Each stop's nominal sensor pose.
-    pub sensors: &'a [Pose2],
+    pub sensors: &'a [Pose],
     /// The landmark radius, metres.
     pub radius: f64,
     /// Every detection.
@@ -123,7 +123,7 @@ fn truth_distances(
     stops: &[Stop],
     dets: &[&Detection],
     obs: &[&Observation],
-    nominal: &[Pose2],
+    nominal: &[Pose],
     radius: f64,
 ) -> Option<(Vec<f64>, &'static str)> {
     let mount = rec.meta.lidar.as_ref();
@@ -139,8 +139,8 @@ fn truth_distances(
         ));
     }
     let truth = rec.truth.as_deref().filter(|t| !t.is_empty())?;
-    let start = Pose2::new(truth[0].x_m, truth[0].y_m, truth[0].yaw_rad);
-    let true_sensor: Vec<Option<Pose2>> = stops
+    let start = Pose::new(truth[0].x_m, truth[0].y_m, truth[0].yaw_rad);
+    let true_sensor: Vec<Option<Pose>> = stops
         .iter()
         .map(|s| {
             let w: Vec<_> = truth
@@ -148,7 +148,7 @@ fn truth_distances(
                 .filter(|t| t.t_s >= s.t_start_s && t.t_s <= s.t_end_s)
                 .collect();
             let t = w.get(w.len() / 2)?;
-            let p = Pose2::new(t.x_m, t.y_m, t.yaw_rad).relative_to(&start);
+            let p = Pose::new(t.x_m, t.y_m, t.yaw_rad).relative_to(&start);
             Some(p.compose(
                 mount.map_or(0.0, |m| m.x_m),
                 mount.map_or(0.0, |m| m.y_m),

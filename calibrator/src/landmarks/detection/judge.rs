@@ -5,8 +5,8 @@
 use super::{beam, occluded, points, Detection, Reject, Segment, FREE_FIT_MIN_BEAMS};
 use crate::landmarks::circle_fit::{dist, fit_free, fit_known_radius, line_rms};
 use crate::landmarks::options::DetectionOptions;
-use crate::landmarks::pose::wrap;
 use crate::landmarks::scan::{Beam, StopScan, BEAMS};
+use hilsim_recording::wrap_angle;
 
 /// A segment's verdict: each test a cylinder of radius `r` passes and a wall or clutter does not,
 /// then the detection's bearing and range.
@@ -42,8 +42,8 @@ pub(super) fn judge(
     let range = central_range(scan, seg, &angles, psi, &circle, r, opts)?;
     Ok(Detection {
         stop,
-        bearing_rad: wrap(psi),
-        fit_bearing_rad: wrap(psi_fit),
+        bearing_rad: wrap_angle(psi),
+        fit_bearing_rad: wrap_angle(psi_fit),
         from_edges,
         centre_range_m: circle.d_c,
         range_m: range.range_m,
@@ -121,7 +121,7 @@ fn fit_cylinder(
     }
     let psi = circle.centre[1].atan2(circle.centre[0]);
     // Unwrap ψ next to the segment's angles.
-    let psi = mid + wrap(psi - mid);
+    let psi = mid + wrap_angle(psi - mid);
     let half = (r / d_c).asin().to_degrees();
     let lo = (psi - angles[0]).to_degrees();
     let hi = (angles[n - 1] - psi).to_degrees();

@@ -33,7 +33,7 @@ mod align;
 #[cfg(test)]
 mod tests;
 
-use hilsim_recording::{LidarMount, LidarSample, Recording};
+use hilsim_recording::{LidarSample, Mount, Recording};
 
 use self::align::{commanded_forward, interpolate_odometry, nearest_sonar, truth_distances};
 use crate::{CalibrationError, Metrics};
@@ -230,8 +230,8 @@ fn start_distance(
 
 /// The lidar mount and the beam's direction φ from the robot's forward axis, radians; a beam
 /// (nearly) perpendicular to the motion is an error.
-fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(LidarMount, f64), CalibrationError> {
-    let mount = rec.meta.lidar.clone().unwrap_or(LidarMount {
+fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(Mount, f64), CalibrationError> {
+    let mount = rec.meta.lidar.clone().unwrap_or(Mount {
         x_m: 0.0,
         y_m: 0.0,
         yaw_deg: 0.0,

@@ -6,7 +6,7 @@ use hilsim_calibrator::landmarks::monte_carlo::PAPER_ALPHA;
 use hilsim_calibrator::landmarks::regression::horner;
 use hilsim_calibrator::landmarks::{calibrate, Options};
 use hilsim_calibrator::{Calibration, CalibrationError};
-use hilsim_recording::{CommandSample, LidarMount, LidarSample, Meta, Recording};
+use hilsim_recording::{CommandSample, LidarSample, Meta, Mount, Recording};
 
 /// A cylinder of radius 0.12 m, visible only during the stops listed (all when `None`).
 struct Cylinder {
@@ -30,7 +30,7 @@ const SPEED: f64 = 0.1;
 /// five 360-reading revolutions per second, the paper's mean reading f(d)), moves between them.
 fn synthetic(stops: usize, cylinders: &[Cylinder]) -> Recording {
     let mut meta = Meta {
-        lidar: Some(LidarMount {
+        lidar: Some(Mount {
             x_m: 0.0,
             y_m: 0.0,
             yaw_deg: 0.0,

@@ -2,8 +2,8 @@
 //! physics step as they are taken. `hilsim record` writes exactly these samples.
 
 use hilsim_recording::{
-    LidarMount, LidarSample, Meta, OdometrySample, Recording, RobotMeta, SonarMount, SonarSample,
-    SourceMeta, WorldMeta,
+    LidarSample, Meta, OdometrySample, Recording, RobotMeta, SonarMount, SonarSample, SourceMeta,
+    WorldMeta,
 };
 use hilsim_sim::{Collision, Scenario, Simulation, StepState};
 
@@ -247,11 +247,7 @@ fn meta(scenario: &Scenario, seed: u64, sim: &Simulation, lidar: Option<&Lidar>)
         robot: RobotMeta {
             wheel_base_m: scenario.robot.wheel_base_m,
         },
-        lidar: s.lidar.as_ref().map(|l| LidarMount {
-            x_m: l.mount.x_m,
-            y_m: l.mount.y_m,
-            yaw_deg: l.mount.yaw_deg,
-        }),
+        lidar: s.lidar.as_ref().map(|l| l.mount.into()),
         sonar: s.sonar.as_ref().map(|u| SonarMount {
             x_m: u.mount.x_m,
             y_m: u.mount.y_m,

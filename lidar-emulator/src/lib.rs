@@ -6,7 +6,6 @@
 pub mod effects;
 mod emulation;
 pub mod lidar;
-mod mount;
 pub mod neato_packet;
 pub mod normal;
 mod odometer;
@@ -17,7 +16,6 @@ pub mod wire;
 
 pub use emulation::{Emulation, Run, StepSamples};
 pub use lidar::{Lidar, LidarReading};
-pub use mount::Mount;
 pub use odometer::Odometer;
 pub use range_model::{ModelError, RangeModel, RangeModelBuilder};
 pub use sonar::Sonar;

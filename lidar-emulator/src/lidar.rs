@@ -8,9 +8,9 @@ use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
 use crate::effects::LidarEffects;
-use crate::mount::Mount;
 use crate::neato_packet::{MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
+use hilsim_recording::Mount;
 
 /// Error code for "no return": nothing within range, or the reading fell beyond the maximum.
 /// The most frequent code in the real capture `xv11-hand-in-box.bin` (1,996 of ~2,800 invalid
@@ -289,6 +289,8 @@ struct SensorTrack {
     from: [f64; 3],
     delta: [f64; 3],
     mount: Mount,
+    /// The mount's yaw in radians, converted once per step rather than per reading.
+    mount_yaw_rad: f64,
 }
 
 impl SensorTrack {
@@ -300,6 +302,7 @@ impl SensorTrack {
             from: [p0.x, p0.y, p0.yaw],
             delta: [p1.x - p0.x, p1.y - p0.y, wrap_angle(p1.yaw - p0.yaw)],
             mount,
+            mount_yaw_rad: mount.yaw_rad(),
         }
     }
 
@@ -314,7 +317,7 @@ impl SensorTrack {
             let (sin, cos) = yaw.sin_cos();
             [x + cos * m.x_m - sin * m.y_m, y + sin * m.x_m + cos * m.y_m]
         };
-        (origin, yaw + m.yaw_rad)
+        (origin, yaw + self.mount_yaw_rad)
     }
 }
 

@@ -17,11 +17,11 @@
 use hilsim_sim::{scenario, Obstacle, Pose, World};
 
 use crate::effects::{BeamReturn, LidarEffects};
-use crate::mount::Mount;
 use crate::neato_packet::MAX_DISTANCE_MM;
 use crate::normal::Gaussian;
 use crate::range_model::{ModelError, RangeModel};
 use crate::sonar::Sonar;
+use hilsim_recording::Mount;
 
 /// Variance of rounding to whole millimetres, m².
 const ROUNDING_VAR_M2: f64 = 1e-6 / 12.0;

@@ -5,8 +5,8 @@ use hilsim_recording::SonarSample;
 use hilsim_sim::{rng, scenario, StepState, World};
 
 use crate::effects::sonar_range_scale;
-use crate::mount::Mount;
 use crate::range_model::{ModelError, RangeModel};
+use hilsim_recording::Mount;
 
 /// Angular spacing of the rays that sample the cone, radians (0.25°). The nearest point of a
 /// cylinder of radius r at distance d can fall between two rays; the range error is then at most

@@ -29,7 +29,7 @@ mod write;
 
 pub use atomic::{replace_dir_atomically, write_file_atomically};
 pub use error::{Error, ErrorKind};
-pub use meta::{LidarMount, Meta, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
+pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
 pub use samples::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};

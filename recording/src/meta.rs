@@ -1,5 +1,6 @@
 //! `meta.toml`: what a calibrator must know about the robot and the world besides the samples.
 
+use crate::pose::Pose;
 use serde::{Deserialize, Serialize};
 
 /// The format tag every `meta.toml` carries.
@@ -16,7 +17,7 @@ pub struct Meta {
     pub robot: RobotMeta,
     /// The lidar's mount pose; absent when the robot has no lidar.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lidar: Option<LidarMount>,
+    pub lidar: Option<Mount>,
     /// The sonar's mount and beam; absent when the robot has no sonar.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sonar: Option<SonarMount>,
@@ -48,18 +49,33 @@ pub struct RobotMeta {
     pub wheel_base_m: f64,
 }
 
-/// `[lidar]`: the mount pose in the robot frame (x forward, y left).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LidarMount {
+/// A sensor's mount pose in the robot frame (x forward, y left), as files write it: `meta.toml`'s
+/// `[lidar]` table, a scenario's `mount`. The one mount type of the sensor models.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Mount {
     /// Forward offset, metres.
     #[serde(default)]
     pub x_m: f64,
     /// Leftward offset, metres.
     #[serde(default)]
     pub y_m: f64,
-    /// Yaw of the lidar's 0° axis relative to the robot's forward axis, degrees.
+    /// Yaw of the sensor's 0° axis relative to the robot's forward axis, degrees.
     #[serde(default)]
     pub yaw_deg: f64,
+}
+
+impl Mount {
+    /// The yaw in radians.
+    #[must_use]
+    pub fn yaw_rad(&self) -> f64 {
+        self.yaw_deg.to_radians()
+    }
+
+    /// The sensor's pose in the world when the robot is at `robot`.
+    #[must_use]
+    pub fn in_world(&self, robot: &Pose) -> Pose {
+        robot.compose(self.x_m, self.y_m, self.yaw_rad())
+    }
 }
 
 /// `[sonar]`: the mount and the beam.

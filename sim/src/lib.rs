@@ -34,8 +34,8 @@ mod simulation;
 pub mod world;
 
 pub use drive::{DriveProgram, WheelCommand};
-pub use motor_lag::MotorLag;
 pub use hilsim_recording::pose::{self, Pose};
+pub use motor_lag::MotorLag;
 pub use scenario::{Scenario, ScenarioError};
 pub use simulation::{Collision, Simulation, StepState};
 pub use world::{Obstacle, RayHit, World};

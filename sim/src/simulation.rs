@@ -8,9 +8,9 @@ use rapier2d::prelude::*;
 use crate::actuation::ActuationError;
 use crate::drive::{DriveProgram, WheelCommand};
 use crate::motor_lag::MotorLag;
-use hilsim_recording::pose::Pose;
 use crate::scenario::Scenario;
 use crate::world::{Obstacle, World};
+use hilsim_recording::pose::Pose;
 
 /// The robot touched an obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,8 +5,8 @@
 
 use rapier2d::prelude::*;
 
-use hilsim_recording::pose::Pose;
 use crate::scenario::Scenario;
+use hilsim_recording::pose::Pose;
 
 /// What a collider is, so a sensor can ask what it hit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,8 +4,7 @@
 //! physics), and a recording drawn straight from the models without the physics.
 
 use hilsim_recording::{
-    CommandSample, LidarMount, LidarSample, Meta, OdometrySample, Recording, SonarSample,
-    TruthSample,
+    CommandSample, LidarSample, Meta, Mount, OdometrySample, Recording, SonarSample, TruthSample,
 };
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -142,7 +141,7 @@ pub fn synthetic_recording(revolutions: usize, rng: &mut impl Rng) -> Recording 
     let commanded = -3.5 / duration;
     let actual = commanded * 1.01;
     let mut rec = Recording::new(Meta::default());
-    rec.meta.lidar = Some(LidarMount {
+    rec.meta.lidar = Some(Mount {
         x_m: 0.0,
         y_m: 0.0,
         yaw_deg: 0.0,

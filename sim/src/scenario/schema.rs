@@ -282,7 +282,8 @@ pub struct Sensors {
     pub odometer: Option<Odometer>,
 }
 
-/// A sensor's mount pose on the robot (x forward, y left).
+/// A sensor's `mount` table in a scenario: parsed strictly (an unknown key is an error), then
+/// used as the recording's [`hilsim_recording::Mount`], the one mount of the sensor models.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mount {
@@ -295,6 +296,16 @@ pub struct Mount {
     /// Yaw relative to the robot's forward axis, degrees.
     #[serde(default)]
     pub yaw_deg: f64,
+}
+
+impl From<Mount> for hilsim_recording::Mount {
+    fn from(m: Mount) -> Self {
+        Self {
+            x_m: m.x_m,
+            y_m: m.y_m,
+            yaw_deg: m.yaw_deg,
+        }
+    }
 }
 
 /// `[sensors.lidar]`: the Neato XV-11 triangulation lidar.

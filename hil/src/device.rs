@@ -10,7 +10,7 @@ use serialport::{ClearBuffer, DataBits, FlowControl, Parity, SerialPort, StopBit
 
 use crate::link::SerialLink;
 
-/// The XV-11's baud rate (shared/protocol/neato-xv11.md).
+/// The XV-11's baud rate (docs/formats/neato-xv11.md).
 pub const XV11_BAUD: u32 = 115_200;
 
 /// A device opened for writing the lidar stream.

@@ -9,7 +9,7 @@ use hilsim_lidar_emulator::neato_packet::{
 
 const CAPTURE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/captures/xv11-hand-in-box.bin"
+    "/../tests/data/captures/xv11-hand-in-box.bin"
 );
 
 fn capture() -> Vec<u8> {

@@ -233,7 +233,7 @@ fn serve_to_an_existing_device_writes_the_stream_there() {
 #[test]
 fn decode_counts_the_real_capture_and_writes_csv() {
     let tmp = tempfile::tempdir().unwrap();
-    let capture = root().join("../shared/captures/xv11-hand-in-box.bin");
+    let capture = root().join("tests/data/captures/xv11-hand-in-box.bin");
     let capture = capture.to_str().unwrap();
     let out = hilsim(
         tmp.path(),

@@ -1,5 +1,5 @@
 //! The Neato XV-11 lidar serial packet codec (firmware 2.4 / 2.6), as described in
-//! `shared/protocol/neato-xv11.md`.
+//! `docs/formats/neato-xv11.md`.
 //!
 //! A pure state machine: nothing here opens a port, reads a clock or prints. The serial link
 //! only moves bytes; this module turns readings into bytes ([`Packet::encode`],

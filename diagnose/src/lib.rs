@@ -36,7 +36,7 @@ pub mod stats;
 mod trajectory;
 
 pub use align::Alignment;
-pub use catalogue::{Effect, ParamSpec, Sensor};
+pub use catalogue::{DrawSource, Effect, ParamSpec, SelfTestRange, Sensor};
 pub use diagnosis::diagnose;
 pub use error::MismatchError;
 pub use explain::CandidateFit;

@@ -263,6 +263,7 @@ mod tests {
             hi,
             log,
             grid: 11,
+            self_test: crate::SelfTestRange::uniform(lo, hi),
         }
     }
 

@@ -12,7 +12,7 @@ use hilsim_lidar_emulator::prediction::{
     BeamNodes, LidarPredictor, OdometerPredictor, SonarPredictor,
 };
 use hilsim_recording::{CommandSample, TruthSample};
-use hilsim_sim::scenario::{self, Effects, LidarTiming};
+use hilsim_sim::scenario::{Effects, LidarTiming};
 use hilsim_sim::{replay, Obstacle, Pose, Scenario, World};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -21,7 +21,8 @@ use std::sync::{Arc, RwLock};
 /// Readings predicted per parallel task.
 const CHUNK: usize = 2048;
 /// The widest beam the mixed-pixel fit tries (its catalogue range), radians.
-const MAX_HALF_WIDTH_RAD: f64 = 3.0 * std::f64::consts::PI / 180.0;
+const MAX_HALF_WIDTH_RAD: f64 =
+    Effect::LidarMixedPixels.params()[0].hi * std::f64::consts::PI / 180.0;
 
 /// A lidar reading's place: the robot's pose (x, y, yaw) and the beam's angle, bit for bit.
 type BeamKey = [u64; 4];
@@ -170,50 +171,8 @@ impl SimPhysics {
     /// The scenario's effects with the hypothesis's switched on over them.
     fn effects(&self, h: &Hypothesis) -> Effects {
         let mut e = self.scenario.effects.clone();
-        let p = |i: usize| h.params.get(i).copied().unwrap_or(0.0);
-        match h.effect {
-            None => {}
-            Some(Effect::LidarIncidenceAngle) => {
-                e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: p(0) });
-            }
-            Some(Effect::LidarReflectivity) => {
-                e.lidar_reflectivity = Some(scenario::LidarReflectivity {
-                    coefficient_m: p(0),
-                    reference: 0.8,
-                });
-            }
-            Some(Effect::LidarMixedPixels) => {
-                e.lidar_mixed_pixels = (p(0) > 0.0).then_some(scenario::LidarMixedPixels {
-                    half_width_deg: p(0),
-                });
-            }
-            Some(Effect::LidarWarmupDrift) => {
-                e.lidar_warmup_drift = Some(scenario::LidarWarmupDrift {
-                    coefficient_per_m: p(0),
-                    time_constant_s: p(1).max(1e-3),
-                });
-            }
-            Some(Effect::SonarBeamWidth) => {
-                e.sonar_beam_width = Some(scenario::SonarBeamWidth {
-                    half_angle_deg: p(0).clamp(0.0, 89.0),
-                });
-            }
-            Some(Effect::SonarSpeedOfSound) => {
-                e.sonar_speed_of_sound = Some(scenario::SonarSpeedOfSound {
-                    air_temperature_c: p(0),
-                    calibrated_at_c: 20.0,
-                });
-            }
-            Some(Effect::OdometerWheelSlip) => {
-                e.odometer_wheel_slip = Some(scenario::OdometerWheelSlip { gain_s: p(0) });
-            }
-            Some(Effect::DriveMotorLag) => {
-                e.drive_motor_lag = (p(0) > 1e-6).then_some(scenario::DriveMotorLag {
-                    time_constant_s: p(0),
-                });
-            }
-            // Timing, not a sensor table: see `lidar`.
-            Some(Effect::LidarMotionSkew) => {}
+        if let Some(effect) = h.effect {
+            effect.apply(&h.params, &mut e);
         }
         e
     }
@@ -335,9 +294,7 @@ impl Physics for SimPhysics {
         // Where a wider cone would look (asked only with the nominal model: a covariate).
         let wide = hypothesis.effect.is_none().then(|| {
             let mut e = effects.clone();
-            e.sonar_beam_width = Some(scenario::SonarBeamWidth {
-                half_angle_deg: 30.0,
-            });
+            Effect::SonarBeamWidth.apply(&[30.0], &mut e);
             SonarPredictor::new(config, &e)
         });
         times

@@ -1,10 +1,11 @@
 //! What a trial conceals: an effect (or none) and its parameters, drawn from (S, i) alone.
 
-use hilsim_sim::scenario::{self, Effects};
+use hilsim_sim::scenario::Effects;
 use hilsim_sim::Scenario;
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 use rand_xoshiro::SplitMix64;
 
+use crate::catalogue::{DrawSource, SelfTestRange};
 use crate::Effect;
 
 /// The trial's draws, from (S, i) alone: SplitMix64 started from a mix of the two.
@@ -48,147 +49,58 @@ pub struct Drawn {
     pub params: Vec<(String, f64)>,
 }
 
-/// Draws trial `i`'s effect. The moderate ranges (× `strength`):
-/// incidence κ ±[0.01, 0.03]; reflectivity c ±[0.008, 0.02] m; mixed pixels half-width
-/// [0.5, 1.5]°; motion skew (the head's own period); warm-up k ±[0.004, 0.01] /m with τ in
-/// [5, 20] s; sonar cone [8, 20]°; air temperature 20 °C ± [15, 30] °C; slip gain
-/// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s.
+/// Draws trial `i`'s effect: none, or one of the catalogue (each with probability 1/10, or the
+/// `only` one: 0 none, 1..=9 the catalogue in order), and its parameters from their
+/// [`SelfTestRange`]s (the documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {
     let drawn_class = (d.unit() * 10.0).floor() as usize;
-    // 0: none; 1..=9: the catalogue in order.
     let k = only.unwrap_or(drawn_class);
     let mut effects = nominal.effects.clone();
-    let (effect, truth, params) = if (1..=5).contains(&k) {
-        draw_lidar(k, d, strength, nominal, &mut effects)
-    } else {
-        draw_other(k, d, strength, &mut effects)
+    let effect = k.checked_sub(1).and_then(|i| Effect::ALL.get(i).copied());
+    let Some(effect) = effect else {
+        return Drawn {
+            effect: None,
+            effects,
+            truth: None,
+            params: Vec::new(),
+        };
     };
+    let specs = effect.params();
+    let values: Vec<f64> = specs
+        .iter()
+        .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
+        .collect();
+    effect.apply(&values, &mut effects);
     Drawn {
-        effect,
+        effect: Some(effect),
         effects,
-        truth,
-        params,
+        truth: Some(specs[0].self_test.scored(values[0])),
+        params: specs
+            .iter()
+            .zip(&values)
+            .map(|(spec, &v)| (spec.name.to_string(), v))
+            .collect(),
     }
 }
 
-/// The concealed effect, its scored parameter's true value and every parameter drawn.
-type Concealed = (Option<Effect>, Option<f64>, Vec<(String, f64)>);
-
-/// Draws lidar effect `k` (1..=5, the catalogue's order) into `effects`.
-fn draw_lidar(
-    k: usize,
-    d: &mut Draws,
-    s: f64,
-    nominal: &Scenario,
-    effects: &mut Effects,
-) -> Concealed {
-    match k {
-        1 => {
-            let v = d.sign() * d.between(0.01, 0.03) * s;
-            effects.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: v });
-            (
-                Some(Effect::LidarIncidenceAngle),
-                Some(v),
-                vec![("coefficient".into(), v)],
-            )
+/// One parameter's true value, drawn from `range`.
+fn draw_value(range: &SelfTestRange, d: &mut Draws, strength: f64, nominal: &Scenario) -> f64 {
+    let (lo, hi) = match range.source {
+        DrawSource::Uniform { lo, hi } => (lo, hi),
+        DrawSource::LidarRevolution => {
+            return 60.0 / nominal.sensors.lidar.as_ref().map_or(300.0, |l| l.rpm);
         }
-        2 => {
-            let v = d.sign() * d.between(0.008, 0.02) * s;
-            effects.lidar_reflectivity = Some(scenario::LidarReflectivity {
-                coefficient_m: v,
-                reference: 0.8,
-            });
-            (
-                Some(Effect::LidarReflectivity),
-                Some(v),
-                vec![("coefficient_m".into(), v)],
-            )
-        }
-        3 => {
-            let v = (d.between(0.5, 1.5) * s).min(5.0);
-            effects.lidar_mixed_pixels = Some(scenario::LidarMixedPixels { half_width_deg: v });
-            (
-                Some(Effect::LidarMixedPixels),
-                Some(v),
-                vec![("half_width_deg".into(), v)],
-            )
-        }
-        4 => {
-            effects.lidar_motion_skew = Some(scenario::LidarMotionSkew {});
-            let rpm = nominal.sensors.lidar.as_ref().map_or(300.0, |l| l.rpm);
-            let period = 60.0 / rpm;
-            (
-                Some(Effect::LidarMotionSkew),
-                Some(period),
-                vec![("revolution_s".into(), period)],
-            )
-        }
-        5 => {
-            let v = d.sign() * d.between(0.004, 0.01) * s;
-            let tau = d.between(5.0, 20.0);
-            effects.lidar_warmup_drift = Some(scenario::LidarWarmupDrift {
-                coefficient_per_m: v,
-                time_constant_s: tau,
-            });
-            (
-                Some(Effect::LidarWarmupDrift),
-                Some(v),
-                vec![
-                    ("coefficient_per_m".into(), v),
-                    ("time_constant_s".into(), tau),
-                ],
-            )
-        }
-        _ => (None, None, Vec::new()),
+    };
+    // The sign is drawn before the magnitude.
+    let sign = if range.signed { d.sign() } else { 1.0 };
+    let mut v = sign * d.between(lo, hi);
+    if range.scaled {
+        v *= strength;
     }
-}
-
-/// Draws effect `k` (6..=9, the catalogue's order; anything else: none) into `effects`.
-fn draw_other(k: usize, d: &mut Draws, s: f64, effects: &mut Effects) -> Concealed {
-    match k {
-        6 => {
-            let v = (d.between(8.0, 20.0) * s).min(60.0);
-            effects.sonar_beam_width = Some(scenario::SonarBeamWidth { half_angle_deg: v });
-            (
-                Some(Effect::SonarBeamWidth),
-                Some(v),
-                vec![("half_angle_deg".into(), v)],
-            )
-        }
-        7 => {
-            let dt = d.sign() * d.between(15.0, 30.0) * s;
-            let t = (20.0 + dt).clamp(-50.0, 60.0);
-            effects.sonar_speed_of_sound = Some(scenario::SonarSpeedOfSound {
-                air_temperature_c: t,
-                calibrated_at_c: 20.0,
-            });
-            // Scored: the departure from the calibration temperature.
-            (
-                Some(Effect::SonarSpeedOfSound),
-                Some(t - 20.0),
-                vec![("air_temperature_c".into(), t)],
-            )
-        }
-        8 => {
-            let v = d.between(0.03, 0.1) * s;
-            effects.odometer_wheel_slip = Some(scenario::OdometerWheelSlip { gain_s: v });
-            (
-                Some(Effect::OdometerWheelSlip),
-                Some(v),
-                vec![("gain_s".into(), v)],
-            )
-        }
-        9 => {
-            let v = (d.between(0.1, 0.4) * s).min(10.0);
-            effects.drive_motor_lag = Some(scenario::DriveMotorLag { time_constant_s: v });
-            (
-                Some(Effect::DriveMotorLag),
-                Some(v),
-                vec![("time_constant_s".into(), v)],
-            )
-        }
-        _ => (None, None, Vec::new()),
+    if let Some(centre) = range.around {
+        v += centre;
     }
+    v.clamp(range.min, range.max)
 }
 
 /// Trial `i`'s "real" scenario: the nominal one with the drawn effect and its own noise seed.

@@ -72,11 +72,7 @@ pub(crate) fn trial(
             let fitted = fit.map(|f| f.params.clone()).unwrap_or_default();
             let param_error = match (diag.verdict, drawn.effect, drawn.truth, fit) {
                 (Verdict::Effect(v), Some(e), Some(t), Some(f)) if v == e => {
-                    let got = if e == Effect::SonarSpeedOfSound {
-                        f.params[0] - 20.0
-                    } else {
-                        f.params[0]
-                    };
+                    let got = e.params()[0].self_test.scored(f.params[0]);
                     Some((got - t).abs() / t.abs())
                 }
                 _ => None,

@@ -1,8 +1,19 @@
 //! The catalogue of effects `hilsim diagnose` knows (`interfaces.md`): each one a piece of
 //! physics a simulation may leave out, the sensor it shows in, its parameters with the range the
-//! fit searches, and the sentence that says what was left out.
+//! fit searches and the range the self-test draws from (`params`), the scenario's
+//! `[effects]` table that switches it on (`scenario`), and the sentence that says what was left
+//! out (`sentences`). The one place in the diagnosis that knows an effect: adding one touches
+//! its physics (`hilsim-sim`'s `[effects]`, `hilsim-lidar-emulator`'s `effects`) and its entry
+//! here.
+
+mod params;
+mod scenario;
+mod sentences;
 
 use std::fmt;
+
+use params::{lin, log};
+pub use params::{DrawSource, ParamSpec, SelfTestRange};
 
 /// Which sensor (or the drive) an effect shows in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -67,45 +78,6 @@ pub enum Effect {
     DriveMotorLag,
 }
 
-/// A parameter of an effect and the range the fit searches.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ParamSpec {
-    /// Its name (the scenario key of `[effects.NAME]` where there is one).
-    pub name: &'static str,
-    /// Its unit, for reports.
-    pub unit: &'static str,
-    /// Lowest value searched.
-    pub lo: f64,
-    /// Highest value searched.
-    pub hi: f64,
-    /// Searched on a logarithmic scale (positive ranges spanning decades).
-    pub log: bool,
-    /// Points of the coarse grid the search starts from.
-    pub grid: usize,
-}
-
-const fn lin(name: &'static str, unit: &'static str, lo: f64, hi: f64, grid: usize) -> ParamSpec {
-    ParamSpec {
-        name,
-        unit,
-        lo,
-        hi,
-        log: false,
-        grid,
-    }
-}
-
-const fn log(name: &'static str, unit: &'static str, lo: f64, hi: f64, grid: usize) -> ParamSpec {
-    ParamSpec {
-        name,
-        unit,
-        lo,
-        hi,
-        log: true,
-        grid,
-    }
-}
-
 impl Effect {
     /// The whole catalogue, in `interfaces.md` order.
     pub const ALL: [Effect; 9] = [
@@ -166,22 +138,83 @@ impl Effect {
 
     /// Its parameters, in the order a [`super::Hypothesis`] holds them.
     ///
-    /// The ranges are wide enough for any plausible unit (several times the self-test's draws)
-    /// and the grids fine enough that the likelihood is unimodal between neighbouring points.
+    /// The fit's ranges are wide enough for any plausible unit (several times the self-test's
+    /// draws) and the grids fine enough that the likelihood is unimodal between neighbouring
+    /// points. The self-test's moderate ranges (× its strength unless said): incidence κ
+    /// ±[0.01, 0.03]; reflectivity c ±[0.008, 0.02] m; mixed pixels half-width [0.5, 1.5]°
+    /// (at most 5°); motion skew the head's own period; warm-up k ±[0.004, 0.01] /m with τ in
+    /// [5, 20] s (unscaled); sonar cone [8, 20]° (at most 60°); air temperature 20 °C ±
+    /// [15, 30] °C (within [−50, 60] °C, scored as the departure from 20 °C); slip gain
+    /// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s (at most 10 s).
     #[must_use]
-    pub fn params(self) -> &'static [ParamSpec] {
-        const INCIDENCE: [ParamSpec; 1] = [lin("coefficient", "", -0.1, 0.1, 11)];
-        const REFLECTIVITY: [ParamSpec; 1] = [lin("coefficient_m", "m", -0.1, 0.1, 11)];
-        const MIXED: [ParamSpec; 1] = [log("half_width_deg", "deg", 0.05, 3.0, 10)];
-        const SKEW: [ParamSpec; 1] = [lin("revolution_s", "s", 0.0, 0.6, 9)];
+    pub const fn params(self) -> &'static [ParamSpec] {
+        use SelfTestRange as R;
+        const INCIDENCE: [ParamSpec; 1] = [lin(
+            "coefficient",
+            "",
+            (-0.1, 0.1),
+            11,
+            R::uniform(0.01, 0.03).signed(),
+        )];
+        const REFLECTIVITY: [ParamSpec; 1] = [lin(
+            "coefficient_m",
+            "m",
+            (-0.1, 0.1),
+            11,
+            R::uniform(0.008, 0.02).signed(),
+        )];
+        const MIXED: [ParamSpec; 1] = [log(
+            "half_width_deg",
+            "deg",
+            (0.05, 3.0),
+            10,
+            R::uniform(0.5, 1.5).at_most(5.0),
+        )];
+        const SKEW: [ParamSpec; 1] = [lin(
+            "revolution_s",
+            "s",
+            (0.0, 0.6),
+            9,
+            R::lidar_revolution(),
+        )];
         const WARMUP: [ParamSpec; 2] = [
-            lin("coefficient_per_m", "1/m", -0.05, 0.05, 7),
-            log("time_constant_s", "s", 1.0, 1000.0, 6),
+            lin(
+                "coefficient_per_m",
+                "1/m",
+                (-0.05, 0.05),
+                7,
+                R::uniform(0.004, 0.01).signed(),
+            ),
+            log(
+                "time_constant_s",
+                "s",
+                (1.0, 1000.0),
+                6,
+                R::uniform(5.0, 20.0).unscaled(),
+            ),
         ];
-        const BEAM: [ParamSpec; 1] = [lin("half_angle_deg", "deg", 0.0, 45.0, 16)];
-        const SOUND: [ParamSpec; 1] = [lin("air_temperature_c", "degC", -50.0, 60.0, 23)];
-        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", -0.5, 0.5, 11)];
-        const LAG: [ParamSpec; 1] = [log("time_constant_s", "s", 0.005, 5.0, 13)];
+        const BEAM: [ParamSpec; 1] = [lin(
+            "half_angle_deg",
+            "deg",
+            (0.0, 45.0),
+            16,
+            R::uniform(8.0, 20.0).at_most(60.0),
+        )];
+        const SOUND: [ParamSpec; 1] = [lin(
+            "air_temperature_c",
+            "degC",
+            (-50.0, 60.0),
+            23,
+            R::uniform(15.0, 30.0).signed().around(20.0, -50.0, 60.0),
+        )];
+        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (-0.5, 0.5), 11, R::uniform(0.03, 0.1))];
+        const LAG: [ParamSpec; 1] = [log(
+            "time_constant_s",
+            "s",
+            (0.005, 5.0),
+            13,
+            R::uniform(0.1, 0.4).at_most(10.0),
+        )];
         match self {
             Effect::LidarIncidenceAngle => &INCIDENCE,
             Effect::LidarReflectivity => &REFLECTIVITY,
@@ -240,66 +273,6 @@ impl Effect {
             Effect::DriveMotorLag => 0.02,
         };
         (value - absent).abs() >= least
-    }
-
-    /// One sentence: the physics the simulation left out, with the fitted parameters (and the
-    /// declared sonar cone the beam width replaces).
-    #[must_use]
-    pub fn explanation(self, params: &[f64], declared_half_angle_deg: f64) -> String {
-        let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
-        match self {
-            Effect::LidarIncidenceAngle => format!(
-                "The simulated lidar ranges every surface as if it met it head-on; the real one's \
-                 range error grows with the angle of incidence ({:+.1} mm per metre at 45°).",
-                p(0) * 1000.0
-            ),
-            Effect::LidarReflectivity => format!(
-                "The simulated lidar ranges every material alike; the real one's range walks with \
-                 the surface's reflectivity ({:+.1} mm on a surface of half the reference's).",
-                p(0) * 1000.0
-            ),
-            Effect::LidarMixedPixels => format!(
-                "The simulated lidar's beam is a line; the real beam is {:.2}° wide, and where it \
-                 grazes an edge it returns a range between foreground and background.",
-                2.0 * p(0)
-            ),
-            Effect::LidarMotionSkew => format!(
-                "The simulated lidar takes a whole revolution at one instant; the real one turns \
-                 for {:.2} s while the robot moves.",
-                p(0)
-            ),
-            Effect::LidarWarmupDrift => format!(
-                "The simulated lidar is warm from power-on; the real one's range bias drifts as it \
-                 warms up ({:+.1} mm at 2 m at power-on, settling with a {:.0} s time constant).",
-                p(0) * 4.0 * 1000.0,
-                p(1)
-            ),
-            Effect::SonarBeamWidth if declared_half_angle_deg > 0.0 => format!(
-                "The simulated sonar's cone is ±{declared_half_angle_deg:.1}°; the real one \
-                 returns the nearest echo anywhere in a cone of ±{:.1}°.",
-                p(0)
-            ),
-            Effect::SonarBeamWidth => format!(
-                "The simulated sonar sees along its axis only; the real one returns the nearest \
-                 echo anywhere in a cone of ±{:.1}°.",
-                p(0)
-            ),
-            Effect::SonarSpeedOfSound => format!(
-                "The simulated sonar assumes sound travels at its calibration temperature (20 °C); \
-                 the real air was at {:.1} °C, which scales every range.",
-                p(0)
-            ),
-            Effect::OdometerWheelSlip => format!(
-                "The simulated wheels grip perfectly; the real ones slip as they accelerate, so \
-                 the encoders lead the true travel by {:.0} ms × the wheel's speed.",
-                p(0) * 1000.0
-            ),
-            Effect::DriveMotorLag => format!(
-                "The simulated wheels reach a commanded speed at once; the real ones follow it \
-                 with a first-order lag of {:.2} s.",
-                p(0)
-            ),
-        }
     }
 }
 

@@ -1,0 +1,78 @@
+//! The scenario's `[effects]` table that switches each effect on: how the diagnosis's physics
+//! tries a hypothesis, and how the self-test conceals a drawn effect in its "real" run.
+
+use hilsim_sim::scenario::{self, Effects};
+
+use super::Effect;
+
+/// The reference reflectivity of `[effects.lidar_reflectivity]` (the catalogue's coefficient is
+/// the range walk on a surface of half of it).
+const REFERENCE_REFLECTIVITY: f64 = 0.8;
+/// The temperature the sonar's speed of sound is calibrated at, °C.
+const CALIBRATED_AT_C: f64 = 20.0;
+
+impl Effect {
+    /// Switches the effect on in `effects` with `params` (in the order of [`Effect::params`]; a
+    /// missing one is 0), replacing its table if the scenario already has one. A parameter at
+    /// which the scenario's table cannot exist (a mixed-pixel footprint or a motor lag of 0)
+    /// leaves the effect off.
+    ///
+    /// Motion skew's table has no parameter: the revolution's duration is the lidar's `rpm` in
+    /// a scenario, and the diagnosis's physics fits it as the timing of each reading
+    /// ([`crate::SimPhysics`]).
+    ///
+    /// ```
+    /// use hilsim_diagnose::Effect;
+    /// let mut effects = hilsim_sim::scenario::Effects::default();
+    /// Effect::SonarBeamWidth.apply(&[12.0], &mut effects);
+    /// assert_eq!(effects.sonar_beam_width.map(|b| b.half_angle_deg), Some(12.0));
+    /// ```
+    pub fn apply(self, params: &[f64], effects: &mut Effects) {
+        let p = |i: usize| params.get(i).copied().unwrap_or(0.0);
+        let e = effects;
+        match self {
+            Effect::LidarIncidenceAngle => {
+                e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: p(0) });
+            }
+            Effect::LidarReflectivity => {
+                e.lidar_reflectivity = Some(scenario::LidarReflectivity {
+                    coefficient_m: p(0),
+                    reference: REFERENCE_REFLECTIVITY,
+                });
+            }
+            Effect::LidarMixedPixels => {
+                e.lidar_mixed_pixels = (p(0) > 0.0).then_some(scenario::LidarMixedPixels {
+                    half_width_deg: p(0),
+                });
+            }
+            Effect::LidarMotionSkew => {
+                e.lidar_motion_skew = Some(scenario::LidarMotionSkew {});
+            }
+            Effect::LidarWarmupDrift => {
+                e.lidar_warmup_drift = Some(scenario::LidarWarmupDrift {
+                    coefficient_per_m: p(0),
+                    time_constant_s: p(1).max(1e-3),
+                });
+            }
+            Effect::SonarBeamWidth => {
+                e.sonar_beam_width = Some(scenario::SonarBeamWidth {
+                    half_angle_deg: p(0).clamp(0.0, 89.0),
+                });
+            }
+            Effect::SonarSpeedOfSound => {
+                e.sonar_speed_of_sound = Some(scenario::SonarSpeedOfSound {
+                    air_temperature_c: p(0),
+                    calibrated_at_c: CALIBRATED_AT_C,
+                });
+            }
+            Effect::OdometerWheelSlip => {
+                e.odometer_wheel_slip = Some(scenario::OdometerWheelSlip { gain_s: p(0) });
+            }
+            Effect::DriveMotorLag => {
+                e.drive_motor_lag = (p(0) > 0.0).then_some(scenario::DriveMotorLag {
+                    time_constant_s: p(0),
+                });
+            }
+        }
+    }
+}

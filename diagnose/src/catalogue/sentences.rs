@@ -1,0 +1,65 @@
+//! The sentence each effect's verdict is told in.
+
+use super::Effect;
+
+impl Effect {
+    /// One sentence: the physics the simulation left out, with the fitted parameters (and the
+    /// declared sonar cone the beam width replaces).
+    #[must_use]
+    pub fn explanation(self, params: &[f64], declared_half_angle_deg: f64) -> String {
+        let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
+        match self {
+            Effect::LidarIncidenceAngle => format!(
+                "The simulated lidar ranges every surface as if it met it head-on; the real one's \
+                 range error grows with the angle of incidence ({:+.1} mm per metre at 45°).",
+                p(0) * 1000.0
+            ),
+            Effect::LidarReflectivity => format!(
+                "The simulated lidar ranges every material alike; the real one's range walks with \
+                 the surface's reflectivity ({:+.1} mm on a surface of half the reference's).",
+                p(0) * 1000.0
+            ),
+            Effect::LidarMixedPixels => format!(
+                "The simulated lidar's beam is a line; the real beam is {:.2}° wide, and where it \
+                 grazes an edge it returns a range between foreground and background.",
+                2.0 * p(0)
+            ),
+            Effect::LidarMotionSkew => format!(
+                "The simulated lidar takes a whole revolution at one instant; the real one turns \
+                 for {:.2} s while the robot moves.",
+                p(0)
+            ),
+            Effect::LidarWarmupDrift => format!(
+                "The simulated lidar is warm from power-on; the real one's range bias drifts as it \
+                 warms up ({:+.1} mm at 2 m at power-on, settling with a {:.0} s time constant).",
+                p(0) * 4.0 * 1000.0,
+                p(1)
+            ),
+            Effect::SonarBeamWidth if declared_half_angle_deg > 0.0 => format!(
+                "The simulated sonar's cone is ±{declared_half_angle_deg:.1}°; the real one \
+                 returns the nearest echo anywhere in a cone of ±{:.1}°.",
+                p(0)
+            ),
+            Effect::SonarBeamWidth => format!(
+                "The simulated sonar sees along its axis only; the real one returns the nearest \
+                 echo anywhere in a cone of ±{:.1}°.",
+                p(0)
+            ),
+            Effect::SonarSpeedOfSound => format!(
+                "The simulated sonar assumes sound travels at its calibration temperature (20 °C); \
+                 the real air was at {:.1} °C, which scales every range.",
+                p(0)
+            ),
+            Effect::OdometerWheelSlip => format!(
+                "The simulated wheels grip perfectly; the real ones slip as they accelerate, so \
+                 the encoders lead the true travel by {:.0} ms × the wheel's speed.",
+                p(0) * 1000.0
+            ),
+            Effect::DriveMotorLag => format!(
+                "The simulated wheels reach a commanded speed at once; the real ones follow it \
+                 with a first-order lag of {:.2} s.",
+                p(0)
+            ),
+        }
+    }
+}

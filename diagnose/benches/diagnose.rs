@@ -15,10 +15,10 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 
+use cpu_time::ProcessTime;
 use hilsim_diagnose::{diagnose, Options, SimPhysics, Verdict};
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
-use cpu_time::ProcessTime;
 
 /// The nominal scenario run for 60 s, and a "real" run of it with the lidar's incidence effect.
 fn setup() -> (Scenario, Recording) {

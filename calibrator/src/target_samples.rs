@@ -231,11 +231,7 @@ fn start_distance(
 /// The lidar mount and the beam's direction φ from the robot's forward axis, radians; a beam
 /// (nearly) perpendicular to the motion is an error.
 fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(Mount, f64), CalibrationError> {
-    let mount = rec.meta.lidar.clone().unwrap_or(Mount {
-        x_m: 0.0,
-        y_m: 0.0,
-        yaw_deg: 0.0,
-    });
+    let mount = rec.meta.lidar.unwrap_or_default();
     if ![mount.x_m, mount.y_m, mount.yaw_deg]
         .iter()
         .all(|v| v.is_finite())

@@ -59,6 +59,17 @@ pub struct Options {
     pub max_order: usize,
 }
 
+impl Options {
+    /// The target these options name.
+    #[must_use]
+    pub fn sample_options(&self) -> SampleOptions {
+        SampleOptions {
+            beam_deg: self.beam_deg,
+            start_distance_m: self.start_distance_m,
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Self {
@@ -279,13 +290,7 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
             "no truth.csv: the ground-truth baseline needs the true pose".into(),
         ));
     }
-    let samples = target_samples::extract(
-        rec,
-        &SampleOptions {
-            beam_deg: opts.beam_deg,
-            start_distance_m: opts.start_distance_m,
-        },
-    )?;
+    let samples = target_samples::extract(rec, &opts.sample_options())?;
     let Some(truth) = samples.truth_m.as_ref() else {
         return Err(CalibrationError::Missing(
             "no start distance: none was given (--start-distance), and meta.toml's [world] \

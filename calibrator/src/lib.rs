@@ -19,6 +19,7 @@ pub mod smoothing;
 pub mod stats;
 pub mod target_samples;
 
-pub use by_method::{calibrate, em_options, TargetOptions};
+pub use by_method::{calibrate, em_options};
 pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};
 pub use error::CalibrationError;
+pub use target_samples::SampleOptions;

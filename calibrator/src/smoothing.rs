@@ -36,7 +36,7 @@ use hilsim_recording::Recording;
 pub use crate::em::Estimate;
 use crate::em::{self, EmOptions, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
 use crate::kalman_smoother::RtsSmoother;
-use crate::target_samples::{self, SampleOptions, TargetSamples};
+use crate::target_samples::{self, TargetSamples};
 use crate::{groundtruth, Calibration, CalibrationError, Sensor, SensorModel};
 
 /// Prior sd of the first distance, in units of the first lidar reading's sd, when the start
@@ -55,13 +55,7 @@ pub fn smooth(
     trained: &Calibration,
     opts: &EmOptions,
 ) -> Result<Vec<Estimate>, CalibrationError> {
-    let samples = target_samples::extract(
-        rec,
-        &SampleOptions {
-            beam_deg: opts.beam_deg,
-            start_distance_m: opts.start_distance_m,
-        },
-    )?;
+    let samples = target_samples::extract(rec, &opts.sample_options())?;
     smooth_samples(&samples, trained, opts)
 }
 

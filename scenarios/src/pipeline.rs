@@ -1,6 +1,6 @@
 //! One scenario end to end: emulate, calibrate with its methods, measure, check.
 
-use hilsim_calibrator::{Calibration, TargetOptions};
+use hilsim_calibrator::{Calibration, SampleOptions};
 use hilsim_lidar_emulator::{Emulation, Run};
 use hilsim_sim::Scenario;
 
@@ -94,7 +94,7 @@ pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report, Run
     let mut calibrations = Vec::new();
     for &method in &scenario.calibration.methods {
         let calibration =
-            hilsim_calibrator::calibrate(&run.recording, method, TargetOptions::default())
+            hilsim_calibrator::calibrate(&run.recording, method, SampleOptions::default())
                 .map_err(|e| RunError::Calibration {
                     origin: origin.to_string(),
                     method: method.name(),

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::smoothing;
-use hilsim_calibrator::{Calibration, TargetOptions};
+use hilsim_calibrator::{Calibration, SampleOptions};
 use hilsim_recording::{write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
@@ -26,7 +26,7 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<()> {
     Ok(())
 }
 
-fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<TargetOptions> {
+fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions> {
     let beam_deg = beam.unwrap_or(0.0);
     if !beam_deg.is_finite() {
         bail!("--beam: expected a finite angle in degrees");
@@ -34,7 +34,7 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<TargetOptions
     if start.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
         bail!("--start-distance: expected a positive distance in metres");
     }
-    Ok(TargetOptions {
+    Ok(SampleOptions {
         beam_deg,
         start_distance_m: start,
     })

@@ -130,7 +130,9 @@ impl EmOptions {
         Ok(())
     }
 
-    pub(super) fn sample_options(&self) -> SampleOptions {
+    /// The target these options name.
+    #[must_use]
+    pub fn sample_options(&self) -> SampleOptions {
         SampleOptions {
             beam_deg: self.beam_deg,
             start_distance_m: self.start_distance_m,

@@ -480,21 +480,6 @@ mod tests {
 
     /// The process no longer runs (gone, or a zombie waiting for init to reap it).
     fn gone(pid: i32) -> bool {
-        let deadline = Instant::now() + Duration::from_secs(2);
-        loop {
-            match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
-                Err(_) => return true,
-                Ok(stat)
-                    if stat
-                        .rsplit(')')
-                        .next()
-                        .is_some_and(|s| s.trim_start().starts_with('Z')) =>
-                {
-                    return true
-                }
-                Ok(_) if Instant::now() > deadline => return false,
-                Ok(_) => thread::sleep(POLL),
-            }
-        }
+        crate::process::has_exited(pid.unsigned_abs(), Duration::from_secs(2))
     }
 }

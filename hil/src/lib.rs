@@ -13,6 +13,7 @@ pub mod hil_run;
 mod link;
 pub mod loopback;
 pub mod motion;
+pub mod process;
 mod pty;
 pub mod serve;
 mod streamer;

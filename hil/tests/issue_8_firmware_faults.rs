@@ -6,8 +6,7 @@
 
 use std::collections::BTreeMap;
 use std::sync::atomic::AtomicBool;
-use std::thread;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use hilsim_hil::firmware::{Ended, Firmware};
 use hilsim_hil::hil_run::{run, Ending, Fault, HilConfig, HilPorts, HilReport, HilWorld};
@@ -37,24 +36,7 @@ fn open_fds() -> BTreeMap<String, String> {
 
 /// The process no longer runs (gone, or a zombie waiting for init to reap it).
 fn gone(pid: u32) -> bool {
-    let deadline = Instant::now() + Duration::from_secs(2);
-    loop {
-        match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
-            Err(_) => return true,
-            Ok(stat)
-                if stat
-                    .rsplit(')')
-                    .next()
-                    .unwrap_or("")
-                    .trim_start()
-                    .starts_with('Z') =>
-            {
-                return true
-            }
-            Ok(_) if Instant::now() > deadline => return false,
-            Ok(_) => thread::sleep(Duration::from_millis(10)),
-        }
-    }
+    hilsim_hil::process::has_exited(pid, Duration::from_secs(2))
 }
 
 /// Runs `script` under `sh -c` as the firmware for up to 6 s with a 1 s watchdog. Every

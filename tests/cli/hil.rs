@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
-use std::thread;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use hilsim_recording::Recording;
 
@@ -83,24 +82,7 @@ fn firmware_pid(text: &str) -> u32 {
 
 /// The process no longer runs (gone, or a zombie waiting for init to reap it).
 fn gone(pid: u32) -> bool {
-    let deadline = Instant::now() + Duration::from_secs(2);
-    loop {
-        match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
-            Err(_) => return true,
-            Ok(stat)
-                if stat
-                    .rsplit(')')
-                    .next()
-                    .unwrap_or("")
-                    .trim_start()
-                    .starts_with('Z') =>
-            {
-                return true
-            }
-            Ok(_) if Instant::now() > deadline => return false,
-            Ok(_) => thread::sleep(Duration::from_millis(10)),
-        }
-    }
+    hilsim_hil::process::has_exited(pid, Duration::from_secs(2))
 }
 
 /// Asserts that the firmware (its summary line starts with `name:`) decoded every revolution

@@ -1,0 +1,28 @@
+//! Whether a process still runs: what the tests of every exit path (and anyone checking for
+//! orphans a firmware left) ask of the system.
+
+use std::thread;
+use std::time::{Duration, Instant};
+
+/// Whether process `pid` is gone, or a zombie waiting for its parent to reap it, within `within`
+/// (polled every 10 ms from `/proc`; Linux).
+#[must_use]
+pub fn has_exited(pid: u32, within: Duration) -> bool {
+    let deadline = Instant::now() + within;
+    loop {
+        match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+            Err(_) => return true,
+            // The state follows the command name, which is in parentheses and may hold any byte.
+            Ok(stat)
+                if stat
+                    .rsplit(')')
+                    .next()
+                    .is_some_and(|s| s.trim_start().starts_with('Z')) =>
+            {
+                return true
+            }
+            Ok(_) if Instant::now() > deadline => return false,
+            Ok(_) => thread::sleep(Duration::from_millis(10)),
+        }
+    }
+}

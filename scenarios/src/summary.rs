@@ -34,11 +34,7 @@ impl Report {
             self.run.collisions.len()
         )?;
         for c in &self.run.collisions {
-            writeln!(
-                out,
-                "  collision at t = {:.2} s with {:?}",
-                c.t_s, c.obstacle
-            )?;
+            writeln!(out, "  {c}")?;
         }
         if rec.lidar.is_some() {
             writeln!(

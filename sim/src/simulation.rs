@@ -23,6 +23,17 @@ pub struct Collision {
     pub pose: Pose,
 }
 
+impl std::fmt::Display for Collision {
+    /// `collision at t = 1.25 s with Wall(2)`, as run summaries print it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "collision at t = {:.2} s with {:?}",
+            self.t_s, self.obstacle
+        )
+    }
+}
+
 /// What happened during one physics step, for the sensors to sample from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepState {

@@ -50,11 +50,7 @@ impl HilReport {
             }
         }
         for c in &self.run.collisions {
-            writeln!(
-                out,
-                "  collision at t = {:.2} s with {:?}",
-                c.t_s, c.obstacle
-            )?;
+            writeln!(out, "  {c}")?;
         }
         let c = &self.commands;
         writeln!(

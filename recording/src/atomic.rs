@@ -5,17 +5,88 @@
 //! recognises as leftovers of an interrupted write and removes.
 
 use std::fs;
-use std::io::Write;
+use std::io::{self, Write};
+use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};
 
-use crate::Error;
+use crate::{Error, FORMAT};
+
+/// Where an output file goes, decided before anything is written: a user's path is never
+/// replaced by something of another kind.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum OutputTarget {
+    /// A regular file (or nothing yet) at this path, symbolic links followed: written to a
+    /// temporary sibling and renamed over it.
+    Replace(PathBuf),
+    /// A character device or a FIFO (`/dev/null`, `/dev/stdout`, a pipe): written through, as a
+    /// shell's `>` would, never replaced.
+    WriteThrough(PathBuf),
+}
+
+impl OutputTarget {
+    /// What writing to `path` means.
+    ///
+    /// # Errors
+    /// `path` is a directory, a socket, a block device, or a symbolic link that leads nowhere.
+    pub fn of(path: &Path) -> Result<Self, Error> {
+        let refuse = |what: &str| {
+            Error::io(
+                path,
+                io::Error::other(format!("{what}; refusing to write over it")),
+            )
+        };
+        match fs::symlink_metadata(path) {
+            Err(err) if err.kind() == io::ErrorKind::NotFound => {
+                return Ok(Self::Replace(path.to_path_buf()))
+            }
+            Err(err) => return Err(Error::io(path, err)),
+            Ok(_) => {}
+        }
+        // Follow links: the file the user names is the one they mean.
+        let target =
+            fs::canonicalize(path).map_err(|_| refuse("is a symbolic link that leads nowhere"))?;
+        let kind = fs::metadata(&target)
+            .map_err(|err| Error::io(path, err))?
+            .file_type();
+        if kind.is_file() {
+            Ok(Self::Replace(target))
+        } else if kind.is_char_device() || kind.is_fifo() {
+            Ok(Self::WriteThrough(target))
+        } else if kind.is_dir() {
+            Err(refuse("is a directory"))
+        } else {
+            Err(refuse("is not a regular file"))
+        }
+    }
+}
+
+/// Whether `a` and `b` are the same file (same device and inode); false when either is absent.
+#[must_use]
+pub fn is_same_file(a: &Path, b: &Path) -> bool {
+    match (fs::metadata(a), fs::metadata(b)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
 
 /// Writes `contents` to `path` through a temporary file in the same directory, then renames it
-/// over `path`, so a reader sees either the old file or the whole new one.
+/// over `path`, so a reader sees either the old file or the whole new one. A symbolic link is
+/// followed; a device or FIFO is written through (see [`OutputTarget`]).
 ///
 /// # Errors
-/// Any I/O error, naming `path`.
+/// Any I/O error, naming `path`; a directory or other non-file at `path` is refused.
 pub fn write_file_atomically(path: &Path, contents: &[u8]) -> Result<(), Error> {
+    let path = match OutputTarget::of(path)? {
+        OutputTarget::Replace(path) => path,
+        OutputTarget::WriteThrough(device) => {
+            return fs::OpenOptions::new()
+                .write(true)
+                .open(&device)
+                .and_then(|mut file| file.write_all(contents))
+                .map_err(|err| Error::io(&device, err));
+        }
+    };
+    let path = path.as_path();
     let tmp = sibling(path, "tmp");
     let result = (|| {
         let mut file = fs::File::create(&tmp)?;
@@ -70,6 +141,72 @@ where
         let _ = fs::remove_dir_all(&old);
     }
     Ok(())
+}
+
+/// Whether `dir` may be replaced by a recording: it is absent, an empty directory, or a hilsim
+/// recording (a directory whose `meta.toml` names the format). Anything else is the user's.
+///
+/// # Errors
+/// `dir` is something else (a file, a link, a directory of other things), with what it is.
+pub fn check_replaceable_recording(dir: &Path) -> Result<(), Error> {
+    let refuse = |what: &str| {
+        Error::io(
+            dir,
+            io::Error::other(format!(
+                "{what}; refusing to replace it (an output directory is replaced only when it \
+                 holds a hilsim recording)"
+            )),
+        )
+    };
+    let meta = match fs::symlink_metadata(dir) {
+        Err(err) if err.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(err) => return Err(Error::io(dir, err)),
+        Ok(meta) => meta,
+    };
+    if !meta.is_dir() {
+        return Err(refuse("exists and is not a directory"));
+    }
+    let mut entries = fs::read_dir(dir).map_err(|err| Error::io(dir, err))?;
+    if entries.next().is_none() {
+        return Ok(());
+    }
+    if names_the_format(&dir.join("meta.toml")) {
+        Ok(())
+    } else {
+        Err(refuse("exists and is not a hilsim recording"))
+    }
+}
+
+/// Whether `path` is a small regular file whose `format` key is the recording format's.
+fn names_the_format(path: &Path) -> bool {
+    // A real meta.toml is a few hundred bytes; anything large is not one.
+    const MAX_META_BYTES: u64 = 1 << 20;
+    let Ok(meta) = fs::symlink_metadata(path) else {
+        return false;
+    };
+    if !meta.is_file() || meta.len() > MAX_META_BYTES {
+        return false;
+    }
+    fs::read_to_string(path)
+        .ok()
+        .and_then(|text| text.parse::<toml::Table>().ok())
+        .is_some_and(|table| table.get("format").and_then(|f| f.as_str()) == Some(FORMAT))
+}
+
+/// [`replace_dir_atomically`] for a recording's directory: refused unless `dir` may be replaced
+/// ([`check_replaceable_recording`]).
+///
+/// # Errors
+/// As [`check_replaceable_recording`] and [`replace_dir_atomically`].
+pub fn replace_recording_dir<E>(
+    dir: &Path,
+    fill: impl FnOnce(&Path) -> Result<(), E>,
+) -> Result<(), E>
+where
+    E: From<Error>,
+{
+    check_replaceable_recording(dir)?;
+    replace_dir_atomically(dir, fill)
 }
 
 /// `dir/.name.tag.PID`: hidden, in the same file system (so `rename` is atomic), unique per

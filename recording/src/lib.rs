@@ -27,7 +27,10 @@ mod read;
 mod samples;
 mod write;
 
-pub use atomic::{replace_dir_atomically, write_file_atomically};
+pub use atomic::{
+    check_replaceable_recording, is_same_file, replace_dir_atomically, replace_recording_dir,
+    write_file_atomically, OutputTarget,
+};
 pub use error::{Error, ErrorKind};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
@@ -55,6 +58,16 @@ pub struct Recording {
 }
 
 impl Recording {
+    /// The files a recording directory may hold.
+    pub const FILES: [&'static str; 6] = [
+        "meta.toml",
+        "commands.csv",
+        "odometry.csv",
+        "lidar.csv",
+        "sonar.csv",
+        "truth.csv",
+    ];
+
     /// An empty recording with the given metadata.
     #[must_use]
     pub fn new(meta: Meta) -> Self {

@@ -3,20 +3,20 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::atomic::{replace_dir_atomically, write_file_atomically};
+use crate::atomic::{replace_recording_dir, write_file_atomically};
 use crate::{Error, Recording};
 
 impl Recording {
-    /// Writes the recording into `dir`, replacing whatever recording was there only once the new
-    /// one is complete (see [`replace_dir_atomically`]).
+    /// Writes the recording into `dir`, replacing a recording that was there only once the new
+    /// one is complete; anything else at `dir` is refused (see [`replace_recording_dir`]).
     ///
     /// Output is a pure function of the recording: floats are written in Rust's shortest
     /// round-trip form, so equal recordings give byte-identical files.
     ///
     /// # Errors
-    /// An I/O error naming the file.
+    /// An I/O error naming the file; `dir` holds something other than a recording.
     pub fn write_dir(&self, dir: &Path) -> Result<(), Error> {
-        replace_dir_atomically(dir, |tmp| self.write_files(tmp))
+        replace_recording_dir(dir, |tmp| self.write_files(tmp))
     }
 
     /// Writes the recording's files into an existing directory, each atomically. Use this to add

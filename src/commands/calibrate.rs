@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::smoothing;
 use hilsim_calibrator::{Calibration, SampleOptions};
-use hilsim_recording::{write_file_atomically, Recording};
+use hilsim_recording::{is_same_file, write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
@@ -42,6 +42,23 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions
 
 pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<()> {
     let target = target_options(args.beam, args.start_distance)?;
+    if let Some(csv) = &args.csv {
+        // The inputs: the calibration and the recording's own files.
+        let inputs = std::iter::once(args.calibration.clone()).chain(
+            Recording::FILES
+                .iter()
+                .map(|name| args.recording.join(name)),
+        );
+        for input in inputs {
+            if is_same_file(csv, &input) {
+                bail!(
+                    "{}: is an input ({}); refusing to write the CSV over it",
+                    csv.display(),
+                    input.display()
+                );
+            }
+        }
+    }
     let trained = read_calibration(&args.calibration)?;
     let rec = Recording::read_dir(&args.recording)?;
     let estimates = smoothing::smooth(&rec, &trained, &hilsim_calibrator::em_options(target))

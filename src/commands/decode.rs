@@ -22,12 +22,13 @@
 //! `index_gaps`, `readings`, `invalid`, `strength_warning` (integers) and `rpm_min`,
 //! `rpm_median`, `rpm_max` (floats over accepted packets, 0.0 when there are none).
 
-use std::fs::File;
+use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, ErrorKind, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use hilsim_hil::decode::{decode_stream, decoded_csv_rows, DecodeCounts, DECODED_CSV_HEADER};
+use hilsim_recording::{is_same_file, OutputTarget};
 use tempfile::NamedTempFile;
 
 /// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
@@ -49,7 +50,7 @@ pub fn run(
         None => decode_stream::<std::io::Error>(&mut source, None).map_err(read_error)?,
         Some(path) => {
             let cannot_write = || format!("{}: cannot write", path.display());
-            let mut out = create_csv(path)?;
+            let mut out = CsvOut::create(path, input)?;
             let mut rows = String::new();
             let mut write = |revolution: &_| -> std::io::Result<()> {
                 rows.clear();
@@ -64,39 +65,92 @@ pub fn run(
                 Err(err) if write_failed => return Err(err).with_context(cannot_write),
                 other => other.map_err(read_error)?,
             };
-            let file = out
-                .into_inner()
-                .map_err(|err| err.into_error())
-                .with_context(cannot_write)?;
-            file.as_file().sync_all().with_context(cannot_write)?;
-            file.persist(path)
-                .map_err(|err| err.error)
-                .with_context(cannot_write)?;
+            out.finish().with_context(cannot_write)?;
             counts
         }
     };
     report(input, &counts, json, stdout).context("stdout: cannot write")
 }
 
-/// The CSV being written, with its header: a hidden temporary sibling of `path` (so the final
-/// rename is atomic), removed if anything fails before it is persisted.
-fn create_csv(path: &Path) -> anyhow::Result<BufWriter<NamedTempFile>> {
-    let Some(name) = path.file_name() else {
-        bail!("{}: not a file name for the CSV output", path.display());
-    };
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let file = tempfile::Builder::new()
-        .prefix(&format!(".{}.", name.to_string_lossy()))
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .with_context(|| format!("{}: cannot create", path.display()))?;
-    let mut out = BufWriter::new(file);
-    writeln!(out, "{DECODED_CSV_HEADER}")
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    Ok(out)
+/// The CSV being written, its header first.
+enum CsvOut {
+    /// A hidden temporary sibling of the target (so the final rename is atomic), removed if
+    /// anything fails before it is persisted.
+    Replace {
+        file: BufWriter<NamedTempFile>,
+        to: PathBuf,
+    },
+    /// A device or FIFO (`/dev/null`, a pipe), written through.
+    Through(BufWriter<File>),
+}
+
+impl CsvOut {
+    /// Opens the CSV at `path` (see [`OutputTarget`]); refuses to write over `input`.
+    fn create(path: &Path, input: &Path) -> anyhow::Result<Self> {
+        if is_same_file(path, input) {
+            bail!(
+                "{}: is the input; refusing to write the CSV over it",
+                path.display()
+            );
+        }
+        let mut out = match OutputTarget::of(path)? {
+            OutputTarget::WriteThrough(device) => Self::Through(BufWriter::new(
+                OpenOptions::new()
+                    .write(true)
+                    .open(&device)
+                    .with_context(|| format!("{}: cannot open", path.display()))?,
+            )),
+            OutputTarget::Replace(to) => {
+                let Some(name) = to.file_name() else {
+                    bail!("{}: not a file name for the CSV output", path.display());
+                };
+                let dir = match to.parent() {
+                    Some(dir) if !dir.as_os_str().is_empty() => dir,
+                    _ => Path::new("."),
+                };
+                let file = tempfile::Builder::new()
+                    .prefix(&format!(".{}.", name.to_string_lossy()))
+                    .suffix(".tmp")
+                    .tempfile_in(dir)
+                    .with_context(|| format!("{}: cannot create", path.display()))?;
+                Self::Replace {
+                    file: BufWriter::new(file),
+                    to,
+                }
+            }
+        };
+        writeln!(out, "{DECODED_CSV_HEADER}")
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+        Ok(out)
+    }
+
+    /// Flushes, and puts a replaced file in place.
+    fn finish(self) -> std::io::Result<()> {
+        match self {
+            Self::Through(mut file) => file.flush(),
+            Self::Replace { file, to } => {
+                let file = file.into_inner().map_err(|err| err.into_error())?;
+                file.as_file().sync_all()?;
+                file.persist(to).map(|_| ()).map_err(|err| err.error)
+            }
+        }
+    }
+}
+
+impl Write for CsvOut {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match self {
+            Self::Replace { file, .. } => file.write(buf),
+            Self::Through(file) => file.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        match self {
+            Self::Replace { file, .. } => file.flush(),
+            Self::Through(file) => file.flush(),
+        }
+    }
 }
 
 fn open_input(input: &Path) -> anyhow::Result<File> {

@@ -23,7 +23,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     out.write_all(report.summary().as_bytes())?;
     if let Some(dir) = &args.out {
         let results = report.results_json();
-        hilsim_recording::replace_dir_atomically(dir, |tmp| -> Result<()> {
+        hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
             report.run.recording.write_files(tmp)?;
             write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
             Ok(())

@@ -7,6 +7,7 @@ mod common;
 mod dataset;
 mod diagnose;
 mod hil;
+mod outputs;
 mod record;
 mod run;
 mod scenario_test;

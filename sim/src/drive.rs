@@ -36,16 +36,12 @@ impl DriveProgram {
     pub fn new(scenario: &Scenario) -> Self {
         let dt = scenario.step_s();
         let half_base = scenario.robot.wheel_base_m / 2.0;
-        let turn_rate = scenario.robot.turn_rate_deg_s.to_radians();
         let mut segments = Vec::with_capacity(scenario.drive.len());
         let mut start_step = 0;
         for step in &scenario.drive {
-            let duration_s = match (step.speed_mps, step.distance_m, step.stop_s, step.turn_deg) {
-                (Some(v), Some(d), _, _) => d / v.abs(),
-                (_, _, Some(t), _) => t,
-                (_, _, _, Some(deg)) => deg.to_radians().abs() / turn_rate,
-                // Validation guarantees one kind per step.
-                _ => continue,
+            // Validation guarantees one kind per step.
+            let Some(duration_s) = step.duration_s(scenario.robot.turn_rate_deg_s) else {
+                continue;
             };
             let steps = (duration_s / dt).round() as u64;
             let steps = if duration_s > 0.0 { steps.max(1) } else { 0 };

@@ -15,10 +15,8 @@ use std::time::Duration;
 use anyhow::{anyhow, bail, Context, Result};
 use hilsim_hil::firmware::{split_command_line, Firmware};
 use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
+use hilsim_sim::scenario::MAX_RUN_S;
 use hilsim_sim::Scenario;
-
-/// The longest run or watchdog accepted, seconds (a day: anything longer is a typo).
-const MAX_SECONDS: f64 = 86_400.0;
 
 #[derive(Debug, clap::Args)]
 pub struct HilArgs {
@@ -45,10 +43,10 @@ pub struct HilArgs {
 
 fn seconds(flag: &str, value: f64) -> Result<Duration> {
     if !value.is_finite() {
-        bail!("{flag} must be a number of seconds in (0, {MAX_SECONDS}], got a non-finite value");
+        bail!("{flag} must be a number of seconds in (0, {MAX_RUN_S}], got a non-finite value");
     }
-    if !(value > 0.0 && value <= MAX_SECONDS) {
-        bail!("{flag} must be a number of seconds in (0, {MAX_SECONDS}], got {value}");
+    if !(value > 0.0 && value <= MAX_RUN_S) {
+        bail!("{flag} must be a number of seconds in (0, {MAX_RUN_S}], got {value}");
     }
     Ok(Duration::from_secs_f64(value))
 }

@@ -71,6 +71,32 @@ const CORPUS: &[(&str, usize, &str)] = &[
         1,
         "invalid type: integer `42`, expected a string",
     ),
+    // Issue 18: values with no physical sense are refused with the documented limit.
+    (
+        "issue-18-duration-a-billion-seconds.toml",
+        2,
+        "duration_s: expected at most 86400 s (a day)",
+    ),
+    (
+        "issue-18-drive-a-million-km.toml",
+        7,
+        "drive: the drive program lasts 10000000000 s; expected at most 86400 s",
+    ),
+    (
+        "issue-18-sonar-rate-a-gigahertz.toml",
+        9,
+        "sensors.sonar.rate_hz: expected at most 1000 Hz",
+    ),
+    (
+        "issue-18-yaw-1e300.toml",
+        5,
+        "robot.start.yaw_deg: expected an angle within ±360 degrees",
+    ),
+    (
+        "issue-18-wall-beyond-rapier-precision.toml",
+        9,
+        "world.walls[0].from: expected coordinates within ±1000 m",
+    ),
 ];
 
 #[test]

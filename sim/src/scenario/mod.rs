@@ -34,6 +34,7 @@ mod validate_effects;
 pub use effects::*;
 pub use error::ScenarioError;
 pub use schema::*;
+pub use validate::{MAX_ANGLE_DEG, MAX_RUN_S, MAX_SENSOR_RATE_HZ, MAX_WORLD_M};
 
 #[cfg(test)]
 mod tests;

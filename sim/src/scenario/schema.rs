@@ -270,6 +270,20 @@ pub struct DriveStep {
     pub turn_deg: Option<f64>,
 }
 
+impl DriveStep {
+    /// How long the step lasts, seconds (a turn at `turn_rate_deg_s`), before rounding to
+    /// physics steps; `None` for a step of no known kind (validation refuses those).
+    #[must_use]
+    pub fn duration_s(&self, turn_rate_deg_s: f64) -> Option<f64> {
+        match (self.speed_mps, self.distance_m, self.stop_s, self.turn_deg) {
+            (Some(v), Some(d), _, _) => Some(d / v.abs()),
+            (_, _, Some(t), _) => Some(t),
+            (_, _, _, Some(deg)) => Some(deg.to_radians().abs() / turn_rate_deg_s.to_radians()),
+            _ => None,
+        }
+    }
+}
+
 /// `[sensors]`.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -7,6 +7,51 @@ use super::metrics;
 use super::schema::{DriveStep, Scenario};
 use super::validate_effects;
 
+/// The longest run a scenario may describe, seconds: a day. A recording of a day at the default
+/// rates is a few GB; a longer one is a mistake (`duration_s = 1e9`), not an experiment.
+pub const MAX_RUN_S: f64 = 86_400.0;
+/// The largest coordinate or size in a world, metres: rapier computes in `f32`, whose resolution
+/// at 1 km is 0.06 mm, still below the sensors' millimetre; beyond, geometry degrades.
+pub const MAX_WORLD_M: f64 = 1_000.0;
+/// The largest angle of a pose or mount, degrees (one turn either way; a larger one is a typo).
+pub const MAX_ANGLE_DEG: f64 = 360.0;
+/// The fastest sonar ping or odometer report, Hz: faster than any ultrasonic ranger's echo or
+/// wheel encoder's report, and at most 86.4 million samples in a day's run.
+pub const MAX_SENSOR_RATE_HZ: f64 = 1_000.0;
+
+fn angle(path: Vec<Key>, deg: f64) -> Check {
+    finite(path.clone(), deg)?;
+    if deg.abs() > MAX_ANGLE_DEG {
+        return fail(
+            path,
+            format!("expected an angle within ±{MAX_ANGLE_DEG} degrees, found {deg}"),
+        );
+    }
+    Ok(())
+}
+
+fn size(path: Vec<Key>, v: f64) -> Check {
+    positive(path.clone(), v)?;
+    if v > MAX_WORLD_M {
+        return fail(
+            path,
+            format!("expected at most {MAX_WORLD_M} m (rapier's f32 precision), found {v}"),
+        );
+    }
+    Ok(())
+}
+
+fn rate(path: Vec<Key>, hz: f64) -> Check {
+    positive(path.clone(), hz)?;
+    if hz > MAX_SENSOR_RATE_HZ {
+        return fail(
+            path,
+            format!("expected at most {MAX_SENSOR_RATE_HZ} Hz, found {hz}"),
+        );
+    }
+    Ok(())
+}
+
 fn finite(path: Vec<Key>, v: f64) -> Check {
     if v.is_finite() {
         Ok(())
@@ -41,18 +86,26 @@ fn non_negative(path: Vec<Key>, v: f64) -> Check {
 }
 
 fn point(path: Vec<Key>, p: [f64; 2]) -> Check {
-    if p.iter().all(|c| c.is_finite()) {
-        Ok(())
-    } else {
-        fail(
+    if !p.iter().all(|c| c.is_finite()) {
+        return fail(
             path,
             format!(
                 "expected finite coordinates, found [{}, {}]",
                 toml_number(p[0]),
                 toml_number(p[1])
             ),
-        )
+        );
     }
+    if p.iter().any(|c| c.abs() > MAX_WORLD_M) {
+        return fail(
+            path,
+            format!(
+                "expected coordinates within ±{MAX_WORLD_M} m (rapier's f32 precision), found [{}, {}]",
+                p[0], p[1]
+            ),
+        );
+    }
+    Ok(())
 }
 
 /// Polynomial coefficients of eq. (2): finite, and for noise also non-negative (a standard
@@ -87,6 +140,12 @@ pub(super) fn validate(s: &Scenario) -> Check {
     }
     if let Some(d) = s.duration_s {
         positive(key_path!["duration_s"], d)?;
+        if d > MAX_RUN_S {
+            return fail(
+                key_path!["duration_s"],
+                format!("expected at most {MAX_RUN_S} s (a day), found {d}"),
+            );
+        }
     }
     let hz = s.physics.step_hz;
     if !(hz.is_finite() && (10.0..=10_000.0).contains(&hz)) {
@@ -161,7 +220,7 @@ fn world(s: &Scenario) -> Check {
     }
     for (i, c) in w.cylinders.iter().enumerate() {
         point(key_path!["world", "cylinders", i, "center"], c.center)?;
-        positive(key_path!["world", "cylinders", i, "radius"], c.radius)?;
+        size(key_path!["world", "cylinders", i, "radius"], c.radius)?;
         material(
             s,
             key_path!["world", "cylinders", i, "material"],
@@ -179,9 +238,9 @@ fn world(s: &Scenario) -> Check {
     }
     for (i, b) in w.boards.iter().enumerate() {
         point(key_path!["world", "boards", i, "center"], b.center)?;
-        positive(key_path!["world", "boards", i, "length"], b.length)?;
-        positive(key_path!["world", "boards", i, "thickness"], b.thickness)?;
-        finite(key_path!["world", "boards", i, "yaw_deg"], b.yaw_deg)?;
+        size(key_path!["world", "boards", i, "length"], b.length)?;
+        size(key_path!["world", "boards", i, "thickness"], b.thickness)?;
+        angle(key_path!["world", "boards", i, "yaw_deg"], b.yaw_deg)?;
         material(
             s,
             key_path!["world", "boards", i, "material"],
@@ -195,9 +254,10 @@ fn robot(s: &Scenario) -> Check {
     let r = &s.robot;
     finite(key_path!["robot", "start", "x"], r.start.x)?;
     finite(key_path!["robot", "start", "y"], r.start.y)?;
-    finite(key_path!["robot", "start", "yaw_deg"], r.start.yaw_deg)?;
-    positive(key_path!["robot", "wheel_base_m"], r.wheel_base_m)?;
-    positive(key_path!["robot", "radius_m"], r.radius_m)?;
+    point(key_path!["robot", "start"], [r.start.x, r.start.y])?;
+    angle(key_path!["robot", "start", "yaw_deg"], r.start.yaw_deg)?;
+    size(key_path!["robot", "wheel_base_m"], r.wheel_base_m)?;
+    size(key_path!["robot", "radius_m"], r.radius_m)?;
     positive(key_path!["robot", "turn_rate_deg_s"], r.turn_rate_deg_s)?;
     let a = r.actuation;
     non_negative(key_path!["robot", "actuation", "scale_sd"], a.scale_sd)?;
@@ -220,6 +280,19 @@ fn robot(s: &Scenario) -> Check {
 fn drive(s: &Scenario) -> Check {
     for (i, step) in s.drive.iter().enumerate() {
         drive_step(i, step)?;
+    }
+    let program_s: f64 = s
+        .drive
+        .iter()
+        .filter_map(|step| step.duration_s(s.robot.turn_rate_deg_s))
+        .sum();
+    if program_s > MAX_RUN_S {
+        return fail(
+            key_path!["drive"],
+            format!(
+                "the drive program lasts {program_s} s; expected at most {MAX_RUN_S} s (a day)"
+            ),
+        );
     }
     if s.drive.is_empty() && s.duration_s.is_none() {
         return fail(
@@ -321,7 +394,7 @@ fn sensors(s: &Scenario) -> Check {
                 ),
             );
         }
-        positive(p("rate_hz"), u.rate_hz)?;
+        rate(p("rate_hz"), u.rate_hz)?;
         positive(p("max_range_m"), u.max_range_m)?;
         mount(key_path!["sensors", "sonar", "mount"], u.mount)?;
     }
@@ -335,7 +408,7 @@ fn sensors(s: &Scenario) -> Check {
         }
         non_negative(p("noise_m"), o.noise_m)?;
         positive(p("tick_m"), o.tick_m)?;
-        positive(p("rate_hz"), o.rate_hz)?;
+        rate(p("rate_hz"), o.rate_hz)?;
     }
     Ok(())
 }
@@ -344,7 +417,8 @@ fn mount(path: Vec<Key>, m: super::schema::Mount) -> Check {
     for v in [m.x_m, m.y_m, m.yaw_deg] {
         finite(path.clone(), v)?;
     }
-    Ok(())
+    point(path.clone(), [m.x_m, m.y_m])?;
+    angle(path, m.yaw_deg)
 }
 
 /// The robot's disc must not overlap any obstacle at t = 0.

@@ -20,6 +20,7 @@
 mod atomic;
 mod csv;
 mod error;
+mod input;
 mod meta;
 mod names;
 pub mod pose;

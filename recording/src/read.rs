@@ -1,9 +1,9 @@
 //! Reading a recording directory, strictly: a malformed file is an error naming the file and line.
 
-use std::fs;
 use std::path::Path;
 
-use crate::csv::Table;
+use crate::csv::read_table;
+use crate::input::{self, MAX_META_BYTES};
 use crate::{
     CommandSample, Error, LidarSample, Meta, OdometrySample, Recording, SonarSample, TruthSample,
     FORMAT,
@@ -16,6 +16,10 @@ impl Recording {
     /// absent. Columns are found by name, so extra columns are ignored; times must be finite,
     /// non-negative and never go backwards.
     ///
+    /// Tables are streamed, so memory is what the samples take, about the size of the file.
+    /// Every file must be a regular file (a device or pipe may never end); a table's line may be
+    /// at most 64 KiB and a table at most 16 GiB; `meta.toml` at most 1 MiB.
+    ///
     /// # Errors
     /// A missing required file, or the first malformed line, naming the file and line.
     pub fn read_dir(dir: &Path) -> Result<Self, Error> {
@@ -23,8 +27,7 @@ impl Recording {
             return Err(Error::format(dir, None, "not a recording directory"));
         }
         let meta = read_meta(&dir.join("meta.toml"))?;
-        let commands_path = dir.join("commands.csv");
-        let commands = read_commands(&commands_path, &read_text(&commands_path)?)?;
+        let commands = read_commands(&dir.join("commands.csv"))?;
         Ok(Self {
             meta,
             commands,
@@ -36,32 +39,20 @@ impl Recording {
     }
 }
 
-fn read_text(path: &Path) -> Result<String, Error> {
-    let bytes = fs::read(path).map_err(|err| Error::io(path, err))?;
-    String::from_utf8(bytes).map_err(|err| {
-        let line = 1 + err.as_bytes()[..err.utf8_error().valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        Error::format(path, Some(line), "not UTF-8 text")
-    })
-}
-
 fn optional<T>(
     dir: &Path,
     name: &str,
-    read: fn(&Path, &str) -> Result<Vec<T>, Error>,
+    read: fn(&Path) -> Result<Vec<T>, Error>,
 ) -> Result<Option<Vec<T>>, Error> {
     let path = dir.join(name);
     if !path.exists() {
         return Ok(None);
     }
-    let text = read_text(&path)?;
-    read(&path, &text).map(Some)
+    read(&path).map(Some)
 }
 
 fn read_meta(path: &Path) -> Result<Meta, Error> {
-    let text = read_text(path)?;
+    let text = input::read_small_text(path, MAX_META_BYTES, "a meta.toml")?;
     let meta: Meta = toml::from_str(&text).map_err(|err| {
         let line = err
             .span()
@@ -110,33 +101,34 @@ fn read_meta(path: &Path) -> Result<Meta, Error> {
 /// `sample(t_s, values)` (columns looked up, and cells parsed, in that order).
 fn read_numbers<T, const N: usize>(
     path: &Path,
-    text: &str,
     columns: [&str; N],
     sample: impl Fn(f64, [f64; N]) -> T,
 ) -> Result<Vec<T>, Error> {
-    let table = Table::parse(path, text)?;
-    let t = table.column("t_s")?;
-    let mut indices = [0; N];
-    for (index, name) in indices.iter_mut().zip(columns) {
-        *index = table.column(name)?;
-    }
     let mut prev = None;
-    table
-        .rows()
-        .map(|row| {
-            let t_s = row.f64(t)?;
+    read_table(
+        path,
+        |header| {
+            let t = header.column("t_s")?;
+            let mut indices = [0; N];
+            for (index, name) in indices.iter_mut().zip(columns) {
+                *index = header.column(name)?;
+            }
+            Ok((t, indices))
+        },
+        |(t, indices), row| {
+            let t_s = row.f64(*t)?;
             row.check_time(t_s, &mut prev)?;
             let mut values = [0.0; N];
-            for (value, &index) in values.iter_mut().zip(&indices) {
+            for (value, &index) in values.iter_mut().zip(indices) {
                 *value = row.f64(index)?;
             }
             Ok(sample(t_s, values))
-        })
-        .collect()
+        },
+    )
 }
 
-fn read_commands(path: &Path, text: &str) -> Result<Vec<CommandSample>, Error> {
-    read_numbers(path, text, ["left_mps", "right_mps"], |t_s, [l, r]| {
+fn read_commands(path: &Path) -> Result<Vec<CommandSample>, Error> {
+    read_numbers(path, ["left_mps", "right_mps"], |t_s, [l, r]| {
         CommandSample {
             t_s,
             left_mps: l,
@@ -145,70 +137,81 @@ fn read_commands(path: &Path, text: &str) -> Result<Vec<CommandSample>, Error> {
     })
 }
 
-fn read_odometry(path: &Path, text: &str) -> Result<Vec<OdometrySample>, Error> {
-    read_numbers(path, text, ["left_m", "right_m"], |t_s, [l, r]| {
-        OdometrySample {
-            t_s,
-            left_m: l,
-            right_m: r,
-        }
+fn read_odometry(path: &Path) -> Result<Vec<OdometrySample>, Error> {
+    read_numbers(path, ["left_m", "right_m"], |t_s, [l, r]| OdometrySample {
+        t_s,
+        left_m: l,
+        right_m: r,
     })
 }
 
-fn read_lidar(path: &Path, text: &str) -> Result<Vec<LidarSample>, Error> {
-    let table = Table::parse(path, text)?;
-    let t = table.column("t_s")?;
-    let rev = table.column("rev")?;
-    let angle = table.column("angle_deg")?;
-    let range = table.column("range_m")?;
-    let strength = table.column("strength")?;
-    let invalid = table.column("invalid")?;
-    let warning = table.column("warning")?;
-    let truth = table.optional_column("true_range_m");
+fn read_lidar(path: &Path) -> Result<Vec<LidarSample>, Error> {
+    struct Columns {
+        t: usize,
+        rev: usize,
+        angle: usize,
+        range: usize,
+        strength: usize,
+        invalid: usize,
+        warning: usize,
+        truth: Option<usize>,
+    }
     let mut prev = None;
-    table
-        .rows()
-        .map(|row| {
-            let t_s = row.f64(t)?;
+    read_table(
+        path,
+        |header| {
+            Ok(Columns {
+                t: header.column("t_s")?,
+                rev: header.column("rev")?,
+                angle: header.column("angle_deg")?,
+                range: header.column("range_m")?,
+                strength: header.column("strength")?,
+                invalid: header.column("invalid")?,
+                warning: header.column("warning")?,
+                truth: header.optional_column("true_range_m"),
+            })
+        },
+        |c, row| {
+            let t_s = row.f64(c.t)?;
             row.check_time(t_s, &mut prev)?;
-            let angle_deg: u16 = row.uint(angle)?;
+            let angle_deg: u16 = row.uint(c.angle)?;
             if angle_deg >= 360 {
-                return Err(Error::format(
-                    path,
-                    Some(row.line),
-                    format!("column `angle_deg`: expected 0..359, found {angle_deg}"),
-                ));
+                return Err(row.error(format!(
+                    "column `angle_deg`: expected 0..359, found {angle_deg}"
+                )));
             }
-            let range_m = row.f64(range)?;
+            let range_m = row.f64(c.range)?;
             if range_m < 0.0 {
-                return Err(Error::format(
-                    path,
-                    Some(row.line),
-                    format!("column `range_m`: must not be negative, found {range_m}"),
-                ));
+                return Err(row.error(format!(
+                    "column `range_m`: must not be negative, found {range_m}"
+                )));
             }
             Ok(LidarSample {
                 t_s,
-                rev: row.uint(rev)?,
+                rev: row.uint(c.rev)?,
                 angle_deg,
                 range_m,
-                strength: row.uint(strength)?,
-                invalid: row.flag(invalid)?,
-                warning: row.flag(warning)?,
-                true_range_m: truth.map(|c| row.f64(c)).transpose()?,
+                strength: row.uint(c.strength)?,
+                invalid: row.flag(c.invalid)?,
+                warning: row.flag(c.warning)?,
+                true_range_m: c.truth.map(|c| row.f64(c)).transpose()?,
             })
-        })
-        .collect()
+        },
+    )
 }
 
-fn read_sonar(path: &Path, text: &str) -> Result<Vec<SonarSample>, Error> {
-    let table = Table::parse(path, text)?;
-    let (t, range) = (table.column("t_s")?, table.column("range_m")?);
-    let truth = table.optional_column("true_range_m");
+fn read_sonar(path: &Path) -> Result<Vec<SonarSample>, Error> {
     let mut prev = None;
-    table
-        .rows()
-        .map(|row| {
+    read_table(
+        path,
+        |header| {
+            Ok((
+                header.column("t_s")?,
+                header.column("range_m")?,
+                header.optional_column("true_range_m"),
+            ))
+        },
+        |&(t, range, truth), row| {
             let t_s = row.f64(t)?;
             row.check_time(t_s, &mut prev)?;
             Ok(SonarSample {
@@ -216,12 +219,12 @@ fn read_sonar(path: &Path, text: &str) -> Result<Vec<SonarSample>, Error> {
                 range_m: row.f64(range)?,
                 true_range_m: truth.map(|c| row.f64(c)).transpose()?,
             })
-        })
-        .collect()
+        },
+    )
 }
 
-fn read_truth(path: &Path, text: &str) -> Result<Vec<TruthSample>, Error> {
-    read_numbers(path, text, ["x_m", "y_m", "yaw_rad"], |t_s, [x, y, yaw]| {
+fn read_truth(path: &Path) -> Result<Vec<TruthSample>, Error> {
+    read_numbers(path, ["x_m", "y_m", "yaw_rad"], |t_s, [x, y, yaw]| {
         TruthSample {
             t_s,
             x_m: x,
@@ -234,6 +237,7 @@ fn read_truth(path: &Path, text: &str) -> Result<Vec<TruthSample>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     fn write(dir: &Path, name: &str, text: &str) {
         fs::write(dir.join(name), text).unwrap();
@@ -306,6 +310,58 @@ mod tests {
             &format!("{header}0,0,1,1.0,70000,0,0\n"),
         );
         assert!(err(dir.path()).contains("column `strength`"));
+    }
+
+    #[test]
+    fn the_first_error_is_the_one_a_whole_file_reader_found_first() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        // A row of the wrong width comes before an earlier row's bad value …
+        write(dir.path(), "sonar.csv", "t_s,range_m\n0,abc\n0.1\n");
+        assert!(err(dir.path()).contains("sonar.csv:3: expected 2 fields"));
+        // … and before a missing column; a line that is not UTF-8 comes before everything.
+        write(dir.path(), "sonar.csv", "t_s,range\n0\n0,1\n\n0,\u{ff}\n");
+        assert!(err(dir.path()).contains("sonar.csv:2: expected 2 fields"));
+        fs::write(dir.path().join("sonar.csv"), b"t_s,range\n0\n\n0,\xff\n").unwrap();
+        assert!(err(dir.path()).ends_with("sonar.csv:4: not UTF-8 text"));
+        // Blank lines count, and `\r\n` line breaks are read as `\n`.
+        write(
+            dir.path(),
+            "sonar.csv",
+            "\r\nt_s,range_m\r\n \r\n0,1\r\n0,x\r\n",
+        );
+        assert!(err(dir.path())
+            .ends_with("sonar.csv:5: column `range_m`: expected a finite number, found `x`"));
+    }
+
+    #[test]
+    fn limits_end_reading_with_one_error() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        let long = format!(
+            "t_s,range_m\n0,1\n0,{}\n",
+            "1".repeat(crate::input::MAX_LINE_BYTES)
+        );
+        write(dir.path(), "sonar.csv", &long);
+        assert!(err(dir.path())
+            .ends_with("sonar.csv:3: line longer than 64 KiB; not a recording's table"));
+        // A line of exactly the limit is read (and here is a number too large).
+        let longest = format!(
+            "t_s,range_m\n0,1\n0,{}\r\n",
+            "1".repeat(crate::input::MAX_LINE_BYTES - 3)
+        );
+        write(dir.path(), "sonar.csv", &longest);
+        assert!(err(dir.path()).contains("sonar.csv:3: column `range_m`"));
+        // Devices, which may never end, are refused before they are opened.
+        fs::remove_file(dir.path().join("sonar.csv")).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", dir.path().join("sonar.csv")).unwrap();
+        assert!(err(dir.path()).ends_with("sonar.csv: not a regular file but a character device"));
+        let meta = format!(
+            "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n#{}\n",
+            "x".repeat(1 << 20)
+        );
+        write(dir.path(), "meta.toml", &meta);
+        assert!(err(dir.path()).ends_with("meta.toml: larger than 1 MiB; not a meta.toml"));
     }
 
     #[test]

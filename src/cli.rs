@@ -126,7 +126,7 @@ pub struct CalibrateArgs {
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub beam: Option<f64>,
     /// Lidar-to-target distance at t = 0 (default: `target_start_distance_m` of meta.toml).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub start_distance: Option<f64>,
 }
 
@@ -155,7 +155,7 @@ pub struct SmoothArgs {
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub beam: Option<f64>,
     /// Lidar-to-target distance at t = 0 (default: meta.toml).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub start_distance: Option<f64>,
 }
 

@@ -41,6 +41,9 @@ fn main() -> ExitCode {
     let _ = out.flush();
     match result {
         Ok(code) => code,
+        // A reader that stopped reading (`hilsim … | head`) is not an error: stop quietly, as
+        // ripgrep does.
+        Err(err) if is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
             // One line: the chain of context joined by ": ".
             let line = format!("{err:#}").replace('\n', " ");
@@ -48,4 +51,13 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Whether `err` comes from writing to a pipe whose reader has gone.
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }

@@ -125,6 +125,15 @@ fn gather(ctx: &Context<'_>, notes: &mut Vec<String>) -> Result<Vec<SensorData>,
             "no sensor has enough readings to compare".into(),
         ));
     }
+    // The drive alone is the commands against the trajectory: with no sensor in common the
+    // recording says nothing about the sensors, so "agrees within its noise" would be false.
+    if data.iter().all(|d| d.sensor == Sensor::Drive) {
+        return Err(MismatchError::Refused(
+            "no sensor in common with the scenario (lidar, sonar or odometer with enough \
+             readings): only the drive could be compared"
+                .into(),
+        ));
+    }
     Ok(data)
 }
 

@@ -1,5 +1,6 @@
 //! Finding the scenario files `hilsim scenario test` runs.
 
+use std::collections::HashSet;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -26,20 +27,31 @@ impl DiscoverError {
 }
 
 /// The scenario files at `path`: the file itself, or every `*.toml` below the directory in
-/// name order, except `Cargo.toml` (a crate's manifest, as beside the checked-in scenarios).
+/// name order, except `Cargo.toml` (a crate's manifest, as beside the checked-in scenarios);
+/// each directory is entered once, however many links lead to it.
 ///
 /// # Errors
 /// [`DiscoverError`]: the path that could not be read or listed.
 pub fn scenario_files(path: &Path) -> Result<Vec<PathBuf>, DiscoverError> {
     let mut files = Vec::new();
-    collect(path, &mut files)?;
+    collect(path, &mut files, &mut HashSet::new())?;
     Ok(files)
 }
 
-fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<(), DiscoverError> {
+/// Collects below `path`, entering each directory once (`visited`: canonical paths), so links
+/// that lead back up the tree end the walk instead of repeating it.
+fn collect(
+    path: &Path,
+    files: &mut Vec<PathBuf>,
+    visited: &mut HashSet<PathBuf>,
+) -> Result<(), DiscoverError> {
     let meta = std::fs::metadata(path).map_err(DiscoverError::at(path, "cannot read"))?;
     if meta.is_file() {
         files.push(path.to_path_buf());
+        return Ok(());
+    }
+    let canonical = std::fs::canonicalize(path).map_err(DiscoverError::at(path, "cannot read"))?;
+    if !visited.insert(canonical) {
         return Ok(());
     }
     let mut entries: Vec<PathBuf> = std::fs::read_dir(path)
@@ -49,7 +61,7 @@ fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<(), DiscoverError> {
     entries.sort();
     for entry in entries {
         if entry.is_dir() {
-            collect(&entry, files)?;
+            collect(&entry, files, visited)?;
         } else if entry.extension().is_some_and(|e| e == "toml")
             && entry.file_name().is_some_and(|n| n != "Cargo.toml")
         {

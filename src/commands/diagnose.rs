@@ -35,7 +35,7 @@ pub struct DiagnoseArgs {
     /// Run N blind trials: each draws an effect (or none) and its parameters, records a "real"
     /// run with it, diagnoses it against the nominal scenario and scores the answer.
     #[arg(long, value_name = "N")]
-    pub self_test: Option<usize>,
+    pub self_test: Option<u64>,
     /// Seed of the self-test's draws (default 1).
     #[arg(long, value_name = "S", requires = "self_test")]
     pub seed: Option<u64>,
@@ -57,6 +57,12 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         if n == 0 {
             bail!("--self-test: expected at least one trial");
         }
+        if n > self_test::MAX_TRIALS {
+            bail!(
+                "--self-test: expected at most {} trials, found {n}",
+                self_test::MAX_TRIALS
+            );
+        }
         if !(args.strength.is_finite() && args.strength > 0.0 && args.strength <= 5.0) {
             bail!("--strength: expected a factor in (0, 5]");
         }
@@ -74,13 +80,13 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             },
         };
         let plan = Plan {
-            trials: n as u64,
+            trials: n,
             seed,
             strength: args.strength,
             only,
         };
         if let Some(i) = args.trial {
-            if i >= n as u64 {
+            if i >= n {
                 bail!("--trial: expected a trial below --self-test {n}, found {i}");
             }
             let run = self_test::one(&scenario, plan, i)?;

@@ -7,6 +7,7 @@ mod common;
 mod dataset;
 mod diagnose;
 mod hil;
+mod limits;
 mod outputs;
 mod record;
 mod run;

@@ -10,6 +10,11 @@ mod run;
 mod score;
 mod trial;
 
+/// The most trials a self-test runs: at roughly 10 s of CPU a trial (a 60 s recording made and
+/// diagnosed), 100,000 trials are about twelve CPU-days; more is a typo, and a count is checked
+/// before anything is allocated for it.
+pub const MAX_TRIALS: u64 = 100_000;
+
 pub use draw::Drawn;
 pub use run::{one, run, Plan, SelfTest, TrialRun};
 pub use score::{Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_PARAM_ERROR};

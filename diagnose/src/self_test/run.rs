@@ -52,8 +52,16 @@ impl SelfTest {
 /// Runs `plan`'s trials of `nominal` in parallel.
 ///
 /// # Errors
-/// [`MismatchError::Input`] when the nominal scenario's sensor models are invalid.
+/// [`MismatchError::Input`] when the nominal scenario's sensor models are invalid or more than
+/// [`super::MAX_TRIALS`] trials are asked for.
 pub fn run(nominal: &Scenario, plan: Plan) -> Result<SelfTest, MismatchError> {
+    if plan.trials > super::MAX_TRIALS {
+        return Err(MismatchError::Input(format!(
+            "at most {} trials, asked for {}",
+            super::MAX_TRIALS,
+            plan.trials
+        )));
+    }
     SimPhysics::new(nominal)?;
     let outcomes: Vec<Outcome> = (0..plan.trials)
         .into_par_iter()

@@ -1,0 +1,99 @@
+//! Counts, flags, pipes, links and recordings that once hung, panicked or answered wrongly
+//! (issue 18): each now ends in the documented exit code with one clear line, or none.
+
+use std::fs;
+use std::process::{Command, Stdio};
+
+use super::common::*;
+
+/// A scenario that runs in a moment: a room, a robot standing still, no sensors.
+const TINY: &str = "name = \"tiny\"\nduration_s = 0.5\n[robot]\nstart = { x = 0.0, y = 0.0 }\n\
+                    wheel_base_m = 0.23\n";
+
+#[test]
+fn issue_18_self_test_counts_are_checked_before_anything_is_allocated() {
+    let tmp = tempfile::tempdir().unwrap();
+    for n in ["18446744073709551615", "1000000000000", "100001"] {
+        let err = assert_bad_input(&hilsim(tmp.path(), &["diagnose", "--self-test", n]));
+        assert!(
+            err.contains("--self-test: expected at most 100000 trials"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn issue_18_a_negative_start_distance_is_a_value_not_a_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    for command in ["calibrate", "smooth"] {
+        let mut args = vec![command, "rec"];
+        if command == "calibrate" {
+            args.extend(["--method", "em"]);
+        } else {
+            args.extend(["--calibration", "cal.json"]);
+        }
+        args.extend(["--start-distance", "-1"]);
+        let err = assert_bad_input(&hilsim(tmp.path(), &args));
+        assert!(
+            err.contains("--start-distance: expected a positive distance"),
+            "{command}: {err}"
+        );
+    }
+}
+
+#[test]
+fn issue_18_a_reader_that_goes_away_ends_the_run_quietly() {
+    let tmp = tempfile::tempdir().unwrap();
+    fs::write(tmp.path().join("tiny.toml"), TINY).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hilsim"))
+        .args(["run", "tiny.toml"])
+        .current_dir(tmp.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close the read end before the run has anything to print.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(out.stderr.is_empty(), "{}", stderr(&out));
+}
+
+#[test]
+fn issue_18_scenario_test_enters_each_directory_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    fs::create_dir(&dir).unwrap();
+    fs::write(dir.join("tiny.toml"), TINY).unwrap();
+    // Two links back to the directory itself: an exponential walk without a visited set.
+    std::os::unix::fs::symlink(".", dir.join("again")).unwrap();
+    std::os::unix::fs::symlink("..", dir.join("up")).unwrap();
+    let out = hilsim(tmp.path(), &["scenario", "test", "s"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(
+        stdout(&out).ends_with("1 passed, 0 failed\n"),
+        "{}",
+        stdout(&out)
+    );
+}
+
+#[test]
+fn issue_18_diagnose_with_no_sensor_in_common_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = fs::read_to_string(repo_file("scenarios/straight-board.toml")).unwrap();
+    fs::write(tmp.path().join("with.toml"), &scenario).unwrap();
+    let o = hilsim(tmp.path(), &["record", "with.toml", "--out", "rec"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // The same world and drive with no sensor declared.
+    let start = scenario.find("[sensors.lidar]").unwrap();
+    let end = scenario.find("[calibration]").unwrap();
+    let without = format!("{}{}", &scenario[..start], &scenario[end..])
+        .replace("methods = [\"em\", \"groundtruth\"]", "methods = []");
+    let without = &without[..without.find("[[expect]]").unwrap()];
+    fs::write(tmp.path().join("without.toml"), without).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", "without.toml", "--real", "rec"],
+    ));
+    assert!(err.contains("no sensor in common"), "{err}");
+}

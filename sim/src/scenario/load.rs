@@ -1,6 +1,7 @@
 //! Reading a scenario: TOML into the typed form, then the checks serde cannot express; every
 //! error names the file and, where it can, the line.
 
+use std::io::Read;
 use std::path::Path;
 
 use super::error::ScenarioError;
@@ -8,8 +9,13 @@ use super::locate;
 use super::schema::Scenario;
 use super::validate;
 
+/// The largest scenario file read, in bytes. A real one is a few KB (the largest checked in is
+/// under 3 KB); a file is read whole before it is parsed, so this bounds what any input, even
+/// an endless one (`/dev/zero`, a pipe that never closes), costs.
+pub(crate) const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+
 impl Scenario {
-    /// Reads and validates a scenario file.
+    /// Reads and validates a scenario file: at most [`MAX_SCENARIO_BYTES`] (1 MiB).
     ///
     /// # Errors
     /// The file cannot be read, is not UTF-8 TOML, does not match the format, or fails a check.
@@ -24,11 +30,7 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::load`].
     pub fn load_with_duration(path: &Path, duration_s: Option<f64>) -> Result<Self, ScenarioError> {
-        let bytes = std::fs::read(path).map_err(|err| ScenarioError {
-            file: path.to_path_buf(),
-            line: None,
-            message: format!("cannot read: {err}"),
-        })?;
+        let bytes = read_bounded(path)?;
         let text = String::from_utf8(bytes).map_err(|err| ScenarioError {
             file: path.to_path_buf(),
             line: Some(
@@ -74,5 +76,47 @@ impl Scenario {
             message: format!("{}: {}", locate::display(&invalid.path), invalid.message),
         })?;
         Ok(scenario)
+    }
+}
+
+/// The bytes of `path`, when there are at most [`MAX_SCENARIO_BYTES`]. A regular file's length is
+/// checked before it is read; anything else (a pipe, a device) is read up to one byte more.
+fn read_bounded(path: &Path) -> Result<Vec<u8>, ScenarioError> {
+    let max = MAX_SCENARIO_BYTES;
+    let error = |message: String| ScenarioError {
+        file: path.to_path_buf(),
+        line: None,
+        message,
+    };
+    let cannot_read = |err: std::io::Error| error(format!("cannot read: {err}"));
+    let too_large = || error("larger than 1 MiB; not a scenario file".to_string());
+    let file = std::fs::File::open(path).map_err(cannot_read)?;
+    let meta = file.metadata().map_err(cannot_read)?;
+    if meta.is_file() && meta.len() > max {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot_read)?;
+    if bytes.len() as u64 > max {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_endless_file_is_refused_after_1_mib() {
+        let zero = Scenario::load(Path::new("/dev/zero")).unwrap_err();
+        assert_eq!(
+            zero.to_string(),
+            "/dev/zero: larger than 1 MiB; not a scenario file"
+        );
+        let missing = Scenario::load(Path::new("/nonexistent/missing.toml")).unwrap_err();
+        assert!(missing.message.starts_with("cannot read: "), "{missing}");
     }
 }

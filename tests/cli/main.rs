@@ -2,6 +2,7 @@
 //! directory with the user's environment removed.
 
 mod bad_input;
+mod bounded_input;
 mod calibrate;
 mod common;
 mod dataset;

@@ -387,6 +387,10 @@ pub(crate) fn build_pool(jobs: Option<NonZeroUsize>) -> Result<rayon::ThreadPool
 }
 
 /// Creates `dir` for the dataset `params`, or checks that it holds this dataset.
+///
+/// Shards may start at the same instant on a fresh directory (a Slurm job array): one of them
+/// creates `dataset.toml` (whole, with create-new semantics) and the others find it and check it;
+/// none removes another's temporaries.
 fn open_dir(dir: &Path, params: &Params) -> Result<(), Error> {
     match fs::metadata(dir) {
         Ok(m) if !m.is_dir() => return Err(Error::mismatch(dir, "not a directory")),
@@ -397,31 +401,36 @@ fn open_dir(dir: &Path, params: &Params) -> Result<(), Error> {
         Err(err) => return Err(Error::io(dir, err)),
     }
     let file = dir.join(DATASET_FILE);
-    if file.exists() {
-        let stored = Params::read(&file)?;
-        return match stored.difference(params) {
-            None => Ok(()),
-            Some(diff) => Err(Error::mismatch(
-                &file,
-                format!(
-                    "this directory holds another dataset: it was {diff}; give the same \
-                     parameters to resume it, or choose another --out"
-                ),
-            )),
-        };
+    if !file.exists() {
+        // Only an empty directory becomes a dataset (leftovers of writing dataset.toml aside).
+        // Listed before looking for dataset.toml again: whatever a shard writes, it writes after
+        // dataset.toml exists, so what was listed while there was none is not a shard's.
+        let others = entries(dir)?
+            .into_iter()
+            .filter(|(name, _)| leftover(name) != Some(Leftover::File(DATASET_FILE.to_string())))
+            .count();
+        if !file.exists() {
+            if others > 0 {
+                return Err(Error::mismatch(
+                    dir,
+                    "exists and is not a dataset (no dataset.toml): choose a new or empty \
+                     directory",
+                ));
+            }
+            if params.create_file(&file)? {
+                return Ok(());
+            }
+        }
     }
-    // Only an empty directory becomes a dataset (a leftover of writing dataset.toml aside).
-    let others = entries(dir)?
-        .into_iter()
-        .filter(|(name, _)| leftover(name) != Some(Leftover::File(DATASET_FILE.to_string())))
-        .count();
-    if others > 0 {
-        return Err(Error::mismatch(
-            dir,
-            "exists and is not a dataset (no dataset.toml): choose a new or empty directory",
-        ));
+    let stored = Params::read_settled(&file)?;
+    match stored.difference(params) {
+        None => Ok(()),
+        Some(diff) => Err(Error::mismatch(
+            &file,
+            format!(
+                "this directory holds another dataset: it was {diff}; give the same \
+                 parameters to resume it, or choose another --out"
+            ),
+        )),
     }
-    remove_leftovers(dir, |l| *l == Leftover::File(DATASET_FILE.to_string()))?;
-    write_file_atomically(&file, params.to_toml().as_bytes())?;
-    Ok(())
 }

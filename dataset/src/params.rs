@@ -1,8 +1,12 @@
 //! `DIR/dataset.toml`: the parameters that define a dataset. Resuming or merging compares them,
 //! so that runs of two different datasets are never mixed in one directory.
 
+use std::collections::hash_map::RandomState;
 use std::fs;
-use std::path::Path;
+use std::hash::BuildHasher;
+use std::io::{ErrorKind, Write as _};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
@@ -108,6 +112,75 @@ impl Params {
         })
     }
 
+    /// Creates `DIR/dataset.toml` at `path` holding these parameters, whole or not at all, unless
+    /// it exists: returns whether this call created it. Safe when several processes (shards
+    /// started at the same instant, on one machine or many sharing a file system) try at once:
+    /// exactly one creates it, the others find it.
+    ///
+    /// The text is written to a temporary file of a name no other writer uses, then hard-linked to
+    /// `path` (which fails when `path` exists: create-new semantics, and a reader never sees it
+    /// half-written). Where the file system has no hard links, `path` is created with
+    /// create-new semantics and written in place; [`Params::read_settled`] waits for it.
+    /// Temporaries of other writers are never touched.
+    ///
+    /// # Errors
+    /// A file cannot be written.
+    pub(crate) fn create_file(&self, path: &Path) -> Result<bool, Error> {
+        let text = self.to_toml();
+        let (tmp, mut file) = unique_temporary(path)?;
+        let written = file
+            .write_all(text.as_bytes())
+            .and_then(|()| file.sync_all());
+        drop(file);
+        if let Err(err) = written {
+            let _ = fs::remove_file(&tmp);
+            return Err(Error::io(&tmp, err));
+        }
+        let linked = fs::hard_link(&tmp, path);
+        let _ = fs::remove_file(&tmp);
+        match linked {
+            Ok(()) => Ok(true),
+            Err(err) if err.kind() == ErrorKind::AlreadyExists => Ok(false),
+            Err(_) => {
+                // No hard links on this file system: create-new, then write in place.
+                match fs::OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(path)
+                {
+                    Ok(mut file) => {
+                        file.write_all(text.as_bytes())
+                            .and_then(|()| file.sync_all())
+                            .map_err(|err| Error::io(path, err))?;
+                        Ok(true)
+                    }
+                    Err(err) if err.kind() == ErrorKind::AlreadyExists => Ok(false),
+                    Err(err) => Err(Error::io(path, err)),
+                }
+            }
+        }
+    }
+
+    /// [`Params::read`], waiting up to 2 s while the file does not parse: another process may
+    /// be writing it in place (see [`Params::create_file`]). A complete file reads at once.
+    ///
+    /// # Errors
+    /// As [`Params::read`], once the wait is over.
+    pub(crate) fn read_settled(path: &Path) -> Result<Self, Error> {
+        const TRIES: u32 = 40;
+        const PAUSE: Duration = Duration::from_millis(50);
+        let mut tries = 1;
+        loop {
+            match Self::read(path) {
+                Err(Error::Corrupt { .. }) if tries < TRIES => {
+                    tries += 1;
+                    std::thread::sleep(PAUSE);
+                }
+                other => return other,
+            }
+        }
+    }
+
     /// What differs between the parameters stored at `path` (`self`) and `asked`, as one
     /// sentence; `None` when they are the same dataset.
     #[must_use]
@@ -149,5 +222,86 @@ impl Params {
         } else {
             None
         }
+    }
+}
+
+/// A new temporary file beside `path`, named `.NAME.tmp.DIGITS` (a leftover of writing `NAME`,
+/// see [`crate::layout`]) with digits no other writer picks: a random number, and the file
+/// created with create-new semantics (so a clash is seen, and another name tried).
+fn unique_temporary(path: &Path) -> Result<(PathBuf, fs::File), Error> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // `RandomState` is seeded from the operating system's randomness (and differs per thread).
+    let random = RandomState::new();
+    let mut attempt = 0_u32;
+    loop {
+        let digits = random.hash_one((std::process::id(), attempt));
+        let tmp = path.with_file_name(format!(".{name}.tmp.{digits}"));
+        match fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(file) => return Ok((tmp, file)),
+            Err(err) if err.kind() == ErrorKind::AlreadyExists && attempt < 100 => attempt += 1,
+            Err(err) => return Err(Error::io(&tmp, err)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Barrier;
+
+    use super::*;
+
+    fn params(seed: u64) -> Params {
+        Params {
+            scenario_name: "room".to_string(),
+            scenario_sha256: "ab".repeat(32),
+            seed,
+            runs: 4,
+            varies: vec![Vary::new("robot.start.x", -1.0, 1.0).unwrap()],
+        }
+    }
+
+    #[test]
+    fn issue_18_writers_at_once_create_dataset_toml_exactly_once_and_whole() {
+        const WRITERS: usize = 8;
+        for round in 0..20 {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("dataset.toml");
+            let barrier = Barrier::new(WRITERS);
+            let created: Vec<bool> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (0..WRITERS)
+                    .map(|_| {
+                        scope.spawn(|| {
+                            barrier.wait();
+                            let p = params(7);
+                            let created = p.create_file(&path).unwrap();
+                            // Whoever created it, every writer reads it whole at once.
+                            assert_eq!(Params::read(&path).unwrap(), p);
+                            created
+                        })
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().unwrap()).collect()
+            });
+            assert_eq!(created.iter().filter(|&&c| c).count(), 1, "round {round}");
+            assert_eq!(fs::read_to_string(&path).unwrap(), params(7).to_toml());
+            let names: Vec<_> = fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name())
+                .collect();
+            assert_eq!(names, ["dataset.toml"], "no temporaries left");
+        }
+        // An existing file is never replaced, whatever it holds.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("dataset.toml");
+        assert!(params(1).create_file(&path).unwrap());
+        assert!(!params(2).create_file(&path).unwrap());
+        assert_eq!(Params::read(&path).unwrap(), params(1));
     }
 }

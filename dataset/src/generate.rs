@@ -64,15 +64,18 @@ impl Dataset {
     ///
     /// In order: `dir` is created, or checked to hold this dataset (its `dataset.toml`, else it
     /// must be empty); leftovers of interrupted writes of this share are removed; the runs already
-    /// made are rescanned (hashes recomputed) and the manifest rebuilt from them; then the missing
-    /// runs are made on `options.jobs` threads in index order. The manifest is rewritten as runs
-    /// complete (at most every 0.5 s) and at the end. A run that fails is recorded with its
-    /// reason and the others go on; runs that failed before are tried again.
+    /// made are rescanned (hashes recomputed), those whose files differ from the content hash a
+    /// manifest recorded for them (truncated, say) removed, and the manifest rebuilt from the
+    /// others; then the missing (and removed) runs are made on `options.jobs` threads in index
+    /// order. The manifest is rewritten as runs complete (at most every 0.5 s) and at the end. A
+    /// run that fails is recorded with its reason and the others go on; runs that failed before
+    /// are tried again.
     ///
     /// # Errors
-    /// `dir` holds something else, a run directory was damaged by hand, `options` name a run
-    /// outside the dataset or shard, or a file cannot be written (the runs made so far stay, and
-    /// the manifest is written for them).
+    /// `dir` holds something else, a run directory no manifest vouches for is not a complete run,
+    /// a run other than `options.only` differs from its manifest, `options` name a run outside
+    /// the dataset or shard, or a file cannot be written (the runs made so far stay, and the
+    /// manifest is written for them).
     pub fn generate(
         &self,
         dir: &Path,
@@ -93,7 +96,22 @@ impl Dataset {
             Leftover::File(name) => *name == manifest_file,
         })?;
 
-        let mut rows = self.rows_made_before(dir, &pool, shard)?;
+        let (mut rows, damaged) = self.rows_made_before(dir, &pool, shard)?;
+        if options.only.is_some() {
+            if let Some(&r) = damaged.iter().find(|&&r| Some(r) != options.only) {
+                return Err(Error::corrupt(
+                    &dir.join(run_dir_name(r)),
+                    "its files differ from the content hash its manifest recorded: resume \
+                     without --run to make it again",
+                ));
+            }
+        }
+        // Removed before the manifest loses their rows (so an interruption now cannot leave a
+        // damaged run that no manifest vouches for); they are made again below.
+        for &r in &damaged {
+            let path = dir.join(run_dir_name(r));
+            fs::remove_dir_all(&path).map_err(|err| Error::io(&path, err))?;
+        }
         let to_make: Vec<u64> = match options.only {
             Some(r) if rows.contains_key(&r) => Vec::new(),
             Some(r) => vec![r],
@@ -120,6 +138,7 @@ impl Dataset {
             share,
             skipped,
             to_make: to_make.len() as u64,
+            remade: damaged.len() as u64,
             jobs,
         });
         let (made, failed) =
@@ -134,26 +153,43 @@ impl Dataset {
         })
     }
 
-    /// The rows of the shard's runs made before, as their files say now (hashes recomputed).
+    /// The rows of the shard's runs made before, as their files say now (hashes recomputed), and
+    /// the runs whose files differ from the content hash a manifest in `dir` recorded for them
+    /// (truncated, say, or unreadable as a run): those are to be made again. A run directory no
+    /// manifest vouches for is trusted when it reads as a complete run (it was renamed into
+    /// place only when complete), and named as an error when it does not.
     fn rows_made_before(
         &self,
         dir: &Path,
         pool: &rayon::ThreadPool,
         shard: Shard,
-    ) -> Result<BTreeMap<u64, Row>, Error> {
+    ) -> Result<(BTreeMap<u64, Row>, Vec<u64>), Error> {
         let made: Vec<u64> = run_dirs(dir, self.params().runs)?
             .into_iter()
             .filter(|&r| shard.contains(r))
             .collect();
-        let scanned: Vec<(u64, RunContent)> = pool.install(|| {
+        let recorded = manifest::recorded_hashes(dir)?;
+        let scanned: Vec<(u64, Result<RunContent, Error>)> = pool.install(|| {
             made.par_iter()
-                .map(|&r| scan_run(&dir.join(run_dir_name(r))).map(|c| (r, c)))
-                .collect::<Result<_, _>>()
-        })?;
-        Ok(scanned
-            .into_iter()
-            .map(|(r, c)| (r, self.row(r, Outcome::Made(c))))
-            .collect())
+                .map(|&r| (r, scan_run(&dir.join(run_dir_name(r)))))
+                .collect()
+        });
+        let mut rows = BTreeMap::new();
+        let mut damaged = Vec::new();
+        for (r, scan) in scanned {
+            let vouched = recorded.get(&r);
+            match (scan, vouched) {
+                (Ok(c), None) => {
+                    rows.insert(r, self.row(r, Outcome::Made(c)));
+                }
+                (Ok(c), Some(hashes)) if hashes.iter().all(|(_, h)| *h == c.sha256) => {
+                    rows.insert(r, self.row(r, Outcome::Made(c)));
+                }
+                (Ok(_) | Err(Error::Corrupt { .. }), Some(_)) => damaged.push(r),
+                (Err(err), _) => return Err(err),
+            }
+        }
+        Ok((rows, damaged))
     }
 
     /// Adds to `rows` the failures the shard's manifest recorded, of runs other than `only` and

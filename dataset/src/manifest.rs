@@ -8,9 +8,10 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::content::RunContent;
+use crate::layout::{entries, is_manifest};
 use crate::Error;
 
 /// A run's row.
@@ -142,6 +143,26 @@ pub fn read(path: &Path) -> Result<Vec<Entry>, Error> {
         out.push(entry);
     }
     Ok(out)
+}
+
+/// The content hashes the manifests in `dir` (whole and shard) record, by run: for each run made,
+/// each manifest that has its row, with the hash it records.
+///
+/// # Errors
+/// A manifest cannot be read, or is not a manifest.
+pub(crate) fn recorded_hashes(dir: &Path) -> Result<BTreeMap<u64, Vec<(PathBuf, String)>>, Error> {
+    let mut hashes: BTreeMap<u64, Vec<(PathBuf, String)>> = BTreeMap::new();
+    for (name, path) in entries(dir)? {
+        if !is_manifest(&name) {
+            continue;
+        }
+        for e in read(&path)? {
+            if let Some(sha) = e.sha256 {
+                hashes.entry(e.run).or_default().push((path.clone(), sha));
+            }
+        }
+    }
+    Ok(hashes)
 }
 
 /// Splits one CSV line (RFC 4180 quoting); `None` if a quote is left open.

@@ -12,6 +12,9 @@ pub struct Plan {
     pub skipped: u64,
     /// Of those, to make now.
     pub to_make: u64,
+    /// Of those to make, runs made before whose files differed from the content hash their
+    /// manifest recorded (truncated, say): removed, to be made again.
+    pub remade: u64,
     /// Worker threads.
     pub jobs: usize,
 }

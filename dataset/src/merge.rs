@@ -40,9 +40,12 @@ pub struct MergeSummary {
 ///
 /// `out` may be new, or a dataset directory itself (then it is one of the sources: with no
 /// `sources`, its own shards' runs and manifests are merged in place, when the shards shared one
-/// directory). Every directory must hold the same dataset (`dataset.toml` parameters). Run
+/// directory). Every directory must hold the same dataset (`dataset.toml` parameters). Before
+/// anything is written, every run is scanned where it is and checked against each content hash
+/// the manifests of all the directories record for it: a run that differs (truncated, say) is
+/// refused, and nothing is merged, so a refused run is never brought into `out`. Then the run
 /// directories missing from `out` are brought in (files hard-linked when on the same file
-/// system, else copied; each run directory is renamed into place when complete). The manifest
+/// system, else copied; each checked again and renamed into place when complete). The manifest
 /// then has a row for each run directory in `out` (content hash recomputed) and for each run a
 /// source's manifest records as failed; the shard manifests in `out` are removed (the merged
 /// manifest holds their rows). Leftovers of interrupted writes in `out` are removed: merge after
@@ -72,48 +75,71 @@ pub fn merge(
     }
     let (reference_file, params) = same_dataset(&all)?;
     if !out_is_dataset {
-        start_output(out, &reference_file)?;
+        check_output(out)?;
     }
-    remove_leftovers(out, |_| true)?;
 
-    // Bring in the runs `out` lacks; note the ones that are in more than one place.
+    // First, reading only: where each run is (in `out`, else in the first source that has it;
+    // the ones in more than one place noted), every run scanned there and checked against each
+    // content hash the manifests record for it. Nothing is written unless every run passes, so
+    // a run refused is never brought into `out`.
     let pool = build_pool(jobs)?;
-    let mut present: BTreeSet<u64> = run_dirs(out, params.runs)?.into_iter().collect();
-    let mut copies: Vec<(PathBuf, u64)> = Vec::new();
+    let in_out = if out_is_dataset {
+        run_dirs(out, params.runs)?
+    } else {
+        Vec::new()
+    };
+    let mut present: BTreeSet<u64> = in_out.iter().copied().collect();
+    let mut located: Vec<(PathBuf, u64)> = in_out
+        .iter()
+        .map(|&r| (out.join(run_dir_name(r)), r))
+        .collect();
     let mut duplicates: Vec<(PathBuf, u64)> = Vec::new();
     for s in &others {
         for r in run_dirs(s, params.runs)? {
             let src = s.join(run_dir_name(r));
             if present.insert(r) {
-                copies.push((src, r));
+                located.push((src, r));
             } else {
                 duplicates.push((src, r));
             }
         }
     }
-    pool.install(|| {
-        copies
+    let scanned: Vec<(PathBuf, u64, RunContent)> = pool.install(|| {
+        located
             .par_iter()
-            .try_for_each(|(src, r)| copy_run(src, &out.join(run_dir_name(*r))))
-    })?;
-
-    // Rows: every run directory in `out`, hashes recomputed.
-    let made: Vec<u64> = present.into_iter().collect();
-    let scanned: Vec<(u64, RunContent)> = pool.install(|| {
-        made.par_iter()
-            .map(|&r| scan_run(&out.join(run_dir_name(r))).map(|c| (r, c)))
+            .map(|(dir, r)| scan_run(dir).map(|c| (dir.clone(), *r, c)))
             .collect::<Result<_, _>>()
     })?;
+    let recorded = recorded_hashes(&all)?;
+    for (dir, r, c) in &scanned {
+        check_recorded(&recorded, *r, dir, c)?;
+    }
+    check_duplicates(&duplicates, &scanned, &pool)?;
     let mut rows: BTreeMap<u64, Row> = BTreeMap::new();
-    for (r, c) in scanned {
+    let mut copies: Vec<(PathBuf, u64, String)> = Vec::new();
+    for (dir, r, c) in scanned {
+        if in_out.binary_search(&r).is_err() {
+            copies.push((dir, r, c.sha256.clone()));
+        }
         rows.insert(r, row(&params, r, Outcome::Made(c)));
     }
-    check_duplicates(out, &duplicates, &rows, &pool)?;
-    let failures = recorded_failures(out, &all, &params, &rows)?;
+    let made = rows.len() as u64;
+    let failures = recorded_failures(&all, &params, &rows)?;
     let failed = failures.len() as u64;
     for (r, reason) in failures {
         rows.insert(r, row(&params, r, Outcome::Failed(reason)));
     }
+
+    // Then the writes: the runs `out` lacks, each checked again as it is brought in.
+    if !out_is_dataset {
+        start_output(out, &reference_file)?;
+    }
+    remove_leftovers(out, |_| true)?;
+    pool.install(|| {
+        copies
+            .par_iter()
+            .try_for_each(|(src, r, sha)| copy_run(src, &out.join(run_dir_name(*r)), sha))
+    })?;
     let keys: Vec<&str> = params.varies.iter().map(|v| v.key()).collect();
     let manifest_path = out.join(MANIFEST_FILE);
     write_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
@@ -124,7 +150,7 @@ pub fn merge(
     }
     Ok(MergeSummary {
         runs: params.runs,
-        made: made.len() as u64,
+        made,
         failed,
         missing: params.runs - rows.len() as u64,
         copied: copies.len() as u64,
@@ -148,23 +174,28 @@ fn other_sources(out: &Path, sources: &[PathBuf]) -> Result<Vec<PathBuf>, Error>
     Ok(others)
 }
 
-/// Makes `out`, new or empty, a dataset directory: a copy of `reference_file`.
-fn start_output(out: &Path, reference_file: &Path) -> Result<(), Error> {
-    if out.exists() {
-        let clutter = entries(out)?
-            .into_iter()
-            .filter(|(name, _)| leftover(name).is_none())
-            .count();
-        if clutter > 0 {
-            return Err(Error::mismatch(
-                out,
-                "exists and is not a dataset (no dataset.toml): choose a new or empty \
-                 directory",
-            ));
-        }
-    } else {
-        fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
+/// `out`, not a dataset, must be new or empty (leftovers of interrupted writes aside).
+fn check_output(out: &Path) -> Result<(), Error> {
+    if !out.exists() {
+        return Ok(());
     }
+    let clutter = entries(out)?
+        .into_iter()
+        .filter(|(name, _)| leftover(name).is_none())
+        .count();
+    if clutter > 0 {
+        return Err(Error::mismatch(
+            out,
+            "exists and is not a dataset (no dataset.toml): choose a new or empty directory",
+        ));
+    }
+    Ok(())
+}
+
+/// Makes `out`, new or empty ([`check_output`]), a dataset directory: a copy of
+/// `reference_file`.
+fn start_output(out: &Path, reference_file: &Path) -> Result<(), Error> {
+    fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
     let bytes = fs::read(reference_file).map_err(|err| Error::io(reference_file, err))?;
     write_file_atomically(&out.join(DATASET_FILE), &bytes)?;
     Ok(())
@@ -184,19 +215,11 @@ fn row(params: &Params, r: u64, outcome: Outcome) -> Row {
     }
 }
 
-/// The content hash of run `r` when it was made.
-fn hash_of(rows: &BTreeMap<u64, Row>, r: u64) -> Option<String> {
-    match rows.get(&r).map(|row| &row.outcome) {
-        Some(Outcome::Made(c)) => Some(c.sha256.clone()),
-        _ => None,
-    }
-}
-
-/// Each run directory found in more than one place must hold what `out`'s does.
+/// Each run directory found in more than one place must hold what the one merged (`located`,
+/// scanned) holds.
 fn check_duplicates(
-    out: &Path,
     duplicates: &[(PathBuf, u64)],
-    rows: &BTreeMap<u64, Row>,
+    located: &[(PathBuf, u64, RunContent)],
     pool: &rayon::ThreadPool,
 ) -> Result<(), Error> {
     let dup_hashes: Vec<(PathBuf, u64, RunContent)> = pool.install(|| {
@@ -205,14 +228,19 @@ fn check_duplicates(
             .map(|(src, r)| scan_run(src).map(|c| (src.clone(), *r, c)))
             .collect::<Result<_, _>>()
     })?;
+    let by_run: BTreeMap<u64, &(PathBuf, u64, RunContent)> =
+        located.iter().map(|l| (l.1, l)).collect();
     for (src, r, c) in dup_hashes {
-        if hash_of(rows, r).as_deref() != Some(c.sha256.as_str()) {
+        let Some((dir, _, merged)) = by_run.get(&r) else {
+            continue;
+        };
+        if merged.sha256 != c.sha256 {
             return Err(Error::mismatch(
                 &src,
                 format!(
                     "differs from {} (content hash {}): the same run made twice differently",
-                    out.join(run_dir_name(r)).display(),
-                    hash_of(rows, r).unwrap_or_default()
+                    dir.display(),
+                    merged.sha256
                 ),
             ));
         }
@@ -220,10 +248,43 @@ fn check_duplicates(
     Ok(())
 }
 
-/// The manifests of `dirs`: failures of runs made nowhere, and a check of every recorded hash
-/// against the run's directory in `out`.
+/// The content hashes the manifests of `dirs` record, by run: each manifest with the hash.
+fn recorded_hashes(dirs: &[PathBuf]) -> Result<BTreeMap<u64, Vec<(PathBuf, String)>>, Error> {
+    let mut all: BTreeMap<u64, Vec<(PathBuf, String)>> = BTreeMap::new();
+    for d in dirs {
+        for (r, mut hashes) in manifest::recorded_hashes(d)? {
+            all.entry(r).or_default().append(&mut hashes);
+        }
+    }
+    Ok(all)
+}
+
+/// Run `r`, found in `dir` with content `c`, must have the content hash every manifest that
+/// records one gives it.
+fn check_recorded(
+    recorded: &BTreeMap<u64, Vec<(PathBuf, String)>>,
+    r: u64,
+    dir: &Path,
+    c: &RunContent,
+) -> Result<(), Error> {
+    for (manifest, sha) in recorded.get(&r).into_iter().flatten() {
+        if *sha != c.sha256 {
+            return Err(Error::mismatch(
+                manifest,
+                format!(
+                    "run {r} has content hash {sha} here, but {} has {}: the run's files changed \
+                     after it was made; nothing was merged (resume its shard to make it again)",
+                    dir.display(),
+                    c.sha256
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The failures the manifests of `dirs` record, of runs made nowhere.
 fn recorded_failures(
-    out: &Path,
     dirs: &[PathBuf],
     params: &Params,
     rows: &BTreeMap<u64, Row>,
@@ -235,25 +296,8 @@ fn recorded_failures(
                 continue;
             }
             for e in manifest::read(&path)? {
-                if e.run >= params.runs {
-                    continue;
-                }
-                match (&e.sha256, hash_of(rows, e.run)) {
-                    (Some(recorded), Some(now)) if *recorded != now => {
-                        return Err(Error::mismatch(
-                            &path,
-                            format!(
-                                "run {} has content hash {recorded} here, but {} has {now}: the \
-                                 run's files changed after it was made",
-                                e.run,
-                                out.join(run_dir_name(e.run)).display()
-                            ),
-                        ));
-                    }
-                    (None, None) => {
-                        failures.entry(e.run).or_insert(e.reason);
-                    }
-                    _ => {}
+                if e.run < params.runs && e.sha256.is_none() && !rows.contains_key(&e.run) {
+                    failures.entry(e.run).or_insert(e.reason);
                 }
             }
         }
@@ -293,8 +337,10 @@ fn same_dataset(dirs: &[PathBuf]) -> Result<(PathBuf, Params), Error> {
 }
 
 /// Brings run directory `src` to `dst`: its files hard-linked (never modified in place, so
-/// sharing them is safe) or, across file systems, copied; renamed into place when complete.
-fn copy_run(src: &Path, dst: &Path) -> Result<(), Error> {
+/// sharing them is safe) or, across file systems, copied; checked to have the content hash `sha`
+/// (what `src` had when it was checked: it may not change meanwhile); renamed into place when
+/// complete, and not at all when the check fails.
+fn copy_run(src: &Path, dst: &Path, sha: &str) -> Result<(), Error> {
     replace_dir_atomically(dst, |tmp| -> Result<(), Error> {
         for (name, path) in entries(src)? {
             if !path.is_file() {
@@ -307,6 +353,16 @@ fn copy_run(src: &Path, dst: &Path) -> Result<(), Error> {
             if fs::hard_link(&path, &to).is_err() {
                 fs::copy(&path, &to).map_err(|err| Error::io(&to, err))?;
             }
+        }
+        let now = scan_run(tmp)?.sha256;
+        if now != sha {
+            return Err(Error::mismatch(
+                src,
+                format!(
+                    "changed while it was being merged (content hash {sha}, now {now}); nothing \
+                     of it was merged"
+                ),
+            ));
         }
         Ok(())
     })

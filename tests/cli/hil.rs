@@ -361,3 +361,36 @@ fn duration_makes_a_scenario_without_drive_program_or_duration_runnable() {
         "{text}"
     );
 }
+
+/// Issue 18: a `hilsim hil` started where SIGINT, SIGTERM and SIGHUP are ignored (a script's
+/// background job, `nohup`) still gives its firmware the default dispositions, so the polite
+/// SIGTERM at the end works and the summary says so.
+#[test]
+fn issue_18_the_firmware_starts_with_default_signal_dispositions() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    // The firmware reads the lidar (so the run has no fault), records its ignored signals and
+    // waits to be told to stop.
+    let firmware = r#"sh -c 'cat "$HILSIM_LIDAR_PORT" >/dev/null & grep SigIgn /proc/self/status > sigign.txt; sleep 30'"#;
+    let hil = format!(
+        "trap '' INT TERM HUP; exec {} hil {} --duration 1 --firmware \"$0\"",
+        env!("CARGO_BIN_EXE_hilsim"),
+        scenario.display()
+    );
+    let out = Command::new("sh")
+        .args(["-c", &hil, firmware])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    let text = stdout(&out);
+    assert!(
+        text.contains("firmware: left on SIGTERM once the run was over"),
+        "{text}{}",
+        stderr(&out)
+    );
+    let line = std::fs::read_to_string(tmp.path().join("sigign.txt")).unwrap();
+    let mask = u64::from_str_radix(line.trim().trim_start_matches("SigIgn:").trim(), 16).unwrap();
+    for (name, number) in [("SIGHUP", 1), ("SIGINT", 2), ("SIGTERM", 15)] {
+        assert_eq!(mask & (1 << (number - 1)), 0, "{name} ignored: {line}");
+    }
+}

@@ -8,7 +8,7 @@ use std::thread;
 
 use hilsim_lidar_emulator::{Emulation, ModelError};
 use hilsim_sim::{Scenario, Simulation};
-use nix::sys::signal::{SigSet, Signal};
+use nix::sys::signal::{self, SigHandler, SigSet, Signal};
 
 use crate::pty::PtyLink;
 
@@ -74,12 +74,21 @@ impl HilWorld {
 /// before any other thread is started: threads inherit the mask (child processes do not; the
 /// standard library clears it for them).
 ///
+/// The three signals' dispositions are set to the default first. A process started in the
+/// background of a script, or under `nohup`, inherits them *ignored*; an ignored signal is
+/// discarded even while blocked, so the wait would never see it, and the firmware would inherit
+/// the ignoring too (ignored dispositions survive `exec`) and shrug off the polite `SIGTERM`.
+///
 /// # Errors
 /// The mask cannot be set or the waiting thread started.
 pub fn stop_on_signals(stop: Arc<AtomicBool>) -> io::Result<()> {
     let mut signals = SigSet::empty();
-    for signal in [Signal::SIGINT, Signal::SIGTERM, Signal::SIGHUP] {
-        signals.add(signal);
+    for which in [Signal::SIGINT, Signal::SIGTERM, Signal::SIGHUP] {
+        // SAFETY: `SIG_DFL` installs no handler, so nothing runs in signal context; the
+        // disposition is process-wide state that this function owns (see above).
+        #[allow(unsafe_code)]
+        unsafe { signal::signal(which, SigHandler::SigDfl) }.map_err(io::Error::from)?;
+        signals.add(which);
     }
     signals.thread_block().map_err(io::Error::from)?;
     thread::Builder::new()

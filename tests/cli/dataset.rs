@@ -423,3 +423,120 @@ fn bad_input_exits_2_with_one_line_and_makes_nothing() {
     let err = assert_bad_input(&out);
     assert!(err.contains("nowhere"), "{err}");
 }
+
+/// Cuts `file` to its first half of lines: still a well-formed table, with another hash.
+fn truncate_lines(file: &Path) {
+    let text = std::fs::read_to_string(file).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines.len() > 4, "{} is too short", file.display());
+    let kept: String = lines[..lines.len() / 2]
+        .iter()
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(file, kept).unwrap();
+}
+
+#[test]
+fn issue_18_a_truncated_run_is_made_again_on_resume() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 1.0);
+    let args = ["dataset", &s, "--runs", "4", "--vary", VARY_X, "--out", "d"];
+    let out = hilsim(tmp.path(), &args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let dir = tmp.path().join("d");
+    let before = tree(&dir);
+    truncate_lines(&dir.join("run-000001/lidar.csv"));
+    let out = hilsim(tmp.path(), &args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("dataset d: 1 made, 3 skipped (made before)"),
+        "{}",
+        stdout(&out)
+    );
+    assert_eq!(
+        tree(&dir),
+        before,
+        "the run is made again, to its original hash"
+    );
+}
+
+#[test]
+fn issue_18_merge_refuses_a_corrupt_shard_run_and_the_target_never_holds_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 1.0);
+    for i in 1..=2 {
+        let shard = format!("{i}/2");
+        let dir = format!("shard-{i}");
+        let args = [
+            "dataset", &s, "--runs", "4", "--out", &dir, "--shard", &shard,
+        ];
+        let out = hilsim(tmp.path(), &args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    }
+    truncate_lines(&tmp.path().join("shard-2/run-000003/lidar.csv"));
+    for attempt in 0..2 {
+        let out = hilsim(
+            tmp.path(),
+            &["dataset", "merge", "--out", "merged", "shard-1", "shard-2"],
+        );
+        let err = assert_bad_input(&out);
+        assert!(
+            err.contains("manifest-shard-2-of-2.csv: run 3 has content hash"),
+            "attempt {attempt}: {err}"
+        );
+        assert!(
+            !tmp.path().join("merged/run-000003").exists(),
+            "attempt {attempt}"
+        );
+    }
+}
+
+#[test]
+fn issue_18_shard_processes_started_at_once_on_a_fresh_directory_all_succeed() {
+    // What a Slurm job array does: K processes, one per shard, on one fresh --out.
+    const K: usize = 4;
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 1.0);
+    let common = [
+        "dataset", &s, "--runs", "8", "--vary", VARY_X, "--jobs", "1",
+    ];
+    let whole = hilsim(
+        tmp.path(),
+        &common
+            .iter()
+            .chain(&["--out", "whole"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(whole.status.code(), Some(0), "{}", stderr(&whole));
+    for round in 0..3 {
+        let out = format!("shared-{round}");
+        let children: Vec<_> = (1..=K)
+            .map(|i| {
+                Command::new(env!("CARGO_BIN_EXE_hilsim"))
+                    .args(common)
+                    .args(["--out", &out, "--shard", &format!("{i}/{K}")])
+                    .current_dir(tmp.path())
+                    .env_clear()
+                    .env("PATH", std::env::var_os("PATH").unwrap_or_default())
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for (i, child) in children.into_iter().enumerate() {
+            let done = child.wait_with_output().unwrap();
+            assert_eq!(
+                done.status.code(),
+                Some(0),
+                "round {round}, shard {}/{K}: {}",
+                i + 1,
+                stderr(&done)
+            );
+        }
+        let merged = hilsim(tmp.path(), &["dataset", "merge", "--out", &out]);
+        assert_eq!(merged.status.code(), Some(0), "{}", stderr(&merged));
+        assert_same_tree(&tmp.path().join(&out), &tmp.path().join("whole"));
+    }
+}

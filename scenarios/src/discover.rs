@@ -46,7 +46,9 @@ fn collect(
     visited: &mut HashSet<PathBuf>,
 ) -> Result<(), DiscoverError> {
     let meta = std::fs::metadata(path).map_err(DiscoverError::at(path, "cannot read"))?;
-    if meta.is_file() {
+    // Anything but a directory is a scenario file to load (a device or a pipe is refused, with
+    // its name, by the scenario reader).
+    if !meta.is_dir() {
         files.push(path.to_path_buf());
         return Ok(());
     }

@@ -2,7 +2,7 @@
 //! `hilsim smooth RECORDING --calibration FILE [--csv OUT]` (the EM paper's Sec. V reuse).
 
 use std::fmt::Write as _;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -91,7 +91,16 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<()> {
 
 /// Reads the JSON that `hilsim calibrate --json` printed.
 fn read_calibration(path: &Path) -> Result<Calibration> {
-    let text = std::fs::read_to_string(path)
+    // A calibration is a few hundred bytes; read at most this much of whatever the path is.
+    const MAX_CALIBRATION_BYTES: u64 = 1 << 20;
+    let file =
+        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut text = String::new();
+    file.take(MAX_CALIBRATION_BYTES + 1)
+        .read_to_string(&mut text)
         .with_context(|| format!("{}: cannot read", path.display()))?;
+    if text.len() as u64 > MAX_CALIBRATION_BYTES {
+        bail!("{}: larger than 1 MiB; not a calibration", path.display());
+    }
     Ok(Calibration::from_json(&text, &path.display().to_string())?)
 }

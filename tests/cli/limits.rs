@@ -97,3 +97,22 @@ fn issue_18_diagnose_with_no_sensor_in_common_is_refused() {
     ));
     assert!(err.contains("no sensor in common"), "{err}");
 }
+
+#[test]
+fn issue_18_an_endless_calibration_or_scenario_path_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["smooth", "rec", "--calibration", "/dev/zero"],
+    ));
+    assert!(
+        err.contains("/dev/zero: larger than 1 MiB; not a calibration"),
+        "{err}"
+    );
+    std::os::unix::fs::symlink("/dev/zero", tmp.path().join("zero.toml")).unwrap();
+    let err = assert_bad_input(&hilsim(tmp.path(), &["scenario", "test", "zero.toml"]));
+    assert!(
+        err.contains("zero.toml: ") && !err.contains("cannot list"),
+        "{err}"
+    );
+}

@@ -12,6 +12,11 @@ use crate::params::Params;
 use crate::seed::{draw, run_seed, MAX_SEED};
 use crate::{Error, Vary};
 
+/// The most runs a dataset holds: `run-NNNNNN` directories have six digits, and a million runs
+/// of a minute's recording (~5 MB each) are already ~5 TB. A count is checked before anything
+/// is allocated for it.
+pub const MAX_RUNS: u64 = 1_000_000;
+
 /// N runs of one scenario, each with its own seed and its own draw of the varied parameters.
 ///
 /// ```
@@ -60,18 +65,7 @@ impl Dataset {
         runs: u64,
         varies: Vec<Vary>,
     ) -> Result<Self, Error> {
-        let bytes = std::fs::read(scenario).map_err(|err| hilsim_sim::ScenarioError {
-            file: scenario.to_path_buf(),
-            line: None,
-            message: format!("cannot read: {err}"),
-        })?;
-        let Ok(text) = String::from_utf8(bytes) else {
-            // The scenario loader names the line of the first byte that is not UTF-8.
-            return Err(Scenario::load(scenario).err().map_or_else(
-                || Error::Parameter(format!("{}: not UTF-8", scenario.display())),
-                Error::from,
-            ));
-        };
+        let text = hilsim_sim::scenario::read_scenario_text(scenario)?;
         Self::from_toml(&text, scenario, seed, runs, varies)
     }
 
@@ -85,7 +79,7 @@ impl Dataset {
     /// recorded as failed.
     ///
     /// # Errors
-    /// The scenario is invalid, `runs` is 0, the seed is above 2^63 − 1 (the largest TOML
+    /// The scenario is invalid, `runs` is 0 or above [`MAX_RUNS`], the seed is above 2^63 − 1 (the largest TOML
     /// integer), a key is given twice, or a vary is unusable as described.
     pub fn from_toml(
         text: &str,
@@ -100,6 +94,11 @@ impl Dataset {
             line: None,
             message: err.message().trim().to_string(),
         })?;
+        if runs > MAX_RUNS {
+            return Err(Error::Parameter(format!(
+                "--runs: expected at most {MAX_RUNS} runs, found {runs}"
+            )));
+        }
         if runs == 0 {
             return Err(Error::Parameter(
                 "--runs: expected at least 1 run".to_string(),

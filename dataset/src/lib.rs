@@ -36,7 +36,7 @@ mod shard;
 mod vary;
 
 pub use content::{scan_run, RunContent};
-pub use dataset::{Dataset, RunFailure};
+pub use dataset::{Dataset, RunFailure, MAX_RUNS};
 pub use error::Error;
 pub use generate::Options;
 pub use merge::{merge, MergeSummary};

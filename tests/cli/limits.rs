@@ -116,3 +116,31 @@ fn issue_18_an_endless_calibration_or_scenario_path_is_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn issue_18_dataset_counts_and_scenarios_are_bounded_before_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &[
+            "dataset",
+            scenario.to_str().unwrap(),
+            "--runs",
+            "1000000000000",
+            "--out",
+            "d",
+        ],
+    ));
+    assert!(
+        err.contains("--runs: expected at most 1000000 runs"),
+        "{err}"
+    );
+    std::os::unix::fs::symlink("/dev/zero", tmp.path().join("zero.toml")).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["dataset", "zero.toml", "--runs", "1", "--out", "d"],
+    ));
+    assert!(err.contains("zero.toml: larger than 1 MiB"), "{err}");
+    assert!(!tmp.path().join("d").exists());
+}

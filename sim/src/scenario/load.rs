@@ -30,17 +30,7 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::load`].
     pub fn load_with_duration(path: &Path, duration_s: Option<f64>) -> Result<Self, ScenarioError> {
-        let bytes = read_bounded(path)?;
-        let text = String::from_utf8(bytes).map_err(|err| ScenarioError {
-            file: path.to_path_buf(),
-            line: Some(
-                1 + err.as_bytes()[..err.utf8_error().valid_up_to()]
-                    .iter()
-                    .filter(|&&b| b == b'\n')
-                    .count(),
-            ),
-            message: "not a text file: expected UTF-8 TOML".to_string(),
-        })?;
+        let text = read_scenario_text(path)?;
         Self::from_toml_with_duration(&text, path, duration_s)
     }
 
@@ -77,6 +67,25 @@ impl Scenario {
         })?;
         Ok(scenario)
     }
+}
+
+/// The text of the scenario file at `path`, unparsed (for tools that edit it before parsing, as
+/// `hilsim dataset --vary` does): at most [`MAX_SCENARIO_BYTES`], UTF-8.
+///
+/// # Errors
+/// The file cannot be read, is larger than the limit, or is not UTF-8 (naming the line).
+pub fn read_scenario_text(path: &Path) -> Result<String, ScenarioError> {
+    let bytes = read_bounded(path)?;
+    String::from_utf8(bytes).map_err(|err| ScenarioError {
+        file: path.to_path_buf(),
+        line: Some(
+            1 + err.as_bytes()[..err.utf8_error().valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count(),
+        ),
+        message: "not a text file: expected UTF-8 TOML".to_string(),
+    })
 }
 
 /// The bytes of `path`, when there are at most [`MAX_SCENARIO_BYTES`]. A regular file's length is

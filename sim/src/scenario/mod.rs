@@ -33,6 +33,7 @@ mod validate_effects;
 
 pub use effects::*;
 pub use error::ScenarioError;
+pub use load::read_scenario_text;
 pub use schema::*;
 pub use validate::{MAX_ANGLE_DEG, MAX_RUN_S, MAX_SENSOR_RATE_HZ, MAX_WORLD_M};
 

@@ -165,10 +165,17 @@ struct Reporter<'a> {
 impl Progress for Reporter<'_> {
     fn planned(&mut self, plan: &Plan) {
         self.planned = plan.to_make;
-        let line = format!(
+        let mut line = format!(
             "{} runs in this share: {} made before, {} to make on {} thread(s)",
             plan.share, plan.skipped, plan.to_make, plan.jobs
         );
+        if plan.remade > 0 {
+            line += &format!(
+                " ({} of them made before but damaged since: their files differ from the \
+                 manifest's hash)",
+                plan.remade
+            );
+        }
         if self.terminal && plan.to_make > 0 {
             let bar =
                 ProgressBar::with_draw_target(Some(plan.to_make), ProgressDrawTarget::stdout());

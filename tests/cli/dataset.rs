@@ -453,6 +453,11 @@ fn issue_18_a_truncated_run_is_made_again_on_resume() {
         "{}",
         stdout(&out)
     );
+    assert!(
+        stdout(&out).contains("(1 of them made before but damaged since"),
+        "the user is told why a run is made again: {}",
+        stdout(&out)
+    );
     assert_eq!(
         tree(&dir),
         before,

@@ -205,8 +205,59 @@ pub fn replace_recording_dir<E>(
 where
     E: From<Error>,
 {
+    recover_from_killed_writers(dir)?;
     check_replaceable_recording(dir)?;
     replace_dir_atomically(dir, fill)
+}
+
+/// Tidies what writers of `dir` that were killed left beside it: an unfinished new recording
+/// (`.NAME.tmp.PID`) is removed; a previous one moved aside (`.NAME.old.PID`) is put back when
+/// `dir` is missing (the writer died between its two renames: that was the only copy), else
+/// removed. Only leftovers of processes no longer running are touched.
+fn recover_from_killed_writers(dir: &Path) -> Result<(), Error> {
+    let (Some(parent), Some(name)) = (dir.parent(), dir.file_name()) else {
+        return Ok(());
+    };
+    let parent = if parent.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        parent
+    };
+    let Ok(entries) = fs::read_dir(parent) else {
+        return Ok(());
+    };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let Some((tag, pid)) = file_name
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.split_once('.'))
+        else {
+            continue;
+        };
+        let Ok(pid) = pid.parse::<u32>() else {
+            continue;
+        };
+        if !matches!(tag, "tmp" | "old") || process_may_run(pid) {
+            continue;
+        }
+        let path = entry.path();
+        if tag == "old" && fs::symlink_metadata(dir).is_err() {
+            fs::rename(&path, dir).map_err(|err| Error::io(dir, err))?;
+        } else if path.is_dir() {
+            fs::remove_dir_all(&path).map_err(|err| Error::io(&path, err))?;
+        } else {
+            fs::remove_file(&path).map_err(|err| Error::io(&path, err))?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether process `pid` may still be running (this one, or any on a system without `/proc`).
+fn process_may_run(pid: u32) -> bool {
+    pid == std::process::id()
+        || !Path::new("/proc/self").exists()
+        || Path::new("/proc").join(pid.to_string()).exists()
 }
 
 /// `dir/.name.tag.PID`: hidden, in the same file system (so `rename` is atomic), unique per

@@ -142,3 +142,40 @@ fn issue_18_smooth_refuses_to_write_over_the_recording() {
     assert!(err.contains("is an input"), "{err}");
     assert_eq!(fs::read(tmp.path().join("rec/lidar.csv")).unwrap(), lidar);
 }
+
+/// A process id that is certainly not running: a child that has exited and been reaped.
+fn dead_pid() -> u32 {
+    let mut child = std::process::Command::new("true").spawn().unwrap();
+    let pid = child.id();
+    child.wait().unwrap();
+    pid
+}
+
+#[test]
+fn issue_18_what_a_killed_writer_left_is_tidied_and_an_orphaned_recording_restored() {
+    let tmp = tempfile::tempdir().unwrap();
+    let pid = dead_pid();
+    // An unfinished new recording of a killed `record --out rec`.
+    let unfinished = tmp.path().join(format!(".rec.tmp.{pid}"));
+    fs::create_dir(&unfinished).unwrap();
+    fs::write(unfinished.join("lidar.csv"), vec![b'0'; 1 << 20]).unwrap();
+    // A writer killed between its renames: the previous recording is only beside `rec`.
+    let o = record(tmp.path(), "prev");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    fs::rename(
+        tmp.path().join("prev"),
+        tmp.path().join(format!(".rec.old.{pid}")),
+    )
+    .unwrap();
+    // Someone else's hidden files are not ours to touch.
+    fs::write(tmp.path().join(".rec.notes"), "mine").unwrap();
+    let o = record(tmp.path(), "rec");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut left: Vec<String> = fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, [".rec.notes", "rec"]);
+    assert!(tmp.path().join("rec/meta.toml").is_file());
+}

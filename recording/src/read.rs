@@ -45,7 +45,9 @@ fn optional<T>(
     read: fn(&Path) -> Result<Vec<T>, Error>,
 ) -> Result<Option<Vec<T>>, Error> {
     let path = dir.join(name);
-    if !path.exists() {
+    // Absent only when nothing is there: a link that leads nowhere (or round in a loop) is a
+    // broken table, reported by the reader, not a sensor the robot lacks.
+    if std::fs::symlink_metadata(&path).is_err() {
         return Ok(None);
     }
     read(&path).map(Some)

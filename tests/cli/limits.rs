@@ -144,3 +144,22 @@ fn issue_18_dataset_counts_and_scenarios_are_bounded_before_work() {
     assert!(err.contains("zero.toml: larger than 1 MiB"), "{err}");
     assert!(!tmp.path().join("d").exists());
 }
+
+#[test]
+fn issue_18_a_looping_link_in_a_recording_is_named_not_taken_for_a_missing_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let o = hilsim(
+        tmp.path(),
+        &["record", scenario.to_str().unwrap(), "--out", "rec"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let sonar = tmp.path().join("rec/sonar.csv");
+    fs::remove_file(&sonar).unwrap();
+    std::os::unix::fs::symlink("sonar.csv", &sonar).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "groundtruth"],
+    ));
+    assert!(err.contains("sonar.csv"), "{err}");
+}

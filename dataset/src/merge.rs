@@ -88,22 +88,7 @@ pub fn merge(
     } else {
         Vec::new()
     };
-    let mut present: BTreeSet<u64> = in_out.iter().copied().collect();
-    let mut located: Vec<(PathBuf, u64)> = in_out
-        .iter()
-        .map(|&r| (out.join(run_dir_name(r)), r))
-        .collect();
-    let mut duplicates: Vec<(PathBuf, u64)> = Vec::new();
-    for s in &others {
-        for r in run_dirs(s, params.runs)? {
-            let src = s.join(run_dir_name(r));
-            if present.insert(r) {
-                located.push((src, r));
-            } else {
-                duplicates.push((src, r));
-            }
-        }
-    }
+    let (located, duplicates) = locate_runs(out, &in_out, &others, params.runs)?;
     let scanned: Vec<(PathBuf, u64, RunContent)> = pool.install(|| {
         located
             .par_iter()
@@ -156,6 +141,36 @@ pub fn merge(
         copied: copies.len() as u64,
         manifest: manifest_path,
     })
+}
+
+/// Run directories and the run each holds.
+type RunPlaces = Vec<(PathBuf, u64)>;
+
+/// Where each run is: in `out` (`in_out`), else in the first of `others` that has it; and the
+/// copies of runs found in more than one place (to be compared).
+fn locate_runs(
+    out: &Path,
+    in_out: &[u64],
+    others: &[PathBuf],
+    runs: u64,
+) -> Result<(RunPlaces, RunPlaces), Error> {
+    let mut present: BTreeSet<u64> = in_out.iter().copied().collect();
+    let mut located: Vec<(PathBuf, u64)> = in_out
+        .iter()
+        .map(|&r| (out.join(run_dir_name(r)), r))
+        .collect();
+    let mut duplicates: Vec<(PathBuf, u64)> = Vec::new();
+    for s in others {
+        for r in run_dirs(s, runs)? {
+            let src = s.join(run_dir_name(r));
+            if present.insert(r) {
+                located.push((src, r));
+            } else {
+                duplicates.push((src, r));
+            }
+        }
+    }
+    Ok((located, duplicates))
 }
 
 /// The sources other than `out`, each once.

@@ -2,8 +2,8 @@
 //! physics step as they are taken. `hilsim record` writes exactly these samples.
 
 use hilsim_recording::{
-    LidarSample, Meta, OdometrySample, Recording, RobotMeta, SonarMount, SonarSample, SourceMeta,
-    WorldMeta,
+    CommandSample, LidarSample, Meta, OdometrySample, Recording, RobotMeta, SampleSink, SonarMount,
+    SonarSample, SourceMeta, Tables, TruthSample, WorldMeta,
 };
 use hilsim_sim::{Collision, Scenario, Simulation, StepState};
 
@@ -179,44 +179,95 @@ impl Emulation {
 
     /// As [`Emulation::run`], also handing each lidar reading and the motor speed of its
     /// revolution to `on_lidar` as it is taken (e.g. to stream it over a serial link).
-    pub fn run_with(mut self, mut on_lidar: impl FnMut(&LidarReading, f64)) -> Run {
-        let mut lidar: Option<Vec<LidarSample>> = self.lidar.as_ref().map(|_| Vec::new());
-        let mut sonar = self.sonar.as_ref().map(|_| Vec::new());
-        let mut odometry = self.odometer.as_ref().map(|_| Vec::new());
-        while self.advance() {
-            let s = &self.samples;
-            if let (Some(out), Some(sensor)) = (&mut lidar, &self.lidar) {
-                for reading in &s.lidar {
-                    on_lidar(reading, sensor.rpm_of_revolution(reading.rev));
-                    out.push(reading.to_sample());
-                }
-            }
-            if let Some(out) = &mut sonar {
-                out.extend_from_slice(&s.sonar);
-            }
-            if let Some(out) = &mut odometry {
-                out.extend_from_slice(&s.odometry);
-            }
-        }
-        // A real unit only ever delivers whole revolutions: the one the run ended inside is not
-        // part of the recording (so the in-process and serial paths carry the same data).
-        if let Some(readings) = &mut lidar {
-            let whole = readings.len() - readings.len() % READINGS_PER_REVOLUTION;
-            readings.truncate(whole);
-        }
-        let (commands, truth, collisions) = self.sim.take_logs();
+    pub fn run_with(self, on_lidar: impl FnMut(&LidarReading, f64)) -> Run {
+        let mut recording = Recording {
+            meta: self.meta.clone(),
+            commands: Vec::new(),
+            odometry: self.odometer.as_ref().map(|_| Vec::new()),
+            lidar: self.lidar.as_ref().map(|_| Vec::new()),
+            sonar: self.sonar.as_ref().map(|_| Vec::new()),
+            truth: Some(Vec::new()),
+        };
+        // A recording in memory takes every sample.
+        let Ok(collisions) = self.drive_into(&mut recording, on_lidar);
         Run {
-            recording: Recording {
-                meta: self.meta,
-                commands,
-                odometry,
-                lidar,
-                sonar,
-                truth: Some(truth),
-            },
+            recording,
             collisions,
         }
     }
+
+    /// The tables a recording of this emulation has (`commands.csv` always).
+    #[must_use]
+    pub fn tables(&self) -> Tables {
+        Tables {
+            odometry: self.odometer.is_some(),
+            lidar: self.lidar.is_some(),
+            sonar: self.sonar.is_some(),
+            truth: true,
+        }
+    }
+
+    /// Runs to the end, handing every sample to `sink` as it is taken, as [`Emulation::run`]
+    /// collects them: what `hilsim record` writes, in memory flat in the run's length (a
+    /// [`hilsim_recording::RecordingStream`]). Returns the collisions.
+    ///
+    /// # Errors
+    /// The sink's, which stops the run.
+    pub fn record_into<S: SampleSink>(self, sink: &mut S) -> Result<Vec<Collision>, S::Error> {
+        self.drive_into(sink, |_, _| {})
+    }
+
+    /// The run's loop: each step's samples to `sink`, each lidar reading also to `on_lidar`.
+    /// A real unit only ever delivers whole revolutions: readings reach `sink` a revolution at a
+    /// time, and the one the run ends inside is not part of the recording (so the in-process
+    /// and serial paths carry the same data).
+    fn drive_into<S: SampleSink>(
+        mut self,
+        sink: &mut S,
+        mut on_lidar: impl FnMut(&LidarReading, f64),
+    ) -> Result<Vec<Collision>, S::Error> {
+        let mut revolution: Vec<LidarSample> = Vec::with_capacity(READINGS_PER_REVOLUTION);
+        while self.advance() {
+            let s = &self.samples;
+            if let Some(sensor) = &self.lidar {
+                for reading in &s.lidar {
+                    on_lidar(reading, sensor.rpm_of_revolution(reading.rev));
+                    revolution.push(reading.to_sample());
+                    if revolution.len() == READINGS_PER_REVOLUTION {
+                        for r in revolution.drain(..) {
+                            sink.lidar(&r)?;
+                        }
+                    }
+                }
+            }
+            for p in &s.sonar {
+                sink.sonar(p)?;
+            }
+            for o in &s.odometry {
+                sink.odometry(o)?;
+            }
+            let (commands, truth) = self.sim.drain_logs();
+            log_into(sink, &commands, &truth)?;
+        }
+        let (commands, truth, collisions) = self.sim.take_logs();
+        log_into(sink, &commands, &truth)?;
+        Ok(collisions)
+    }
+}
+
+/// The simulation's command and truth rows, to `sink`.
+fn log_into<S: SampleSink>(
+    sink: &mut S,
+    commands: &[CommandSample],
+    truth: &[TruthSample],
+) -> Result<(), S::Error> {
+    for c in commands {
+        sink.command(c)?;
+    }
+    for t in truth {
+        sink.truth(t)?;
+    }
+    Ok(())
 }
 
 /// A finished run.

@@ -114,28 +114,40 @@ pub fn replace_dir_atomically<E>(
 where
     E: From<Error>,
 {
+    let tmp = new_sibling_dir(dir)?;
+    if let Err(err) = fill(&tmp) {
+        let _ = fs::remove_dir_all(&tmp);
+        return Err(err);
+    }
+    put_in_place(&tmp, dir).map_err(E::from)
+}
+
+/// A fresh, empty temporary sibling of `dir` (`.NAME.tmp.PID`), its parent created if needed.
+pub(crate) fn new_sibling_dir(dir: &Path) -> Result<PathBuf, Error> {
     if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
         fs::create_dir_all(parent).map_err(|err| Error::io(parent, err))?;
     }
     let tmp = sibling(dir, "tmp");
     let _ = fs::remove_dir_all(&tmp);
     fs::create_dir(&tmp).map_err(|err| Error::io(&tmp, err))?;
-    if let Err(err) = fill(&tmp) {
-        let _ = fs::remove_dir_all(&tmp);
-        return Err(err);
-    }
+    Ok(tmp)
+}
+
+/// Renames the complete `tmp` into place as `dir`: an existing `dir` is moved aside first and
+/// deleted only once the new one is in place; on failure `dir` is put back and `tmp` removed.
+pub(crate) fn put_in_place(tmp: &Path, dir: &Path) -> Result<(), Error> {
     let old = sibling(dir, "old");
     let had_old = dir.exists();
     if had_old {
         let _ = fs::remove_dir_all(&old);
         fs::rename(dir, &old).map_err(|err| Error::io(dir, err))?;
     }
-    if let Err(err) = fs::rename(&tmp, dir) {
+    if let Err(err) = fs::rename(tmp, dir) {
         if had_old {
             let _ = fs::rename(&old, dir);
         }
-        let _ = fs::remove_dir_all(&tmp);
-        return Err(Error::io(dir, err).into());
+        let _ = fs::remove_dir_all(tmp);
+        return Err(Error::io(dir, err));
     }
     if had_old {
         let _ = fs::remove_dir_all(&old);
@@ -214,7 +226,7 @@ where
 /// (`.NAME.tmp.PID`) is removed; a previous one moved aside (`.NAME.old.PID`) is put back when
 /// `dir` is missing (the writer died between its two renames: that was the only copy), else
 /// removed. Only leftovers of processes no longer running are touched.
-fn recover_from_killed_writers(dir: &Path) -> Result<(), Error> {
+pub(crate) fn recover_from_killed_writers(dir: &Path) -> Result<(), Error> {
     let (Some(parent), Some(name)) = (dir.parent(), dir.file_name()) else {
         return Ok(());
     };

@@ -26,6 +26,7 @@ mod names;
 pub mod pose;
 mod read;
 mod samples;
+mod stream;
 mod write;
 
 pub use atomic::{
@@ -37,6 +38,7 @@ pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
 pub use samples::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
+pub use stream::{RecordingStream, SampleSink, Tables};
 
 /// A whole recording: the metadata and one table per sensor.
 ///

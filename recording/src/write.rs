@@ -1,6 +1,5 @@
 //! Writing a [`Recording`] as a directory.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::atomic::{replace_recording_dir, write_file_atomically};
@@ -39,15 +38,15 @@ impl Recording {
     #[must_use]
     pub fn tables(&self) -> Vec<(&'static str, String)> {
         let mut out = Vec::new();
-        let mut s = String::from("t_s,left_mps,right_mps\n");
+        let mut s = String::from(rows::COMMANDS_HEADER);
         for c in &self.commands {
-            let _ = writeln!(s, "{},{},{}", c.t_s, c.left_mps, c.right_mps);
+            rows::command(&mut s, c);
         }
         out.push(("commands.csv", s));
         if let Some(odometry) = &self.odometry {
-            let mut s = String::from("t_s,left_m,right_m\n");
+            let mut s = String::from(rows::ODOMETRY_HEADER);
             for o in odometry {
-                let _ = writeln!(s, "{},{},{}", o.t_s, o.left_m, o.right_m);
+                rows::odometry(&mut s, o);
             }
             out.push(("odometry.csv", s));
         }
@@ -55,54 +54,97 @@ impl Recording {
             // The truth column is all-or-nothing: a simulator knows every true range.
             let with_truth = lidar.iter().all(|r| r.true_range_m.is_some()) && !lidar.is_empty();
             let mut s = String::with_capacity(lidar.len() * 48);
-            s.push_str("t_s,rev,angle_deg,range_m,strength,invalid,warning");
-            s.push_str(if with_truth { ",true_range_m\n" } else { "\n" });
+            s.push_str(rows::lidar_header(with_truth));
             for r in lidar {
-                let _ = write!(
-                    s,
-                    "{},{},{},{},{},{},{}",
-                    r.t_s,
-                    r.rev,
-                    r.angle_deg,
-                    r.range_m,
-                    r.strength,
-                    u8::from(r.invalid),
-                    u8::from(r.warning)
-                );
-                match r.true_range_m.filter(|_| with_truth) {
-                    Some(t) => {
-                        let _ = writeln!(s, ",{t}");
-                    }
-                    None => s.push('\n'),
-                }
+                rows::lidar(&mut s, r, with_truth);
             }
             out.push(("lidar.csv", s));
         }
         if let Some(sonar) = &self.sonar {
             let with_truth = sonar.iter().all(|r| r.true_range_m.is_some()) && !sonar.is_empty();
-            let mut s = String::from(if with_truth {
-                "t_s,range_m,true_range_m\n"
-            } else {
-                "t_s,range_m\n"
-            });
+            let mut s = String::from(rows::sonar_header(with_truth));
             for r in sonar {
-                let _ = write!(s, "{},{}", r.t_s, r.range_m);
-                match r.true_range_m.filter(|_| with_truth) {
-                    Some(t) => {
-                        let _ = writeln!(s, ",{t}");
-                    }
-                    None => s.push('\n'),
-                }
+                rows::sonar(&mut s, r, with_truth);
             }
             out.push(("sonar.csv", s));
         }
         if let Some(truth) = &self.truth {
-            let mut s = String::from("t_s,x_m,y_m,yaw_rad\n");
+            let mut s = String::from(rows::TRUTH_HEADER);
             for p in truth {
-                let _ = writeln!(s, "{},{},{},{}", p.t_s, p.x_m, p.y_m, p.yaw_rad);
+                rows::truth(&mut s, p);
             }
             out.push(("truth.csv", s));
         }
         out
+    }
+}
+
+/// One row of each table, as the whole-table writer above and the streaming writer
+/// (`stream.rs`) both write it: floats in Rust's shortest round-trip form.
+pub(crate) mod rows {
+    use std::fmt::Write as _;
+
+    use crate::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
+
+    pub(crate) const COMMANDS_HEADER: &str = "t_s,left_mps,right_mps\n";
+    pub(crate) const ODOMETRY_HEADER: &str = "t_s,left_m,right_m\n";
+    pub(crate) const TRUTH_HEADER: &str = "t_s,x_m,y_m,yaw_rad\n";
+
+    pub(crate) fn lidar_header(with_truth: bool) -> &'static str {
+        if with_truth {
+            "t_s,rev,angle_deg,range_m,strength,invalid,warning,true_range_m\n"
+        } else {
+            "t_s,rev,angle_deg,range_m,strength,invalid,warning\n"
+        }
+    }
+
+    pub(crate) fn sonar_header(with_truth: bool) -> &'static str {
+        if with_truth {
+            "t_s,range_m,true_range_m\n"
+        } else {
+            "t_s,range_m\n"
+        }
+    }
+
+    // Writing to a String cannot fail.
+    pub(crate) fn command(s: &mut String, c: &CommandSample) {
+        let _ = writeln!(s, "{},{},{}", c.t_s, c.left_mps, c.right_mps);
+    }
+
+    pub(crate) fn odometry(s: &mut String, o: &OdometrySample) {
+        let _ = writeln!(s, "{},{},{}", o.t_s, o.left_m, o.right_m);
+    }
+
+    pub(crate) fn truth(s: &mut String, p: &TruthSample) {
+        let _ = writeln!(s, "{},{},{},{}", p.t_s, p.x_m, p.y_m, p.yaw_rad);
+    }
+
+    pub(crate) fn lidar(s: &mut String, r: &LidarSample, with_truth: bool) {
+        let _ = write!(
+            s,
+            "{},{},{},{},{},{},{}",
+            r.t_s,
+            r.rev,
+            r.angle_deg,
+            r.range_m,
+            r.strength,
+            u8::from(r.invalid),
+            u8::from(r.warning)
+        );
+        true_range(s, r.true_range_m.filter(|_| with_truth));
+    }
+
+    pub(crate) fn sonar(s: &mut String, r: &SonarSample, with_truth: bool) {
+        let _ = write!(s, "{},{}", r.t_s, r.range_m);
+        true_range(s, r.true_range_m.filter(|_| with_truth));
+    }
+
+    fn true_range(s: &mut String, t: Option<f64>) {
+        match t {
+            Some(t) => {
+                let _ = writeln!(s, ",{t}");
+            }
+            None => s.push('\n'),
+        }
     }
 }

@@ -96,6 +96,9 @@ pub struct Simulation {
     pose: Pose,
     wheels: [f64; 2],
     commands: Vec<CommandSample>,
+    /// The command last logged: a row is logged only when the command changes, also after
+    /// [`Simulation::drain_logs`] has handed the rows over.
+    last_command: Option<WheelCommand>,
     truth: Vec<TruthSample>,
     collisions: Vec<Collision>,
     touching: Vec<ColliderHandle>,
@@ -134,6 +137,7 @@ impl Simulation {
             pose,
             wheels: [0.0; 2],
             commands: Vec::new(),
+            last_command: None,
             truth: vec![truth(0.0, pose)],
             collisions: Vec::new(),
             touching: Vec::new(),
@@ -195,10 +199,10 @@ impl Simulation {
         };
         let t0 = self.time_s();
         if self
-            .commands
-            .last()
+            .last_command
             .is_none_or(|c| c.left_mps != command.left_mps || c.right_mps != command.right_mps)
         {
+            self.last_command = Some(command);
             self.commands.push(CommandSample {
                 t_s: t0,
                 left_mps: command.left_mps,
@@ -315,6 +319,15 @@ impl Simulation {
     #[must_use]
     pub fn collisions(&self) -> &[Collision] {
         &self.collisions
+    }
+
+    /// Hands over the command and truth rows logged since the last call (or the start), so that
+    /// a caller writing them out as the run goes keeps memory flat in the run's length.
+    pub fn drain_logs(&mut self) -> (Vec<CommandSample>, Vec<TruthSample>) {
+        (
+            std::mem::take(&mut self.commands),
+            std::mem::take(&mut self.truth),
+        )
     }
 
     /// Hands over the logs, leaving the simulation's empty.

@@ -1,15 +1,19 @@
-//! `hilsim record SCENARIO --out DIR [--seed N]`.
+//! `hilsim record SCENARIO --out DIR [--seed N]`: the samples go to disk as they are taken, so a
+//! run of any length records in flat memory.
 
 use anyhow::{Context, Result};
 use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::RecordingStream;
 
 use crate::cli::RecordArgs;
 
 pub fn record(args: &RecordArgs) -> Result<()> {
     let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
-    let run = Emulation::new(&scenario, scenario.seed)
-        .with_context(|| format!("{}: sensor model", args.scenario.display()))?
-        .run();
-    run.recording.write_dir(&args.out)?;
+    let emulation = Emulation::new(&scenario, scenario.seed)
+        .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
+    let mut stream =
+        RecordingStream::create(&args.out, emulation.meta().clone(), emulation.tables())?;
+    emulation.record_into(&mut stream)?;
+    stream.finish()?;
     Ok(())
 }

@@ -11,7 +11,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::{replace_dir_atomically, write_file_atomically, Recording};
+use hilsim_recording::{write_file_atomically, Recording, RecordingStream};
 use rayon::prelude::*;
 
 use crate::content::{scan_run, RunContent};
@@ -311,36 +311,52 @@ impl Dataset {
         Ok((text, emulation.run().recording))
     }
 
-    /// Makes run `run` in `dir/run-NNNNNN`: its recording and `scenario.toml`, written into a
-    /// temporary directory that is renamed when complete. A panic in the models is a failure of
-    /// this run, not of the dataset.
+    /// Makes run `run` in `dir/run-NNNNNN`: its recording (streamed to disk as it is taken) and
+    /// `scenario.toml`, written into a temporary directory that is renamed when complete. A
+    /// panic in the models is a failure of this run, not of the dataset.
     fn make_run(&self, dir: &Path, run: u64) -> Result<Result<RunContent, RunFailure>, Error> {
-        let (text, recording) =
-            match std::panic::catch_unwind(AssertUnwindSafe(|| self.emulate(run))) {
-                Ok(Ok(made)) => made,
-                Ok(Err(failure)) => return Ok(Err(failure)),
-                Err(payload) => {
-                    let what = payload
-                        .downcast_ref::<&str>()
-                        .map(|s| (*s).to_string())
-                        .or_else(|| payload.downcast_ref::<String>().cloned())
-                        .unwrap_or_default();
-                    return Ok(Err(RunFailure {
-                        reason: format!("internal error: the run panicked: {what}"),
-                    }));
-                }
-            };
         let target = dir.join(run_dir_name(run));
+        match std::panic::catch_unwind(AssertUnwindSafe(|| self.record_run(&target, run))) {
+            Ok(made) => made,
+            Err(payload) => {
+                let what = payload
+                    .downcast_ref::<&str>()
+                    .map(|s| (*s).to_string())
+                    .or_else(|| payload.downcast_ref::<String>().cloned())
+                    .unwrap_or_default();
+                Ok(Err(RunFailure {
+                    reason: format!("internal error: the run panicked: {what}"),
+                }))
+            }
+        }
+    }
+
+    /// Records run `run` at `target` (see [`Dataset::make_run`]); its content, scanned before
+    /// the directory is put in place.
+    fn record_run(&self, target: &Path, run: u64) -> Result<Result<RunContent, RunFailure>, Error> {
+        let (text, scenario) = match self.scenario(run) {
+            Ok(made) => made,
+            Err(failure) => return Ok(Err(failure)),
+        };
+        let emulation = match Emulation::new(&scenario, scenario.seed) {
+            Ok(emulation) => emulation,
+            Err(err) => {
+                return Ok(Err(RunFailure {
+                    reason: format!("sensor model: {err}"),
+                }))
+            }
+        };
+        let mut stream =
+            RecordingStream::create(target, emulation.meta().clone(), emulation.tables())?;
+        emulation.record_into(&mut stream)?;
         let mut content = None;
-        replace_dir_atomically(&target, |tmp| -> Result<(), Error> {
-            recording.write_files(tmp)?;
+        stream.finish_with(|tmp| -> Result<(), Error> {
             write_file_atomically(&tmp.join("scenario.toml"), text.as_bytes())?;
             content = Some(scan_run(tmp)?);
             Ok(())
         })?;
-        content
-            .map(Ok)
-            .ok_or_else(|| Error::corrupt(&target, "the run was not scanned"))
+        let content = content.ok_or_else(|| Error::corrupt(target, "the run was not scanned"))?;
+        Ok(Ok(content))
     }
 
     /// Run `run`'s manifest row.

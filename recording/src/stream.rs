@@ -227,7 +227,19 @@ impl RecordingStream {
     ///
     /// # Errors
     /// An I/O error naming the file.
-    pub fn finish(mut self) -> Result<(), Error> {
+    pub fn finish(self) -> Result<(), Error> {
+        self.finish_with(|_| Ok(()))
+    }
+
+    /// As [`RecordingStream::finish`], running `extra` on the complete directory before it is
+    /// put in place (to add files of one's own beside the recording, or check it).
+    ///
+    /// # Errors
+    /// An I/O error naming the file, or `extra`'s.
+    pub fn finish_with<E: From<Error>>(
+        mut self,
+        extra: impl FnOnce(&Path) -> Result<(), E>,
+    ) -> Result<(), E> {
         let tables = [
             (self.commands.take(), None),
             (self.odometry.take(), None),
@@ -250,6 +262,7 @@ impl RecordingStream {
         let meta = toml::to_string(&self.meta)
             .map_err(|err| Error::format(&meta_path, None, err.to_string()))?;
         write_file_atomically(&meta_path, meta.as_bytes())?;
+        extra(&self.tmp)?;
         put_in_place(&self.tmp, &self.dir)?;
         // In place: nothing for `drop` to remove.
         self.tmp = PathBuf::new();

@@ -7,22 +7,8 @@ pub mod diagnose;
 pub mod hil;
 pub mod record;
 pub mod run;
+mod scenario_file;
 pub mod scenario_test;
 pub mod serve;
 
-use std::path::Path;
-
-use anyhow::Result;
-use hilsim_sim::Scenario;
-
-/// Loads a scenario file, or the built-in one, and applies a `--seed` override.
-pub fn load_scenario(path: Option<&Path>, seed: Option<u64>) -> Result<Scenario> {
-    let mut scenario = match path {
-        Some(path) => Scenario::load(path)?,
-        None => hilsim_scenarios::builtin::straight_board()?,
-    };
-    if let Some(seed) = seed {
-        scenario.seed = seed;
-    }
-    Ok(scenario)
-}
+pub use scenario_file::load_scenario;

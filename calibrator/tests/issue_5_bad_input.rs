@@ -1,7 +1,6 @@
 //! Issue 5: bad input to the EM calibrator, the ground-truth baseline and the smoother gives
 //! the right `CalibrationError` with a message a user can act on, never a panic or a NaN.
 
-#[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
 use std::sync::OnceLock;

@@ -2,7 +2,6 @@
 //! Sensors J. 2017) on the simulated straight-board experiment, with the actuation error its
 //! premise needs (the commands are known, the actual speed is not).
 
-#[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
 use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};

@@ -1,7 +1,6 @@
 //! Issue 5: the ground-truth baseline (ML fit against the true distances, order by AIC, as in
 //! Alhashimi et al., ICINCO 2016) recovers the lidar model and picks the true order.
 
-#[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
 use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};

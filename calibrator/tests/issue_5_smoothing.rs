@@ -1,7 +1,6 @@
 //! Issue 5: reusing a trained calibration (the EM paper's Sec. V): one smoother pass over a new
 //! recording gives calibrated distances without re-running EM.
 
-#[path = "issue_5_fixtures.rs"]
 mod fixtures;
 
 use fixtures::{Record, Run};

@@ -247,10 +247,10 @@ impl Emulation {
                 sink.odometry(o)?;
             }
             let (commands, truth) = self.sim.drain_logs();
-            log_into(sink, &commands, &truth)?;
+            log_into(sink, commands, truth)?;
         }
         let (commands, truth, collisions) = self.sim.take_logs();
-        log_into(sink, &commands, &truth)?;
+        log_into(sink, commands, truth)?;
         Ok(collisions)
     }
 }
@@ -258,14 +258,14 @@ impl Emulation {
 /// The simulation's command and truth rows, to `sink`.
 fn log_into<S: SampleSink>(
     sink: &mut S,
-    commands: &[CommandSample],
-    truth: &[TruthSample],
+    commands: impl IntoIterator<Item = CommandSample>,
+    truth: impl IntoIterator<Item = TruthSample>,
 ) -> Result<(), S::Error> {
     for c in commands {
-        sink.command(c)?;
+        sink.command(&c)?;
     }
     for t in truth {
-        sink.truth(t)?;
+        sink.truth(&t)?;
     }
     Ok(())
 }

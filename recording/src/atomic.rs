@@ -165,8 +165,7 @@ pub fn check_replaceable_recording(dir: &Path) -> Result<(), Error> {
         Error::io(
             dir,
             io::Error::other(format!(
-                "{what}; refusing to replace it (an output directory is replaced only when it \
-                 holds a hilsim recording)"
+                "{what}; refusing to replace it (choose another directory, or empty this one)"
             )),
         )
     };
@@ -185,7 +184,9 @@ pub fn check_replaceable_recording(dir: &Path) -> Result<(), Error> {
     if names_the_format(&dir.join("meta.toml")) {
         Ok(())
     } else {
-        Err(refuse("exists and is not a hilsim recording"))
+        Err(refuse(
+            "exists and holds something other than a hilsim recording",
+        ))
     }
 }
 
@@ -217,7 +218,7 @@ pub fn replace_recording_dir<E>(
 where
     E: From<Error>,
 {
-    recover_from_killed_writers(dir)?;
+    tidy_after_killed_writers(dir)?;
     check_replaceable_recording(dir)?;
     replace_dir_atomically(dir, fill)
 }
@@ -226,7 +227,13 @@ where
 /// (`.NAME.tmp.PID`) is removed; a previous one moved aside (`.NAME.old.PID`) is put back when
 /// `dir` is missing (the writer died between its two renames: that was the only copy), else
 /// removed. Only leftovers of processes no longer running are touched.
-pub(crate) fn recover_from_killed_writers(dir: &Path) -> Result<(), Error> {
+///
+/// It lists `dir`'s parent: call it once per output a command writes, not once per run of a
+/// directory that holds many (a dataset tidies its own).
+///
+/// # Errors
+/// A leftover that cannot be removed or put back.
+pub fn tidy_after_killed_writers(dir: &Path) -> Result<(), Error> {
     let (Some(parent), Some(name)) = (dir.parent(), dir.file_name()) else {
         return Ok(());
     };

@@ -9,8 +9,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::atomic::{
-    check_replaceable_recording, new_sibling_dir, put_in_place, recover_from_killed_writers,
-    write_file_atomically,
+    check_replaceable_recording, new_sibling_dir, put_in_place, write_file_atomically,
 };
 use crate::write::rows;
 use crate::{
@@ -182,12 +181,13 @@ pub struct RecordingStream {
 impl RecordingStream {
     /// Starts a recording to be put at `dir`, with `meta` and the `tables` given. `dir` must be
     /// replaceable ([`crate::check_replaceable_recording`]); it is untouched until
-    /// [`RecordingStream::finish`].
+    /// [`RecordingStream::finish`]. What killed writers left beside `dir` is not looked for here
+    /// (that lists the parent): a command writing one output calls
+    /// [`crate::tidy_after_killed_writers`] first.
     ///
     /// # Errors
     /// `dir` holds something other than a recording, or a file cannot be created.
     pub fn create(dir: &Path, meta: Meta, tables: Tables) -> Result<Self, Error> {
-        recover_from_killed_writers(dir)?;
         check_replaceable_recording(dir)?;
         let tmp = new_sibling_dir(dir)?;
         let mut stream = Self {

@@ -323,11 +323,14 @@ impl Simulation {
 
     /// Hands over the command and truth rows logged since the last call (or the start), so that
     /// a caller writing them out as the run goes keeps memory flat in the run's length.
-    pub fn drain_logs(&mut self) -> (Vec<CommandSample>, Vec<TruthSample>) {
-        (
-            std::mem::take(&mut self.commands),
-            std::mem::take(&mut self.truth),
-        )
+    /// The logs keep their capacity, so a run drained every step allocates nothing for them.
+    pub fn drain_logs(
+        &mut self,
+    ) -> (
+        std::vec::Drain<'_, CommandSample>,
+        std::vec::Drain<'_, TruthSample>,
+    ) {
+        (self.commands.drain(..), self.truth.drain(..))
     }
 
     /// Hands over the logs, leaving the simulation's empty.

@@ -11,6 +11,7 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
+    hilsim_recording::tidy_after_killed_writers(&args.out)?;
     let mut stream =
         RecordingStream::create(&args.out, emulation.meta().clone(), emulation.tables())?;
     emulation.record_into(&mut stream)?;

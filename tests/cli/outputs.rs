@@ -21,7 +21,7 @@ fn issue_18_record_refuses_a_directory_that_is_not_a_recording() {
     fs::write(dir.join("p.txt"), "precious").unwrap();
     let err = assert_bad_input(&record(tmp.path(), "x"));
     assert!(
-        err.contains("x: exists and is not a hilsim recording"),
+        err.contains("x: exists and holds something other than a hilsim recording"),
         "{err}"
     );
     assert_eq!(fs::read_to_string(dir.join("p.txt")).unwrap(), "precious");

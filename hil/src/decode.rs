@@ -68,16 +68,25 @@ impl DecodeCounts {
 /// What is handed each decoded revolution.
 pub type RevolutionSink<'a, E> = &'a mut dyn FnMut(&Revolution) -> Result<(), E>;
 
+/// Why a stream could not be decoded to its end.
+#[derive(Debug)]
+pub enum DecodeError<E> {
+    /// Reading the source failed.
+    Read(io::Error),
+    /// The revolution sink failed (e.g. writing the CSV).
+    Sink(E),
+}
+
 /// Reads `source` to its end and decodes it; with `on_revolution`, hands it each revolution as
 /// it completes (a partial first and last one included). An error from `on_revolution` stops
 /// the decoding and is returned.
 ///
 /// # Errors
 /// A read error other than an interruption or a closed pty, or `on_revolution`'s.
-pub fn decode_stream<E: From<io::Error>>(
+pub fn decode_stream<E>(
     source: &mut dyn Read,
     mut on_revolution: Option<RevolutionSink<'_, E>>,
-) -> Result<DecodeCounts, E> {
+) -> Result<DecodeCounts, DecodeError<E>> {
     let mut decoder = Decoder::new();
     let mut summary = PacketSummary::new();
     let mut assembler = RevolutionAssembler::new();
@@ -88,20 +97,20 @@ pub fn decode_stream<E: From<io::Error>>(
             Ok(len) => len,
             Err(err) if err.kind() == ErrorKind::Interrupted => continue,
             Err(err) if is_closed_pty(&err) => break,
-            Err(err) => return Err(err.into()),
+            Err(err) => return Err(DecodeError::Read(err)),
         };
         for packet in decoder.feed(&chunk[..len]) {
             summary.add(&packet);
             if let Some(sink) = on_revolution.as_mut() {
                 if let Some(revolution) = assembler.push(packet) {
-                    sink(&revolution)?;
+                    sink(&revolution).map_err(DecodeError::Sink)?;
                 }
             }
         }
     }
     if let Some(sink) = on_revolution.as_mut() {
         if let Some(revolution) = assembler.finish() {
-            sink(&revolution)?;
+            sink(&revolution).map_err(DecodeError::Sink)?;
         }
     }
     Ok(DecodeCounts::new(&decoder.finish(), &summary))

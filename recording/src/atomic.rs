@@ -35,16 +35,20 @@ impl OutputTarget {
                 io::Error::other(format!("{what}; refusing to write over it")),
             )
         };
-        match fs::symlink_metadata(path) {
+        let is_link = match fs::symlink_metadata(path) {
             Err(err) if err.kind() == io::ErrorKind::NotFound => {
                 return Ok(Self::Replace(path.to_path_buf()))
             }
             Err(err) => return Err(Error::io(path, err)),
-            Ok(_) => {}
-        }
-        // Follow links: the file the user names is the one they mean.
-        let target =
-            fs::canonicalize(path).map_err(|_| refuse("is a symbolic link that leads nowhere"))?;
+            Ok(meta) => meta.file_type().is_symlink(),
+        };
+        // Follow a link: the file the user names is the one they mean. (Otherwise keep the path
+        // as given, so that messages name it as the user wrote it.)
+        let target = if is_link {
+            fs::canonicalize(path).map_err(|_| refuse("is a symbolic link that leads nowhere"))?
+        } else {
+            path.to_path_buf()
+        };
         let kind = fs::metadata(&target)
             .map_err(|err| Error::io(path, err))?
             .file_type();
@@ -76,28 +80,92 @@ pub fn is_same_file(a: &Path, b: &Path) -> bool {
 /// # Errors
 /// Any I/O error, naming `path`; a directory or other non-file at `path` is refused.
 pub fn write_file_atomically(path: &Path, contents: &[u8]) -> Result<(), Error> {
-    let path = match OutputTarget::of(path)? {
-        OutputTarget::Replace(path) => path,
-        OutputTarget::WriteThrough(device) => {
-            return fs::OpenOptions::new()
-                .write(true)
-                .open(&device)
-                .and_then(|mut file| file.write_all(contents))
-                .map_err(|err| Error::io(&device, err));
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(contents)
+        .map_err(|err| Error::io(file.path(), err))?;
+    file.commit()
+}
+
+/// A file written as [`write_file_atomically`] writes one, for contents that arrive in pieces
+/// (buffered): through a temporary sibling (`.NAME.tmp.PID`) that [`AtomicFile::commit`] syncs
+/// and renames over the target, or straight to a device or FIFO. Dropped uncommitted, it removes
+/// the sibling and leaves the target as it was.
+pub struct AtomicFile {
+    /// The file the user named (links followed).
+    target: PathBuf,
+    /// The temporary sibling, until committed; `None` for a device written through.
+    tmp: Option<PathBuf>,
+    out: io::BufWriter<fs::File>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path` (see [`OutputTarget`]).
+    ///
+    /// # Errors
+    /// `path` is refused, or the file cannot be created.
+    pub fn create(path: &Path) -> Result<Self, Error> {
+        let (target, tmp) = match OutputTarget::of(path)? {
+            OutputTarget::Replace(target) => {
+                let tmp = sibling(&target, "tmp");
+                (target, Some(tmp))
+            }
+            OutputTarget::WriteThrough(device) => (device, None),
+        };
+        let file = match &tmp {
+            Some(tmp) => fs::File::create(tmp),
+            None => fs::OpenOptions::new().write(true).open(&target),
         }
-    };
-    let path = path.as_path();
-    let tmp = sibling(path, "tmp");
-    let result = (|| {
-        let mut file = fs::File::create(&tmp)?;
-        file.write_all(contents)?;
-        file.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    result.map_err(|err| {
-        let _ = fs::remove_file(&tmp);
-        Error::io(path, err)
-    })
+        .map_err(|err| Error::io(path, err))?;
+        Ok(Self {
+            target,
+            tmp,
+            out: io::BufWriter::with_capacity(1 << 16, file),
+        })
+    }
+
+    /// The file being written (links followed).
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.target
+    }
+
+    /// Flushes, syncs and renames the temporary sibling over the target.
+    ///
+    /// # Errors
+    /// An I/O error naming the target; the target is then as it was.
+    pub fn commit(mut self) -> Result<(), Error> {
+        let fail = |err: io::Error| Error::io(&self.target, err);
+        self.out.flush().map_err(fail)?;
+        if let Some(tmp) = &self.tmp {
+            self.out.get_ref().sync_all().map_err(fail)?;
+            fs::rename(tmp, &self.target).map_err(fail)?;
+        }
+        // In place: nothing for `drop` to remove.
+        self.tmp = None;
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.out.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        self.out.write_all(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if let Some(tmp) = &self.tmp {
+            let _ = fs::remove_file(tmp);
+        }
+    }
 }
 
 /// Builds a directory with `fill` in a temporary sibling, then puts it in place of `dir`.

@@ -31,7 +31,7 @@ mod write;
 
 pub use atomic::{
     check_replaceable_recording, is_same_file, replace_dir_atomically, replace_recording_dir,
-    tidy_after_killed_writers, write_file_atomically, OutputTarget,
+    tidy_after_killed_writers, write_file_atomically, AtomicFile, OutputTarget,
 };
 pub use error::{Error, ErrorKind};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};

@@ -22,14 +22,16 @@
 //! `index_gaps`, `readings`, `invalid`, `strength_warning` (integers) and `rpm_min`,
 //! `rpm_median`, `rpm_max` (floats over accepted packets, 0.0 when there are none).
 
-use std::fs::{File, OpenOptions};
-use std::io::{BufWriter, ErrorKind, Write};
-use std::path::{Path, PathBuf};
+use std::convert::Infallible;
+use std::fs::File;
+use std::io::{ErrorKind, Write};
+use std::path::Path;
 
-use anyhow::{bail, Context};
-use hilsim_hil::decode::{decode_stream, decoded_csv_rows, DecodeCounts, DECODED_CSV_HEADER};
-use hilsim_recording::{is_same_file, OutputTarget};
-use tempfile::NamedTempFile;
+use anyhow::{anyhow, bail, Context};
+use hilsim_hil::decode::{
+    decode_stream, decoded_csv_rows, DecodeCounts, DecodeError, DECODED_CSV_HEADER,
+};
+use hilsim_recording::{is_same_file, AtomicFile};
 
 /// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
 /// (one JSON object with `json`, else a short human summary).
@@ -44,113 +46,44 @@ pub fn run(
     stdout: &mut dyn Write,
 ) -> anyhow::Result<()> {
     let mut source = open_input(input)?;
-    let read_error =
-        |err: std::io::Error| anyhow::anyhow!("{}: cannot read: {err}", input.display());
+    let cannot_read = |err: std::io::Error| anyhow!("{}: cannot read: {err}", input.display());
     let counts = match csv {
-        None => decode_stream::<std::io::Error>(&mut source, None).map_err(read_error)?,
+        None => decode_stream::<Infallible>(&mut source, None).map_err(|err| match err {
+            DecodeError::Read(err) => cannot_read(err),
+            DecodeError::Sink(never) => match never {},
+        })?,
         Some(path) => {
-            let cannot_write = || format!("{}: cannot write", path.display());
-            let mut out = CsvOut::create(path, input)?;
+            let mut out = create_csv(path, input)?;
             let mut rows = String::new();
             let mut write = |revolution: &_| -> std::io::Result<()> {
                 rows.clear();
                 decoded_csv_rows(revolution, &mut rows);
                 out.write_all(rows.as_bytes())
             };
-            // A read error names the input, a write error the CSV.
-            let mut write_failed = false;
-            let mut sink = |revolution: &_| write(revolution).inspect_err(|_| write_failed = true);
-            let counts = decode_stream::<std::io::Error>(&mut source, Some(&mut sink));
-            let counts = match counts {
-                Err(err) if write_failed => return Err(err).with_context(cannot_write),
-                other => other.map_err(read_error)?,
-            };
-            out.finish().with_context(cannot_write)?;
+            let counts = decode_stream(&mut source, Some(&mut write)).map_err(|err| match err {
+                DecodeError::Read(err) => cannot_read(err),
+                DecodeError::Sink(err) => anyhow!("{}: cannot write: {err}", path.display()),
+            })?;
+            out.commit()?;
             counts
         }
     };
     report(input, &counts, json, stdout).context("stdout: cannot write")
 }
 
-/// The CSV being written, its header first.
-enum CsvOut {
-    /// A hidden temporary sibling of the target (so the final rename is atomic), removed if
-    /// anything fails before it is persisted.
-    Replace {
-        file: BufWriter<NamedTempFile>,
-        to: PathBuf,
-    },
-    /// A device or FIFO (`/dev/null`, a pipe), written through.
-    Through(BufWriter<File>),
-}
-
-impl CsvOut {
-    /// Opens the CSV at `path` (see [`OutputTarget`]); refuses to write over `input`.
-    fn create(path: &Path, input: &Path) -> anyhow::Result<Self> {
-        if is_same_file(path, input) {
-            bail!(
-                "{}: is the input; refusing to write the CSV over it",
-                path.display()
-            );
-        }
-        let mut out = match OutputTarget::of(path)? {
-            OutputTarget::WriteThrough(device) => Self::Through(BufWriter::new(
-                OpenOptions::new()
-                    .write(true)
-                    .open(&device)
-                    .with_context(|| format!("{}: cannot open", path.display()))?,
-            )),
-            OutputTarget::Replace(to) => {
-                let Some(name) = to.file_name() else {
-                    bail!("{}: not a file name for the CSV output", path.display());
-                };
-                let dir = match to.parent() {
-                    Some(dir) if !dir.as_os_str().is_empty() => dir,
-                    _ => Path::new("."),
-                };
-                let file = tempfile::Builder::new()
-                    .prefix(&format!(".{}.", name.to_string_lossy()))
-                    .suffix(".tmp")
-                    .tempfile_in(dir)
-                    .with_context(|| format!("{}: cannot create", path.display()))?;
-                Self::Replace {
-                    file: BufWriter::new(file),
-                    to,
-                }
-            }
-        };
-        writeln!(out, "{DECODED_CSV_HEADER}")
-            .with_context(|| format!("{}: cannot write", path.display()))?;
-        Ok(out)
+/// The CSV at `path`, its header written: replaced atomically when complete, or written through
+/// a device (see [`AtomicFile`]); never over the `input`.
+fn create_csv(path: &Path, input: &Path) -> anyhow::Result<AtomicFile> {
+    if is_same_file(path, input) {
+        bail!(
+            "{}: is the input; refusing to write the CSV over it",
+            path.display()
+        );
     }
-
-    /// Flushes, and puts a replaced file in place.
-    fn finish(self) -> std::io::Result<()> {
-        match self {
-            Self::Through(mut file) => file.flush(),
-            Self::Replace { file, to } => {
-                let file = file.into_inner().map_err(|err| err.into_error())?;
-                file.as_file().sync_all()?;
-                file.persist(to).map(|_| ()).map_err(|err| err.error)
-            }
-        }
-    }
-}
-
-impl Write for CsvOut {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        match self {
-            Self::Replace { file, .. } => file.write(buf),
-            Self::Through(file) => file.write(buf),
-        }
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        match self {
-            Self::Replace { file, .. } => file.flush(),
-            Self::Through(file) => file.flush(),
-        }
-    }
+    let mut out = AtomicFile::create(path)?;
+    writeln!(out, "{DECODED_CSV_HEADER}")
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    Ok(out)
 }
 
 fn open_input(input: &Path) -> anyhow::Result<File> {
@@ -245,7 +178,7 @@ mod tests {
         let leftovers: Vec<_> = std::fs::read_dir(dir.path())
             .expect("list dir")
             .filter_map(|entry| entry.ok())
-            .filter(|entry| entry.file_name().to_string_lossy().ends_with(".tmp"))
+            .filter(|entry| entry.file_name().to_string_lossy().contains(".tmp."))
             .collect();
         assert!(leftovers.is_empty(), "temporary file left behind");
         let csv_text = csv.then(|| std::fs::read_to_string(&csv_path).expect("csv written"));

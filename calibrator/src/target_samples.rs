@@ -313,21 +313,13 @@ fn beam_readings(
 }
 
 fn check_finite_commands(rec: &Recording) -> Result<(), CalibrationError> {
-    for (i, c) in rec.commands.iter().enumerate() {
-        if !(c.t_s.is_finite() && c.left_mps.is_finite() && c.right_mps.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "commands.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && c.t_s < rec.commands[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "commands.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
-    Ok(())
+    align::check_rows(
+        "commands.csv",
+        rec.commands.iter().map(|c| {
+            let finite = c.t_s.is_finite() && c.left_mps.is_finite() && c.right_mps.is_finite();
+            (c.t_s, finite)
+        }),
+    )
 }
 
 /// MSE and the EM paper's NMSE (Sec. VI: `NMSE = (1/N) Σ (d̂_k − d_k)² / d_k²`) of raw readings

@@ -37,20 +37,15 @@ pub(super) fn interpolate_odometry(
     times: &[f64],
     beam_cos: f64,
 ) -> Result<Vec<Option<f64>>, CalibrationError> {
-    for (i, o) in odo.iter().enumerate() {
-        if !(o.t_s.is_finite() && o.left_m.is_finite() && o.right_m.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "odometry.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && o.t_s < odo[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "odometry.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
+    check_rows(
+        "odometry.csv",
+        odo.iter().map(|o| {
+            (
+                o.t_s,
+                o.t_s.is_finite() && o.left_m.is_finite() && o.right_m.is_finite(),
+            )
+        }),
+    )?;
     let travel = |o: &OdometrySample| -beam_cos * (o.left_m + o.right_m) / 2.0;
     let mut j = 0usize;
     Ok(times
@@ -81,20 +76,12 @@ pub(super) fn nearest_sonar(
     sonar: &[SonarSample],
     times: &[f64],
 ) -> Result<Vec<Option<f64>>, CalibrationError> {
-    for (i, s) in sonar.iter().enumerate() {
-        if !(s.t_s.is_finite() && s.range_m.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "sonar.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && s.t_s < sonar[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "sonar.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
+    check_rows(
+        "sonar.csv",
+        sonar
+            .iter()
+            .map(|s| (s.t_s, s.t_s.is_finite() && s.range_m.is_finite())),
+    )?;
     if sonar.is_empty() {
         return Ok(vec![None; times.len()]);
     }
@@ -126,20 +113,18 @@ pub(super) fn truth_distances(
     mount_xy: [f64; 2],
     phi: f64,
 ) -> Result<Vec<f64>, CalibrationError> {
-    for (i, s) in truth.iter().enumerate() {
-        if !(s.t_s.is_finite() && s.x_m.is_finite() && s.y_m.is_finite() && s.yaw_rad.is_finite()) {
-            return Err(CalibrationError::Invalid(format!(
-                "truth.csv: non-finite value in row {}",
-                i + 1
-            )));
-        }
-        if i > 0 && s.t_s < truth[i - 1].t_s {
-            return Err(CalibrationError::Invalid(format!(
-                "truth.csv: time goes backwards in row {}",
-                i + 1
-            )));
-        }
-    }
+    check_rows(
+        "truth.csv",
+        truth.iter().map(|s| {
+            (
+                s.t_s,
+                s.t_s.is_finite()
+                    && s.x_m.is_finite()
+                    && s.y_m.is_finite()
+                    && s.yaw_rad.is_finite(),
+            )
+        }),
+    )?;
     let lidar_at = |s: &TruthSample| {
         let (sin, cos) = s.yaw_rad.sin_cos();
         [
@@ -169,4 +154,29 @@ pub(super) fn truth_distances(
             start_distance - ((p[0] - p0[0]) * e0[0] + (p[1] - p0[1]) * e0[1])
         })
         .collect())
+}
+
+/// Every row finite and time never going backwards; else the error naming `file` and the row
+/// (from 1). `rows`: each row's time and whether all its values are finite.
+pub(super) fn check_rows(
+    file: &str,
+    rows: impl Iterator<Item = (f64, bool)>,
+) -> Result<(), CalibrationError> {
+    let mut previous = f64::NEG_INFINITY;
+    for (i, (t_s, finite)) in rows.enumerate() {
+        if !finite {
+            return Err(CalibrationError::Invalid(format!(
+                "{file}: non-finite value in row {}",
+                i + 1
+            )));
+        }
+        if t_s < previous {
+            return Err(CalibrationError::Invalid(format!(
+                "{file}: time goes backwards in row {}",
+                i + 1
+            )));
+        }
+        previous = t_s;
+    }
+    Ok(())
 }

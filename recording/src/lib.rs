@@ -19,6 +19,7 @@
 
 mod atomic;
 mod csv;
+mod decimal;
 mod error;
 mod input;
 mod meta;

@@ -82,8 +82,7 @@ impl Recording {
 /// One row of each table, as the whole-table writer above and the streaming writer
 /// (`stream.rs`) both write it: floats in Rust's shortest round-trip form.
 pub(crate) mod rows {
-    use std::fmt::Write as _;
-
+    use crate::decimal::{push_f64, push_int};
     use crate::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
 
     pub(crate) const COMMANDS_HEADER: &str = "t_s,left_mps,right_mps\n";
@@ -106,45 +105,56 @@ pub(crate) mod rows {
         }
     }
 
-    // Writing to a String cannot fail.
+    /// Fields joined by commas, each written as `Display` writes it.
+    fn fields(s: &mut String, numbers: &[f64]) {
+        for (i, &x) in numbers.iter().enumerate() {
+            if i > 0 {
+                s.push(',');
+            }
+            push_f64(s, x);
+        }
+    }
+
     pub(crate) fn command(s: &mut String, c: &CommandSample) {
-        let _ = writeln!(s, "{},{},{}", c.t_s, c.left_mps, c.right_mps);
+        fields(s, &[c.t_s, c.left_mps, c.right_mps]);
+        s.push('\n');
     }
 
     pub(crate) fn odometry(s: &mut String, o: &OdometrySample) {
-        let _ = writeln!(s, "{},{},{}", o.t_s, o.left_m, o.right_m);
+        fields(s, &[o.t_s, o.left_m, o.right_m]);
+        s.push('\n');
     }
 
     pub(crate) fn truth(s: &mut String, p: &TruthSample) {
-        let _ = writeln!(s, "{},{},{},{}", p.t_s, p.x_m, p.y_m, p.yaw_rad);
+        fields(s, &[p.t_s, p.x_m, p.y_m, p.yaw_rad]);
+        s.push('\n');
     }
 
     pub(crate) fn lidar(s: &mut String, r: &LidarSample, with_truth: bool) {
-        let _ = write!(
-            s,
-            "{},{},{},{},{},{},{}",
-            r.t_s,
-            r.rev,
-            r.angle_deg,
-            r.range_m,
-            r.strength,
-            u8::from(r.invalid),
-            u8::from(r.warning)
-        );
+        push_f64(s, r.t_s);
+        s.push(',');
+        push_int(s, r.rev);
+        s.push(',');
+        push_int(s, r.angle_deg);
+        s.push(',');
+        push_f64(s, r.range_m);
+        s.push(',');
+        push_int(s, r.strength);
+        s.push_str(if r.invalid { ",1" } else { ",0" });
+        s.push_str(if r.warning { ",1" } else { ",0" });
         true_range(s, r.true_range_m.filter(|_| with_truth));
     }
 
     pub(crate) fn sonar(s: &mut String, r: &SonarSample, with_truth: bool) {
-        let _ = write!(s, "{},{}", r.t_s, r.range_m);
+        fields(s, &[r.t_s, r.range_m]);
         true_range(s, r.true_range_m.filter(|_| with_truth));
     }
 
     fn true_range(s: &mut String, t: Option<f64>) {
-        match t {
-            Some(t) => {
-                let _ = writeln!(s, ",{t}");
-            }
-            None => s.push('\n'),
+        if let Some(t) = t {
+            s.push(',');
+            push_f64(s, t);
         }
+        s.push('\n');
     }
 }

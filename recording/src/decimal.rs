@@ -16,7 +16,7 @@ const FAST_BELOW: f64 = 2_147_483_648.0; // 2^31
 /// came from `f32` (rapier's positions) has a short exact decimal expansion. Such a tie is found
 /// exactly from the bits and left to `Display`.
 pub(crate) fn push_f64(out: &mut String, x: f64) {
-    if !(x.abs() < FAST_BELOW) {
+    if !x.is_finite() || x.abs() >= FAST_BELOW {
         out.push_str(&x.to_string());
         return;
     }

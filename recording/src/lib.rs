@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 mod atomic;
+mod background;
 mod csv;
 mod decimal;
 mod error;
@@ -34,6 +35,7 @@ pub use atomic::{
     check_replaceable_recording, is_same_file, replace_dir_atomically, replace_recording_dir,
     tidy_after_killed_writers, write_file_atomically, AtomicFile, OutputTarget,
 };
+pub use background::BackgroundStream;
 pub use error::{Error, ErrorKind};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};

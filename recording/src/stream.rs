@@ -223,6 +223,12 @@ impl RecordingStream {
         Ok(stream)
     }
 
+    /// Where the recording is put when finished.
+    #[must_use]
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
     /// Completes every file, writes `meta.toml` and puts the recording in place of `dir`.
     ///
     /// # Errors

@@ -39,6 +39,16 @@ pub struct World {
     robot_collider: ColliderHandle,
     /// Per obstacle collider (indexed by `user_data`): what it is and its reflectivity.
     obstacles: Vec<(Obstacle, f64)>,
+    /// The obstacles as rays see them (see [`World::cast_ray`]).
+    fixed: Vec<FixedShape>,
+}
+
+/// An obstacle's collider with a circle around it, to skip it cheaply for a ray that passes
+/// wide of it.
+struct FixedShape {
+    collider: ColliderHandle,
+    center: Vector,
+    radius: f32,
 }
 
 impl World {
@@ -107,13 +117,28 @@ impl World {
                 .friction(0.0)
                 .active_events(ActiveEvents::COLLISION_EVENTS),
         );
-        // Fill the broad phase now so that rays can be cast before the first step.
+        // Fill the broad phase now so that contacts are known before the first step.
         physics.detect_collisions(&(), &());
+        let fixed = physics
+            .colliders
+            .iter()
+            .filter(|(handle, _)| *handle != robot_collider)
+            .map(|(collider, co)| {
+                let sphere = co.shape().compute_bounding_sphere(co.position());
+                FixedShape {
+                    collider,
+                    center: sphere.center,
+                    // f32 rounding in the test below must never skip a grazing hit.
+                    radius: sphere.radius * (1.0 + 1e-4) + 1e-4,
+                }
+            })
+            .collect();
         Self {
             physics,
             robot,
             robot_collider,
             obstacles,
+            fixed,
         }
     }
 
@@ -132,14 +157,42 @@ impl World {
     /// Casts a ray from `origin` along `heading_rad` (world frame) up to `max_m`, ignoring the
     /// robot's own body. Static obstacles do not move, so the answer does not depend on when
     /// within a physics step it is asked.
+    ///
+    /// The ray is cast against each obstacle's own shape, as rapier's query pipeline does after
+    /// its broad phase, with the same `f32` arithmetic and so the same hits; a world holds
+    /// tens of obstacles, and a circle test that skips most of them is twice as fast as the
+    /// broad phase's tree (which also holds the moving robot). Of two obstacles hit at exactly
+    /// the same distance (a corner), the one added first is reported.
     #[must_use]
     pub fn cast_ray(&self, origin: [f64; 2], heading_rad: f64, max_m: f64) -> Option<RayHit> {
         let (sin, cos) = heading_rad.sin_cos();
         let ray = Ray::new(vec2(origin), Vector::new(cos as f32, sin as f32));
-        let filter = QueryFilter::default().exclude_rigid_body(self.robot);
-        let (handle, hit) =
-            self.physics
-                .cast_ray_and_get_normal(&ray, max_m as f32, true, filter)?;
+        let mut nearest = max_m as f32;
+        let mut best = None;
+        for shape in &self.fixed {
+            let to_center = shape.center - ray.origin;
+            let along = to_center.dot(ray.dir);
+            let beside_sq = to_center.length_squared() - along * along;
+            if along + shape.radius < 0.0
+                || along - shape.radius >= nearest
+                || beside_sq > shape.radius * shape.radius
+            {
+                continue;
+            }
+            let Some(co) = self.physics.colliders.get(shape.collider) else {
+                continue;
+            };
+            if let Some(hit) = co
+                .shape()
+                .cast_ray_and_get_normal(co.position(), &ray, nearest, true)
+            {
+                if hit.time_of_impact < nearest {
+                    nearest = hit.time_of_impact;
+                    best = Some((shape.collider, hit));
+                }
+            }
+        }
+        let (handle, hit) = best?;
         let (obstacle, reflectivity) = self.obstacle_of(handle)?;
         Some(RayHit {
             distance: f64::from(hit.time_of_impact),

@@ -1,9 +1,9 @@
 //! `hilsim record SCENARIO --out DIR [--seed N]`: the samples go to disk as they are taken, so a
-//! run of any length records in flat memory.
+//! run of any length records in flat memory, written by a thread of its own.
 
 use anyhow::{Context, Result};
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::RecordingStream;
+use hilsim_recording::{BackgroundStream, RecordingStream};
 
 use crate::cli::RecordArgs;
 
@@ -12,9 +12,10 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
     hilsim_recording::tidy_after_killed_writers(&args.out)?;
-    let mut stream =
-        RecordingStream::create(&args.out, emulation.meta().clone(), emulation.tables())?;
-    emulation.record_into(&mut stream)?;
-    stream.finish()?;
+    let stream = RecordingStream::create(&args.out, emulation.meta().clone(), emulation.tables())?;
+    // The CSV text is made and written on the other core while the simulation runs.
+    let mut sink = BackgroundStream::spawn(stream)?;
+    emulation.record_into(&mut sink)?;
+    sink.finish()?;
     Ok(())
 }

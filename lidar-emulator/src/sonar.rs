@@ -81,13 +81,18 @@ impl Sonar {
     #[must_use]
     pub fn nearest_echo(&self, world: &World, robot: &hilsim_sim::Pose) -> Option<f64> {
         let sensor = self.mount.in_world(robot);
-        self.ray_offsets
-            .iter()
-            .filter_map(|off| {
-                world.cast_ray([sensor.x, sensor.y], sensor.yaw + off, self.max_range_m)
-            })
-            .map(|hit| hit.distance)
-            .min_by(f64::total_cmp)
+        // Each ray only looks for an echo nearer than the nearest so far: the same minimum,
+        // with most obstacles skipped.
+        let mut nearest: Option<f64> = None;
+        for off in &self.ray_offsets {
+            let max_m = nearest.unwrap_or(self.max_range_m);
+            if let Some(hit) = world.cast_ray([sensor.x, sensor.y], sensor.yaw + off, max_m) {
+                if nearest.is_none_or(|n| hit.distance < n) {
+                    nearest = Some(hit.distance);
+                }
+            }
+        }
+        nearest
     }
 
     /// The expected reading (noise-free, before millimetre rounding) for a nearest echo at

@@ -49,6 +49,37 @@ struct FixedShape {
     collider: ColliderHandle,
     center: Vector,
     radius: f32,
+    /// A wall's two ends, world frame: a ray whose line passes both on one side misses it.
+    ends: Option<[Vector; 2]>,
+}
+
+impl FixedShape {
+    /// Whether a ray from `origin` along `dir` (unit) cannot hit the shape before `nearest`.
+    /// Every test leaves a margin for `f32` rounding: a "maybe" only costs the exact cast.
+    fn is_missed(&self, origin: Vector, dir: Vector, nearest: f32) -> bool {
+        let to_center = self.center - origin;
+        let along = to_center.dot(dir);
+        let beside_sq = to_center.length_squared() - along * along;
+        if along + self.radius < 0.0
+            || along - self.radius >= nearest
+            || beside_sq > self.radius * self.radius
+        {
+            return true;
+        }
+        let Some([a, b]) = self.ends else {
+            return false;
+        };
+        let (to_a, to_b) = (a - origin, b - origin);
+        let margin = 1e-4 * (to_a.length() + to_b.length()) + 1e-6;
+        // Both ends on one side of the ray's line; both behind it; both beyond `nearest` (a
+        // point of the segment is as far along the ray as a mix of its ends).
+        let (side_a, side_b) = (dir.perp_dot(to_a), dir.perp_dot(to_b));
+        let (along_a, along_b) = (dir.dot(to_a), dir.dot(to_b));
+        (side_a > margin && side_b > margin)
+            || (side_a < -margin && side_b < -margin)
+            || along_a.max(along_b) < -margin
+            || along_a.min(along_b) > nearest + margin
+    }
 }
 
 impl World {
@@ -125,11 +156,15 @@ impl World {
             .filter(|(handle, _)| *handle != robot_collider)
             .map(|(collider, co)| {
                 let sphere = co.shape().compute_bounding_sphere(co.position());
+                let ends = co.shape().as_segment().map(|segment| {
+                    [segment.a, segment.b].map(|end| co.position().transform_point(end))
+                });
                 FixedShape {
                     collider,
                     center: sphere.center,
-                    // f32 rounding in the test below must never skip a grazing hit.
+                    // f32 rounding in the tests must never skip a grazing hit.
                     radius: sphere.radius * (1.0 + 1e-4) + 1e-4,
+                    ends,
                 }
             })
             .collect();
@@ -160,7 +195,7 @@ impl World {
     ///
     /// The ray is cast against each obstacle's own shape, as rapier's query pipeline does after
     /// its broad phase, with the same `f32` arithmetic and so the same hits; a world holds
-    /// tens of obstacles, and a circle test that skips most of them is twice as fast as the
+    /// tens of obstacles, and cheap tests that skip most of them are twice as fast as the
     /// broad phase's tree (which also holds the moving robot). Of two obstacles hit at exactly
     /// the same distance (a corner), the one added first is reported.
     #[must_use]
@@ -170,13 +205,7 @@ impl World {
         let mut nearest = max_m as f32;
         let mut best = None;
         for shape in &self.fixed {
-            let to_center = shape.center - ray.origin;
-            let along = to_center.dot(ray.dir);
-            let beside_sq = to_center.length_squared() - along * along;
-            if along + shape.radius < 0.0
-                || along - shape.radius >= nearest
-                || beside_sq > shape.radius * shape.radius
-            {
+            if shape.is_missed(ray.origin, ray.dir, nearest) {
                 continue;
             }
             let Some(co) = self.physics.colliders.get(shape.collider) else {

@@ -17,6 +17,8 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use nix::sys::signal::{killpg, Signal};
+
+use crate::escaped::{kill_all, new_lineage, EscapedProcess, LINEAGE_VARIABLE};
 use nix::unistd::Pid;
 
 /// How many of the firmware's last stderr lines are kept.
@@ -137,12 +139,15 @@ pub enum Ended {
 }
 
 /// The firmware's exit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FirmwareExit {
     /// Its exit status.
     pub status: ExitStatus,
     /// How it came to exit.
     pub ended: Ended,
+    /// Processes it started that left its group and were still running once the group was
+    /// gone; they were killed.
+    pub escaped: Vec<EscapedProcess>,
 }
 
 /// An exit status in words: `exit status 3`, `signal 11 (SIGSEGV)`.
@@ -185,6 +190,8 @@ struct Tail {
 pub struct Firmware {
     child: Child,
     pgid: Pid,
+    /// The value of [`LINEAGE_VARIABLE`] in its environment and its descendants'.
+    lineage: String,
     status: Option<ExitStatus>,
     tail: Arc<Tail>,
 }
@@ -192,7 +199,7 @@ pub struct Firmware {
 impl Firmware {
     /// Starts `argv` (the program, then its arguments) with `env` added to the environment,
     /// stdin from `/dev/null`, stdout inherited and stderr captured, as the leader of a new
-    /// process group.
+    /// process group, and [`LINEAGE_VARIABLE`] set so that what leaves the group is found.
     ///
     /// # Errors
     /// `argv` is empty, or the program cannot be started.
@@ -200,9 +207,11 @@ impl Firmware {
         let (program, args) = argv
             .split_first()
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, SplitError::Empty))?;
+        let lineage = new_lineage();
         let mut child = Command::new(program)
             .args(args)
             .envs(env.iter().copied())
+            .env(LINEAGE_VARIABLE, &lineage)
             .stdin(Stdio::null())
             .stderr(Stdio::piped())
             .process_group(0)
@@ -224,6 +233,7 @@ impl Firmware {
         Ok(Self {
             child,
             pgid,
+            lineage,
             status: None,
             tail,
         })
@@ -253,10 +263,11 @@ impl Firmware {
     /// # Errors
     /// The child cannot be waited for or signalled.
     pub fn shut_down(&mut self, grace: Duration) -> io::Result<FirmwareExit> {
-        let exit = if let Some(status) = self.wait_for(grace)? {
+        let mut exit = if let Some(status) = self.wait_for(grace)? {
             FirmwareExit {
                 status,
                 ended: Ended::ByItself,
+                escaped: Vec::new(),
             }
         } else {
             signal_group(self.pgid, Signal::SIGTERM)?;
@@ -264,6 +275,7 @@ impl Firmware {
                 FirmwareExit {
                     status,
                     ended: Ended::Terminated,
+                    escaped: Vec::new(),
                 }
             } else {
                 signal_group(self.pgid, Signal::SIGKILL)?;
@@ -272,11 +284,13 @@ impl Firmware {
                 FirmwareExit {
                     status,
                     ended: Ended::Killed,
+                    escaped: Vec::new(),
                 }
             }
         };
-        // Whatever the leader left running in its group goes too.
+        // Whatever the leader left running in its group goes too, and what left the group.
         signal_group(self.pgid, Signal::SIGKILL)?;
+        exit.escaped = kill_all(&self.lineage);
         self.wait_for_stderr(Duration::from_millis(500));
         Ok(exit)
     }
@@ -327,6 +341,7 @@ impl Drop for Firmware {
     fn drop(&mut self) {
         // Every path out of the harness comes through here: nothing of the firmware survives.
         let _ = killpg(self.pgid, Signal::SIGKILL);
+        let _ = kill_all(&self.lineage);
         if self.status.is_none() {
             let _ = self.child.wait();
         }
@@ -469,6 +484,28 @@ mod tests {
         let grandchild: i32 = fw.stderr_tail().lines[0].parse().unwrap();
         drop(fw);
         assert!(gone(pid) && gone(grandchild), "{pid} {grandchild}");
+    }
+
+    /// Issue 18: a daemon that left the firmware's group (`setsid`) is reported and killed.
+    #[test]
+    fn issue_18_a_process_that_left_the_group_is_reported_and_killed() {
+        let mut fw = sh("setsid sleep 30 </dev/null >/dev/null 2>&1 & echo $! >&2; exit 0");
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while fw.stderr_tail().lines.is_empty() {
+            assert!(Instant::now() < deadline);
+            thread::sleep(POLL);
+        }
+        let escaped: u32 = fw.stderr_tail().lines[0].parse().unwrap();
+        let exit = fw.shut_down(Duration::from_secs(5)).unwrap();
+        assert_eq!(exit.ended, Ended::ByItself);
+        assert_eq!(
+            exit.escaped,
+            [EscapedProcess {
+                pid: escaped,
+                command: "sleep".into()
+            }]
+        );
+        assert!(gone(escaped as i32), "{escaped}");
     }
 
     #[test]

@@ -12,17 +12,22 @@ pub fn has_exited(pid: u32, within: Duration) -> bool {
     loop {
         match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
             Err(_) => return true,
-            // The state follows the command name, which is in parentheses and may hold any byte.
-            Ok(stat)
-                if stat
-                    .rsplit(')')
-                    .next()
-                    .is_some_and(|s| s.trim_start().starts_with('Z')) =>
-            {
-                return true
-            }
+            Ok(stat) if stat_is_zombie(&stat) => return true,
             Ok(_) if Instant::now() > deadline => return false,
             Ok(_) => thread::sleep(Duration::from_millis(10)),
         }
     }
+}
+
+/// Whether process `pid` is a zombie (ended, not yet reaped); `false` when it is gone.
+#[must_use]
+pub fn is_zombie(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| stat_is_zombie(&stat))
+}
+
+/// The state follows the command name, which is in parentheses and may hold any byte.
+fn stat_is_zombie(stat: &str) -> bool {
+    stat.rsplit(')')
+        .next()
+        .is_some_and(|s| s.trim_start().starts_with('Z'))
 }

@@ -211,9 +211,9 @@ impl World {
             let Some(co) = self.physics.colliders.get(shape.collider) else {
                 continue;
             };
-            if let Some(hit) = co
-                .shape()
-                .cast_ray_and_get_normal(co.position(), &ray, nearest, true)
+            if let Some(hit) =
+                co.shape()
+                    .cast_ray_and_get_normal(co.position(), &ray, nearest, true)
             {
                 if hit.time_of_impact < nearest {
                     nearest = hit.time_of_impact;

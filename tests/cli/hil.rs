@@ -394,3 +394,38 @@ fn issue_18_the_firmware_starts_with_default_signal_dispositions() {
         assert_eq!(mask & (1 << (number - 1)), 0, "{name} ignored: {line}");
     }
 }
+
+/// Issue 18: a daemon the firmware starts in a session of its own (out of reach of the group's
+/// signals) is reported in the summary and does not outlive the run.
+#[test]
+fn issue_18_a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    let firmware = r#"sh -c 'cat "$HILSIM_LIDAR_PORT" >/dev/null & setsid sleep 60 </dev/null >/dev/null 2>&1 & echo $! > daemon.pid; sleep 30'"#;
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--duration",
+            "1",
+            "--firmware",
+            firmware,
+        ],
+    );
+    let text = stdout(&out);
+    let daemon: u32 = std::fs::read_to_string(tmp.path().join("daemon.pid"))
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    assert!(
+        text.contains(&format!(
+            "firmware: 1 process(es) it started had left its process group and were still \
+             running; killed: {daemon} (sleep)"
+        )),
+        "{text}{}",
+        stderr(&out)
+    );
+    assert!(gone(daemon));
+}

@@ -99,7 +99,7 @@ impl HilReport {
             self.max_step_lateness.as_secs_f64() * 1e3
         )?;
         let mut failed = self.fault().is_some();
-        if let Some(exit) = self.firmware {
+        if let Some(exit) = &self.firmware {
             let how = match exit.ended {
                 Ended::ByItself => "exited by itself",
                 Ended::Terminated => "left on SIGTERM once the run was over",
@@ -107,6 +107,16 @@ impl HilReport {
             };
             writeln!(out, "firmware: {how}: {}", describe_status(exit.status))?;
             failed |= exit.ended == Ended::ByItself && !exit.status.success();
+            if !exit.escaped.is_empty() {
+                let list: Vec<String> = exit.escaped.iter().map(ToString::to_string).collect();
+                writeln!(
+                    out,
+                    "firmware: {} process(es) it started had left its process group and were \
+                     still running; killed: {}",
+                    exit.escaped.len(),
+                    list.join(", ")
+                )?;
+            }
         }
         let tail = &self.stderr;
         if failed && !tail.lines.is_empty() {

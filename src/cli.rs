@@ -128,6 +128,18 @@ pub struct CalibrateArgs {
     /// Lidar-to-target distance at t = 0 (default: `target_start_distance_m` of meta.toml).
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub start_distance: Option<f64>,
+    /// Landmarks: the robot is at rest this long after its wheel commands go to zero (default:
+    /// found from the odometry, else from the scans, else 0.3 s).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub settle_s: Option<f64>,
+    /// Landmarks: a stop is used when it holds at least this many lidar revolutions at rest.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 2.0,
+        allow_negative_numbers = true
+    )]
+    pub min_revolutions: f64,
 }
 
 /// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.

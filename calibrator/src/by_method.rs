@@ -6,6 +6,15 @@ use hilsim_recording::Recording;
 use crate::target_samples::SampleOptions;
 use crate::{em, groundtruth, landmarks, Calibration, CalibrationError, Method};
 
+/// What a user sets of the methods (the rest is each method's default).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Settings {
+    /// The beam facing the target and its start distance (EM, ground truth).
+    pub target: SampleOptions,
+    /// Finding the stand-still stops (landmarks).
+    pub stops: landmarks::StopOptions,
+}
+
 /// Calibrates `rec` with `method`, each method with its default options but the target (the beam
 /// facing it and its start distance, for the methods that follow one: EM, ground truth).
 ///
@@ -16,6 +25,26 @@ pub fn calibrate(
     method: Method,
     target: SampleOptions,
 ) -> Result<Calibration, CalibrationError> {
+    calibrate_with(
+        rec,
+        method,
+        &Settings {
+            target,
+            ..Settings::default()
+        },
+    )
+}
+
+/// Calibrates `rec` with `method` and the user's `settings`.
+///
+/// # Errors
+/// The method's [`CalibrationError`].
+pub fn calibrate_with(
+    rec: &Recording,
+    method: Method,
+    settings: &Settings,
+) -> Result<Calibration, CalibrationError> {
+    let target = settings.target;
     match method {
         Method::Em => em::calibrate(rec, &em_options(target)),
         Method::Groundtruth => groundtruth::calibrate(
@@ -26,7 +55,13 @@ pub fn calibrate(
                 ..groundtruth::Options::default()
             },
         ),
-        Method::Landmarks => landmarks::calibrate(rec, &landmarks::Options::default()),
+        Method::Landmarks => landmarks::calibrate(
+            rec,
+            &landmarks::Options {
+                stops: settings.stops,
+                ..landmarks::Options::default()
+            },
+        ),
     }
 }
 

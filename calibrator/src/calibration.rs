@@ -66,9 +66,10 @@ pub struct Calibration {
     /// recording (x forward, y left) (landmarks).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub landmarks: Option<Vec<[f64; 2]>>,
-    /// Further method-specific facts for people (e.g. AIC and cross-validation choices); not
-    /// part of the JSON interface.
-    #[serde(skip)]
+    /// Further method-specific facts for people: what was skipped and why (stops too short, a
+    /// landmark track dropped), choices made (AIC and cross-validation). In the JSON as `notes`
+    /// when there are any; their wording is not an interface.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
 }
 

@@ -19,7 +19,7 @@ pub mod smoothing;
 pub mod stats;
 pub mod target_samples;
 
-pub use by_method::{calibrate, em_options};
+pub use by_method::{calibrate, calibrate_with, em_options, Settings};
 pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};
 pub use error::CalibrationError;
 pub use target_samples::SampleOptions;

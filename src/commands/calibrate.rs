@@ -6,17 +6,32 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use hilsim_calibrator::landmarks::StopOptions;
 use hilsim_calibrator::smoothing;
-use hilsim_calibrator::{Calibration, SampleOptions};
+use hilsim_calibrator::{Calibration, SampleOptions, Settings};
 use hilsim_recording::{is_same_file, write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<()> {
     let target = target_options(args.beam, args.start_distance)?;
+    if args.settle_s.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+        bail!("--settle-s: expected a settling time in seconds, 0 or more");
+    }
+    if !(args.min_revolutions.is_finite() && args.min_revolutions >= 1.0) {
+        bail!("--min-revolutions: expected a number of revolutions, 1 or more");
+    }
+    let settings = Settings {
+        target,
+        stops: StopOptions {
+            settle_s: args.settle_s,
+            min_revolutions: args.min_revolutions,
+            ..StopOptions::default()
+        },
+    };
     let rec = Recording::read_dir(&args.recording)?;
     let method = args.method;
-    let calibration = hilsim_calibrator::calibrate(&rec, method, target)
+    let calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
         .with_context(|| format!("{}: {}", args.recording.display(), method.name()))?;
     if args.json {
         writeln!(out, "{}", calibration.to_json())?;

@@ -142,3 +142,79 @@ fn bad_recordings_exit_2_with_one_line_naming_the_file() {
     let err = run(&["smooth", "rec", "--calibration", "cal.json"]);
     assert!(err.contains("cal.json"), "{err}");
 }
+
+/// Issue 16: stops of 1 s (five revolutions) in a recording without odometry: rest is found
+/// from the scans and every stop is used; the JSON notes say so. Asking for more revolutions
+/// than a stop holds leaves too few stops: exit 2, saying how many were needed.
+#[test]
+fn issue_16_one_second_stops_without_odometry_calibrate() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = std::fs::read_to_string(repo_file("scenarios/landmarks-5.toml"))
+        .unwrap()
+        .replace("stop_s = 2.0", "stop_s = 1.0");
+    std::fs::write(tmp.path().join("short-stops.toml"), scenario).unwrap();
+    let o = hilsim(tmp.path(), &["record", "short-stops.toml", "--out", "rec"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    std::fs::remove_file(tmp.path().join("rec/odometry.csv")).unwrap();
+    let v = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "landmarks", "--json"],
+    ));
+    let notes: Vec<&str> = v["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let used = notes
+        .iter()
+        .find(|n| n.contains("stop(s) used"))
+        .unwrap_or_else(|| panic!("{notes:?}"));
+    assert!(used.starts_with("11 stop(s) used"), "{used}");
+    assert!(used.contains("the scans"), "{used}");
+    assert_eq!(v["landmarks"].as_array().unwrap().len(), 5);
+    // The calibrated model is far better than the raw readings (the declared bias is 5-20 cm).
+    let m = &v["metrics"];
+    let ratio = m["mse_raw"].as_f64().unwrap() / m["mse_calibrated"].as_f64().unwrap();
+    assert!(ratio > 10.0, "{m}");
+
+    let o = hilsim(
+        tmp.path(),
+        &[
+            "calibrate",
+            "rec",
+            "--method",
+            "landmarks",
+            "--min-revolutions",
+            "6",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
+    assert!(
+        stderr(&o).contains("holding at least 6 lidar revolutions"),
+        "{}",
+        stderr(&o)
+    );
+    for bad in [["--settle-s", "-1"], ["--min-revolutions", "0.5"]] {
+        let mut args = vec!["calibrate", "rec", "--method", "landmarks"];
+        args.extend(bad);
+        let o = hilsim(tmp.path(), &args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        assert!(stderr(&o).contains(bad[0]), "{}", stderr(&o));
+    }
+    // A settling time given is used as it is.
+    let v = json(&hilsim(
+        tmp.path(),
+        &[
+            "calibrate",
+            "rec",
+            "--method",
+            "landmarks",
+            "--settle-s",
+            "0.4",
+            "--json",
+        ],
+    ));
+    let notes = v["notes"].to_string();
+    assert!(notes.contains("the settling time given"), "{notes}");
+}

@@ -156,22 +156,39 @@ fn stand_still_stops(
 ) -> Result<Vec<Stop>, CalibrationError> {
     let (stops, report) = find_stops(rec, &opts.stops)?;
     for (t, v) in &report.moving {
+        notes.push(match v {
+            Some(v) => format!(
+                "warning: stop at t = {t:.2} s skipped: the odometry shows motion ({v:.3} m/s)"
+            ),
+            None => format!(
+                "warning: stop at t = {t:.2} s skipped: the odometry shows the wheels never \
+                 stopped"
+            ),
+        });
+    }
+    for (t, revolutions) in &report.too_short {
         notes.push(format!(
-            "warning: stop at t = {t:.2} s dropped: the odometry shows motion ({v:.3} m/s)"
+            "stop at t = {t:.2} s skipped: {revolutions:.1} revolution(s) at rest, {} needed",
+            opts.stops.min_revolutions
         ));
     }
-    if report.too_short > 0 {
+    let mut sources: Vec<&str> = stops.iter().map(|s| s.rest_from.describe()).collect();
+    sources.sort_unstable();
+    sources.dedup();
+    if !stops.is_empty() {
         notes.push(format!(
-            "{} stand-still interval(s) shorter than {} s after the {} s settling time skipped",
-            report.too_short, opts.stops.min_stop_s, opts.stops.settle_s
+            "{} stop(s) used, each from the moment of rest found by {}; lidar revolution {:.3} s",
+            stops.len(),
+            sources.join(" or "),
+            report.revolution_s
         ));
     }
     if stops.len() < 2 {
         return Err(CalibrationError::TooFewSamples(format!(
-            "landmarks: found {} stand-still stop(s) of at least {} s; the bearings of two \
-             stops at least are needed to place a landmark",
+            "landmarks: found {} stand-still stop(s) holding at least {} lidar revolutions at \
+             rest; the bearings of two stops at least are needed to place a landmark",
             stops.len(),
-            opts.stops.min_stop_s
+            opts.stops.min_revolutions
         )));
     }
     Ok(stops)

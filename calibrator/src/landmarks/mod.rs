@@ -35,6 +35,7 @@ pub mod monte_carlo;
 pub mod options;
 pub mod positions;
 pub mod regression;
+pub mod rest;
 pub mod scan;
 pub mod stops;
 

@@ -94,11 +94,13 @@ pub enum Nominal {
 /// Finding the stand-still stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StopOptions {
-    /// A stop shorter than this after settling is skipped: 0.8 s is four XV-11 revolutions
-    /// (5 Hz), enough to gate and average.
-    pub min_stop_s: f64,
-    /// Time after the command goes to zero before the robot is taken to stand still.
-    pub settle_s: f64,
+    /// A stop holding fewer of the lidar's revolutions at rest is skipped: two revolutions give
+    /// every beam two readings to average and gate (the median of two is their mean; a third
+    /// helps the gate but is not needed).
+    pub min_revolutions: f64,
+    /// Time after the command goes to zero before the robot is taken to stand still; `None`:
+    /// found from the odometry or the scans ([`super::rest`]).
+    pub settle_s: Option<f64>,
     /// The odometry confirms a stop when both wheels' fitted speeds stay below this (m/s).
     pub still_speed_mps: f64,
     /// Nominal positions from the commands (the paper) or the odometry.
@@ -108,8 +110,8 @@ pub struct StopOptions {
 impl Default for StopOptions {
     fn default() -> Self {
         Self {
-            min_stop_s: 0.8,
-            settle_s: 0.3,
+            min_revolutions: 2.0,
+            settle_s: None,
             still_speed_mps: 0.01,
             nominal: Nominal::Commands,
         }
@@ -224,8 +226,11 @@ impl Options {
             return bad("the refinement needs a positive tolerance and at least one iteration");
         }
         let s = &self.stops;
-        if !pos(s.min_stop_s) || !nonneg(s.settle_s) || !pos(s.still_speed_mps) {
-            return bad("stop durations and the stand-still speed must be positive");
+        if !(s.min_revolutions.is_finite() && s.min_revolutions >= 1.0) {
+            return bad("a stop needs at least one revolution (--min-revolutions >= 1)");
+        }
+        if s.settle_s.is_some_and(|v| !nonneg(v)) || !pos(s.still_speed_mps) {
+            return bad("the settling time must be >= 0 and the stand-still speed positive");
         }
         let d = &self.detection;
         let fraction = |v: f64| v > 0.0 && v <= 1.0;

@@ -4,12 +4,13 @@
 //!
 //! The paper takes its measurements "after the robot reached its new position (i.e., we are not
 //! considering measurements recorded during transients)" (Sec. 3.1): a stop is an interval of
-//! zero wheel commands, less a settling time at its start, confirmed by the odometry when the
-//! recording has one.
+//! zero wheel commands from the moment the robot came to rest ([`super::rest`]), used when it
+//! holds at least `min_revolutions` of the lidar's revolutions.
 
 use hilsim_recording::{CommandSample, OdometrySample, Recording};
 
 use super::options::{Nominal, StopOptions};
+use super::rest::{rest_start, revolution_period_s, wheel_speed, RestFrom};
 use crate::CalibrationError;
 use hilsim_recording::{wrap_angle, Pose};
 
@@ -25,15 +26,21 @@ pub struct Stop {
     /// Whether the robot was commanded to move before this stop: the stops before the first
     /// motion are at the start pose by definition, whatever the actuation error.
     pub moved_before: bool,
+    /// How the start of rest was found.
+    pub rest_from: RestFrom,
 }
 
 /// What the stop finder saw besides the stops, for the notes.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct StopReport {
-    /// Candidate stops dropped because the odometry showed motion, with their start times.
-    pub moving: Vec<(f64, f64)>,
-    /// Candidate stops dropped for being too short after settling.
-    pub too_short: usize,
+    /// Candidate stops dropped because the odometry showed motion: their start and the speed
+    /// (`None`: the wheels never stopped in the interval).
+    pub moving: Vec<(f64, Option<f64>)>,
+    /// Candidate stops dropped for holding too few revolutions at rest: the interval's start and
+    /// the revolutions it held.
+    pub too_short: Vec<(f64, f64)>,
+    /// The lidar's revolution period the stops were measured in, seconds.
+    pub revolution_s: f64,
 }
 
 /// The stops of a recording, in time order.
@@ -69,19 +76,38 @@ pub fn find_stops(
         ));
     }
     let use_commands = opts.nominal == Nominal::Commands && !rec.commands.is_empty();
+    let lidar = rec.lidar.as_deref().filter(|l| !l.is_empty());
+    report.revolution_s = lidar.map_or(revolution_period_s(&[]), revolution_period_s);
     // The robot stands at the start pose until the first interval that follows a motion.
     let t_ref = intervals.iter().find(|iv| !iv.2).map_or(0.0, |iv| iv.1);
     let mut stops = Vec::new();
     for (t0, t1, moved_before) in intervals {
-        let (a, b) = (t0 + opts.settle_s, t1);
-        if b - a < opts.min_stop_s {
-            report.too_short += 1;
+        // Intervals found in the odometry are at rest from their start.
+        let rest = if rec.commands.is_empty() {
+            Some((t0, RestFrom::Odometry))
+        } else {
+            rest_start(
+                (t0, t1),
+                opts.settle_s,
+                opts.still_speed_mps,
+                odometry,
+                lidar,
+            )
+        };
+        let Some((a, rest_from)) = rest else {
+            report.moving.push((t0, None));
+            continue;
+        };
+        let b = t1;
+        let revolutions = (b - a) / report.revolution_s;
+        // A whole revolution's readings span 359/360 of its period: 1 % slack.
+        if revolutions < opts.min_revolutions * 0.99 {
+            report.too_short.push((t0, revolutions.max(0.0)));
             continue;
         }
         if let Some(odo) = odometry {
-            let speed = odometry_speed(odo, a, b);
-            if speed > opts.still_speed_mps {
-                report.moving.push((a, speed));
+            if let Some(speed) = wheel_speed(odo, (a, b)).filter(|v| *v > opts.still_speed_mps) {
+                report.moving.push((a, Some(speed)));
                 continue;
             }
         }
@@ -96,6 +122,7 @@ pub fn find_stops(
             t_end_s: b,
             pose,
             moved_before,
+            rest_from,
         });
     }
     Ok((stops, report))
@@ -142,7 +169,8 @@ fn still_intervals_from_odometry(
     let mut moved = false;
     let mut last_t = 0.0;
     for s in odo {
-        let still = odometry_speed(odo, s.t_s - half, s.t_s + half) <= opts.still_speed_mps;
+        let still = wheel_speed(odo, (s.t_s - half, s.t_s + half))
+            .is_none_or(|v| v <= opts.still_speed_mps);
         match (still, open) {
             (true, None) => open = Some(s.t_s),
             (false, Some(t0)) => {
@@ -159,30 +187,6 @@ fn still_intervals_from_odometry(
         out.push((t0, last_t, moved));
     }
     out
-}
-
-/// The larger of the two wheels' speeds over `[a, b]`, fitted by least squares (the encoders'
-/// noise is per reading, so a slope is far steadier than a difference of two readings).
-fn odometry_speed(odo: &[OdometrySample], a: f64, b: f64) -> f64 {
-    let window: Vec<&OdometrySample> = odo.iter().filter(|s| s.t_s >= a && s.t_s <= b).collect();
-    if window.len() < 3 {
-        return 0.0;
-    }
-    let n = window.len() as f64;
-    let tm = window.iter().map(|s| s.t_s).sum::<f64>() / n;
-    let stt: f64 = window.iter().map(|s| (s.t_s - tm).powi(2)).sum();
-    if stt <= 0.0 {
-        return 0.0;
-    }
-    let slope = |f: fn(&OdometrySample) -> f64| {
-        let ym = window.iter().map(|s| f(s)).sum::<f64>() / n;
-        window
-            .iter()
-            .map(|s| (s.t_s - tm) * (f(s) - ym))
-            .sum::<f64>()
-            / stt
-    };
-    slope(|s| s.left_m).abs().max(slope(|s| s.right_m).abs())
 }
 
 /// The pose reached at `t` by integrating the commanded wheel speeds from the start pose, each

@@ -35,6 +35,50 @@ pub struct Metrics {
     pub nmse_raw: f64,
     /// Normalised MSE of the calibrated estimates.
     pub nmse_calibrated: f64,
+    /// The lidar model alone: each raw reading inverted through the fitted lidar model. For
+    /// EM the figures above measure the smoothed distance, which also fuses the commands, the
+    /// odometer and the sonar, and can look good while the lidar model is wrong (issue 16).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lidar_model: Option<LidarModelMetrics>,
+}
+
+/// How well the fitted lidar model alone turns raw readings into distances: each raw reading
+/// inverted through it (the landmark paper's eq. 30) against the true distance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LidarModelMetrics {
+    /// MSE of the raw readings, m².
+    pub mse_raw: f64,
+    /// MSE of the inverted readings, m².
+    pub mse_calibrated: f64,
+    /// Raw over calibrated: eq. (31) for the lidar model alone. Larger is better.
+    pub mse_ratio: f64,
+    /// Readings scored.
+    pub readings: usize,
+}
+
+impl LidarModelMetrics {
+    /// The figures of `raw` readings and their `inverted` distances against `truth`, over the
+    /// triples where all three are finite; `None` when there is none.
+    #[must_use]
+    pub fn score(triples: impl IntoIterator<Item = (f64, f64, f64)>) -> Option<Self> {
+        let (mut raw, mut inverted, mut n) = (0.0, 0.0, 0usize);
+        for (r, i, d) in triples {
+            if r.is_finite() && i.is_finite() && d.is_finite() {
+                raw += (r - d).powi(2);
+                inverted += (i - d).powi(2);
+                n += 1;
+            }
+        }
+        (n > 0).then(|| {
+            let (mse_raw, mse_calibrated) = (raw / n as f64, inverted / n as f64);
+            Self {
+                mse_raw,
+                mse_calibrated,
+                mse_ratio: mse_raw / mse_calibrated,
+                readings: n,
+            }
+        })
+    }
 }
 
 impl Metrics {

@@ -45,15 +45,28 @@ impl Calibration {
             }
         }
         if let Some(m) = self.metrics {
+            // What the first figures measure: EM's is its smoothed distance (eq. 31 of the
+            // paper's comparison), which fuses every sensor and the commands.
+            let what = match self.method {
+                Method::Em => "smoothed distance (all sensors and commands)",
+                Method::Landmarks | Method::Groundtruth => "lidar distance",
+            };
             writeln!(
                 s,
-                "  distance MSE raw {:.3e} m², calibrated {:.3e} m² (ratio {:.2}); NMSE raw {:.3e}, calibrated {:.3e}",
+                "  {what}: MSE raw {:.3e} m², calibrated {:.3e} m² (ratio {:.2}); NMSE raw {:.3e}, calibrated {:.3e}",
                 m.mse_raw,
                 m.mse_calibrated,
                 m.mse_ratio(),
                 m.nmse_raw,
                 m.nmse_calibrated
             )?;
+            if let (Method::Em, Some(l)) = (self.method, m.lidar_model) {
+                writeln!(
+                    s,
+                    "  lidar model alone (each raw reading inverted through it): MSE raw {:.3e} m², calibrated {:.3e} m² (ratio {:.2}, {} readings)",
+                    l.mse_raw, l.mse_calibrated, l.mse_ratio, l.readings
+                )?;
+            }
         }
         for note in &self.notes {
             writeln!(s, "  note: {note}")?;

@@ -36,7 +36,7 @@ use hilsim_recording::Recording;
 use nalgebra::{DMatrix, DVector};
 
 use crate::target_samples::{self, SampleOptions};
-use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
+use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
 
 /// `ln(2π)`.
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
@@ -354,7 +354,12 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
         .iter()
         .map(|y| y.and_then(|y| invert(&lidar.alpha, y)))
         .collect();
-    let metrics = target_samples::distance_metrics(truth, &samples.lidar_m, &calibrated);
+    // Its estimates are the lidar model's own: the two figures agree.
+    let metrics =
+        target_samples::distance_metrics(truth, &samples.lidar_m, &calibrated).map(|m| Metrics {
+            lidar_model: target_samples::lidar_model_metrics(truth, &samples.lidar_m, &lidar.alpha),
+            ..m
+        });
     Ok(Calibration {
         method: Method::Groundtruth,
         sensors,

@@ -20,6 +20,6 @@ pub mod stats;
 pub mod target_samples;
 
 pub use by_method::{calibrate, calibrate_with, em_options, Settings};
-pub use calibration::{Calibration, Method, Metrics, Sensor, SensorModel};
+pub use calibration::{Calibration, LidarModelMetrics, Method, Metrics, Sensor, SensorModel};
 pub use error::CalibrationError;
 pub use target_samples::SampleOptions;

@@ -36,7 +36,7 @@ mod tests;
 use hilsim_recording::{LidarSample, Mount, Recording};
 
 use self::align::{commanded_forward, interpolate_odometry, nearest_sonar, truth_distances};
-use crate::{CalibrationError, Metrics};
+use crate::{CalibrationError, LidarModelMetrics, Metrics};
 
 /// Which beam to follow and what is known of the start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -322,6 +322,31 @@ fn check_finite_commands(rec: &Recording) -> Result<(), CalibrationError> {
     )
 }
 
+/// The lidar model alone on the target beam's readings: each raw reading inverted through
+/// `alpha` (the landmark paper's eq. 30) against the truth. `None` without a scorable sample or
+/// when the model cannot be inverted (it nowhere increases with distance).
+#[must_use]
+pub fn lidar_model_metrics(
+    truth: &[f64],
+    raw: &[Option<f64>],
+    alpha: &[f64],
+) -> Option<LidarModelMetrics> {
+    let far = raw.iter().flatten().chain(truth).fold(0.0_f64, |m, v| {
+        if v.is_finite() {
+            m.max(v.abs())
+        } else {
+            m
+        }
+    });
+    let inverse = crate::landmarks::Inverse::new(alpha, [0.0, 2.0 * far + 1.0]).ok()?;
+    LidarModelMetrics::score(
+        truth
+            .iter()
+            .zip(raw)
+            .filter_map(|(&d, y)| y.map(|y| (y, inverse.distance(y), d))),
+    )
+}
+
 /// MSE and the EM paper's NMSE (Sec. VI: `NMSE = (1/N) Σ (d̂_k − d_k)² / d_k²`) of raw readings
 /// and calibrated estimates against the truth, over the samples where both a raw reading and a
 /// finite estimate exist. `None` when there is no such sample.
@@ -354,6 +379,7 @@ pub fn distance_metrics(
             mse_calibrated: mse_cal / n,
             nmse_raw: nmse_raw / n,
             nmse_calibrated: nmse_cal / n,
+            lidar_model: None,
         }
     })
 }

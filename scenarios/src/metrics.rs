@@ -102,6 +102,11 @@ pub fn of_calibration(c: &hilsim_calibrator::Calibration) -> Metrics {
         put("lidar.mse_ratio", metrics.mse_ratio());
         put("lidar.nmse_raw", metrics.nmse_raw);
         put("lidar.nmse_calibrated", metrics.nmse_calibrated);
+        if let Some(l) = metrics.lidar_model {
+            put("lidar_model.mse_raw", l.mse_raw);
+            put("lidar_model.mse_calibrated", l.mse_calibrated);
+            put("lidar_model.mse_ratio", l.mse_ratio);
+        }
     }
     m
 }

@@ -13,7 +13,7 @@ use super::mstep;
 use super::options::{EmOptions, MIN_LIDAR_READINGS, MIN_SPAN_M};
 use crate::kalman_smoother::RtsSmoother;
 use crate::target_samples::{self, TargetSamples};
-use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
+use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
 
 /// Everything a run of EM produced.
 #[derive(Debug, Clone)]
@@ -70,9 +70,13 @@ pub fn run_samples(
     let fit = iterate(&data, opts, params, lin)?;
     let estimates = estimates(&samples, &fit.smoother);
     push_notes(&mut notes, &samples, opts, &fit, valid, start);
+    let lidar_alpha = fit.params.sensors[super::model::LIDAR].alpha;
     let metrics = samples.truth_m.as_ref().and_then(|truth| {
         let calibrated: Vec<Option<f64>> = estimates.iter().map(|e| Some(e.distance_m)).collect();
-        target_samples::distance_metrics(truth, &samples.lidar_m, &calibrated)
+        target_samples::distance_metrics(truth, &samples.lidar_m, &calibrated).map(|m| Metrics {
+            lidar_model: target_samples::lidar_model_metrics(truth, &samples.lidar_m, &lidar_alpha),
+            ..m
+        })
     });
     let calibration = Calibration {
         method: Method::Em,

@@ -11,7 +11,7 @@ use crate::landmarks::inversion::Inverse;
 use crate::landmarks::options::{Estimator, Options};
 use crate::landmarks::positions::{intersect, BearingLine, Weights};
 use crate::landmarks::stops::Stop;
-use crate::{CalibrationError, Metrics};
+use crate::{CalibrationError, LidarModelMetrics, Metrics};
 use hilsim_recording::Pose;
 
 /// What the stages before the estimator found, as the scoring needs it.
@@ -111,6 +111,13 @@ fn metrics(raw: &[f64], calibrated: &[f64], truth: &[f64]) -> Metrics {
         mse_calibrated: c,
         nmse_raw: r / norm,
         nmse_calibrated: c / norm,
+        // The estimates are the raw readings inverted through the fitted model (eq. 30).
+        lidar_model: LidarModelMetrics::score(
+            raw.iter()
+                .zip(calibrated)
+                .zip(truth)
+                .map(|((&r, &c), &d)| (r, c, d)),
+        ),
     }
 }
 

@@ -20,12 +20,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Run(args) => commands::run::run(args, &mut out),
         Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
-        Command::Calibrate(args) => {
-            commands::calibrate::calibrate(args, &mut out).map(|()| ExitCode::SUCCESS)
-        }
-        Command::Smooth(args) => {
-            commands::calibrate::smooth(args, &mut out).map(|()| ExitCode::SUCCESS)
-        }
+        Command::Calibrate(args) => commands::calibrate::calibrate(args, &mut out),
+        Command::Smooth(args) => commands::calibrate::smooth(args, &mut out),
         Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
         Command::Decode(args) => {
             commands::decode::run(&args.input, args.csv.as_deref(), args.json, &mut out)

@@ -110,6 +110,9 @@ pub struct Calibration {
     /// recording (x forward, y left) (landmarks).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub landmarks: Option<Vec<[f64; 2]>>,
+    /// The method's assumptions tested on the data ([`crate::checks`]); a failed one makes
+    /// `hilsim calibrate` exit 1 with the result still printed.
+    pub checks: Vec<crate::checks::Check>,
     /// Further method-specific facts for people: what was skipped and why (stops too short, a
     /// landmark track dropped), choices made (AIC and cross-validation). In the JSON as `notes`
     /// when there are any; their wording is not an interface.
@@ -118,6 +121,11 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The checks that failed.
+    pub fn failed_checks(&self) -> impl Iterator<Item = &crate::checks::Check> {
+        self.checks.iter().filter(|c| !c.pass)
+    }
+
     /// The JSON object of `hilsim calibrate --json`.
     #[must_use]
     pub fn to_json(&self) -> serde_json::Value {

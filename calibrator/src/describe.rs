@@ -68,6 +68,10 @@ impl Calibration {
                 )?;
             }
         }
+        for check in &self.checks {
+            let verdict = if check.pass { "ok" } else { "FAILED" };
+            writeln!(s, "  check {verdict}: {}: {}", check.name, check.detail)?;
+        }
         for note in &self.notes {
             writeln!(s, "  note: {note}")?;
         }
@@ -128,6 +132,7 @@ impl Calibration {
             sensors,
             iterations: 0,
             converged: true,
+            checks: Vec::new(),
             metrics: None,
             order: None,
             landmarks: None,

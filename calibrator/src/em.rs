@@ -50,3 +50,4 @@ pub(crate) use estep::{build_data, e_step};
 pub(crate) use estimate::estimates;
 pub(crate) use model::{Lin, Params, SensorParams};
 pub(crate) use model::{LIDAR, ODOMETER, SONAR};
+pub(crate) use run::lidar_innovations;

@@ -35,8 +35,9 @@ use std::collections::BTreeMap;
 use hilsim_recording::Recording;
 use nalgebra::{DMatrix, DVector};
 
+use crate::landmarks::regression;
 use crate::target_samples::{self, SampleOptions};
-use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
+use crate::{checks, Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
 
 /// `ln(2π)`.
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
@@ -360,6 +361,25 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
             lidar_model: target_samples::lidar_model_metrics(truth, &samples.lidar_m, &lidar.alpha),
             ..m
         });
+    let mut checks = Vec::new();
+    for (sensor, model) in &sensors {
+        checks.extend(checks::bias_plausible(sensor.name(), model));
+    }
+    // The lidar's residuals against the truth, standardised by the fitted noise, in time order.
+    let residuals: Vec<f64> = truth
+        .iter()
+        .zip(&samples.lidar_m)
+        .filter_map(|(&d, y)| {
+            let y = (*y)?;
+            let sd = lidar.beta * d.powi(lidar.noise_power as i32);
+            (sd > 0.0).then(|| (y - regression::horner(&lidar.alpha, d)) / sd)
+        })
+        .collect();
+    checks.extend(checks::white(
+        "lidar.residuals_white",
+        "lidar's standardised residuals against the truth",
+        &residuals,
+    ));
     Ok(Calibration {
         method: Method::Groundtruth,
         sensors,
@@ -368,6 +388,7 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
         metrics,
         order: Some(lidar.order()),
         landmarks: None,
+        checks,
         notes,
     })
 }

@@ -9,6 +9,7 @@
 
 mod by_method;
 pub mod calibration;
+pub mod checks;
 mod describe;
 pub mod em;
 pub mod error;

@@ -32,6 +32,7 @@
 
 use hilsim_recording::Recording;
 
+use crate::checks::{self, Check};
 /// The smoothed distance at one sample (EM's, re-exported here for the smoother's callers).
 pub use crate::em::Estimate;
 use crate::em::{self, EmOptions, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
@@ -55,8 +56,25 @@ pub fn smooth(
     trained: &Calibration,
     opts: &EmOptions,
 ) -> Result<Vec<Estimate>, CalibrationError> {
+    smooth_checked(rec, trained, opts).map(|(estimates, _)| estimates)
+}
+
+/// As [`smooth`], with the recording checked against the calibration as EM checks its own
+/// ([`crate::checks`]): a straight run at one target, the lidar's innovations of the trained
+/// size and white. A recording the calibration does not fit (another lidar, a wrong start
+/// distance) fails them instead of giving confident wrong distances.
+///
+/// # Errors
+/// As [`smooth`].
+pub fn smooth_checked(
+    rec: &Recording,
+    trained: &Calibration,
+    opts: &EmOptions,
+) -> Result<(Vec<Estimate>, Vec<Check>), CalibrationError> {
     let samples = target_samples::extract(rec, &opts.sample_options())?;
-    smooth_samples(&samples, trained, opts)
+    let (estimates, mut checks) = smooth_samples_checked(&samples, trained, opts)?;
+    checks.extend(checks::on_a_line(rec));
+    Ok((estimates, checks))
 }
 
 /// As [`smooth`], on samples already drawn from a recording.
@@ -68,6 +86,15 @@ pub fn smooth_samples(
     trained: &Calibration,
     opts: &EmOptions,
 ) -> Result<Vec<Estimate>, CalibrationError> {
+    smooth_samples_checked(samples, trained, opts).map(|(estimates, _)| estimates)
+}
+
+/// As [`smooth_samples`], with the checks that need only the samples.
+fn smooth_samples_checked(
+    samples: &TargetSamples,
+    trained: &Calibration,
+    opts: &EmOptions,
+) -> Result<(Vec<Estimate>, Vec<Check>), CalibrationError> {
     if !(opts.process_noise_rel >= 0.0 && opts.process_noise_rel.is_finite()) {
         return Err(CalibrationError::Invalid(format!(
             "process_noise_rel must be non-negative, got {}",
@@ -126,7 +153,21 @@ pub fn smooth_samples(
         .collect();
     let mut smoother = RtsSmoother::<2>::new();
     em::e_step(&mut smoother, &data, &params, &mut lin, opts.e_step)?;
-    Ok(em::estimates(samples, &smoother))
+    let innovations = em::lidar_innovations(&data, &params, &smoother, opts);
+    let mut checks: Vec<Check> =
+        checks::target_follows_commands(&samples.commanded_m, &samples.lidar_m)
+            .into_iter()
+            .collect();
+    checks.extend(checks::innovations_sized(
+        "lidar.innovation_size",
+        &innovations,
+    ));
+    checks.extend(checks::white(
+        "lidar.innovations_white",
+        "lidar's standardised innovations",
+        &innovations,
+    ));
+    Ok((em::estimates(samples, &smoother), checks))
 }
 
 /// The EM model's parameters from a fitted model, if its orders fit the paper's state.

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 use std::io::{Read, Write};
 use std::path::Path;
+use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
@@ -13,7 +14,8 @@ use hilsim_recording::{is_same_file, write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
-pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<()> {
+/// Prints the calibration; exit 1 when one of its checks failed (the result is still printed).
+pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let target = target_options(args.beam, args.start_distance)?;
     if args.settle_s.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
         bail!("--settle-s: expected a settling time in seconds, 0 or more");
@@ -38,7 +40,21 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<()> {
     } else {
         out.write_all(calibration.describe().as_bytes())?;
     }
-    Ok(())
+    let failed: Vec<&str> = calibration
+        .failed_checks()
+        .map(|c| c.name.as_str())
+        .collect();
+    if failed.is_empty() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    eprintln!(
+        "hilsim: {}: {}: the recording does not fit the method's assumptions ({}); the result \
+         above is not to be trusted",
+        args.recording.display(),
+        method.name(),
+        failed.join(", ")
+    );
+    Ok(ExitCode::from(1))
 }
 
 fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions> {
@@ -55,7 +71,9 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions
     })
 }
 
-pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<()> {
+/// Writes the smoothed distances; exit 1 when the recording fails a check against the
+/// calibration (the distances are still written; the failed checks go to stderr).
+pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let target = target_options(args.beam, args.start_distance)?;
     if let Some(csv) = &args.csv {
         // The inputs: the calibration and the recording's own files.
@@ -76,8 +94,9 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<()> {
     }
     let trained = read_calibration(&args.calibration)?;
     let rec = Recording::read_dir(&args.recording)?;
-    let estimates = smoothing::smooth(&rec, &trained, &hilsim_calibrator::em_options(target))
-        .with_context(|| format!("{}: smoothing", args.recording.display()))?;
+    let (estimates, checks) =
+        smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))
+            .with_context(|| format!("{}: smoothing", args.recording.display()))?;
     let mut csv = String::from("t_s,distance_m,sd_m\n");
     for e in &estimates {
         let _ = writeln!(
@@ -101,7 +120,20 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<()> {
         }
         None => out.write_all(csv.as_bytes())?,
     }
-    Ok(())
+    let failed: Vec<_> = checks.iter().filter(|c| !c.pass).collect();
+    if failed.is_empty() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    for check in &failed {
+        eprintln!("hilsim: check FAILED: {}: {}", check.name, check.detail);
+    }
+    eprintln!(
+        "hilsim: {}: the recording does not fit the calibration ({} check(s) failed); the \
+         distances are not to be trusted",
+        args.recording.display(),
+        failed.len()
+    );
+    Ok(ExitCode::from(1))
 }
 
 /// Reads the JSON that `hilsim calibrate --json` printed.

@@ -218,3 +218,148 @@ fn issue_16_one_second_stops_without_odometry_calibrate() {
     let notes = v["notes"].to_string();
     assert!(notes.contains("the settling time given"), "{notes}");
 }
+
+/// Issue 16: EM's assumptions checked. On landmarks-5 (its lidar beam sweeps across cylinders
+/// and walls) and with a start distance 2.5 m off it used to print a confident garbage model
+/// with exit 0: now the result is still printed, with the failed checks, and the exit code is 1.
+/// The run it is made for passes every check.
+#[test]
+fn issue_16_em_checks_its_assumptions_and_a_failure_exits_1() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "board");
+    record(tmp.path(), "landmarks-5.toml", "landmarks");
+    let failed = |v: &serde_json::Value| -> Vec<String> {
+        v["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["pass"] == false)
+            .map(|c| c["name"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let v = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "board", "--method", "em", "--json"],
+    ));
+    assert!(failed(&v).is_empty(), "{v}");
+    let names: Vec<&str> = v["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    for name in [
+        "lidar.offset_plausible",
+        "lidar.scale_plausible",
+        "lidar.target_follows_commands",
+        "lidar.innovation_size",
+        "lidar.innovations_white",
+        "path.heading_change_deg",
+        "path.lateral_drift_m",
+    ] {
+        assert!(names.contains(&name), "{name} missing from {names:?}");
+    }
+    for c in v["checks"].as_array().unwrap() {
+        for key in ["value", "threshold"] {
+            assert!(c[key].is_number(), "{c}");
+        }
+        assert!(c["detail"].is_string(), "{c}");
+    }
+
+    let checked = |args: &[&str]| {
+        let o = hilsim(tmp.path(), args);
+        assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+        assert!(v["sensors"]["lidar"]["alpha"].is_array(), "{v}");
+        assert!(stderr(&o).contains("not to be trusted"), "{}", stderr(&o));
+        failed(&v)
+    };
+    let f = checked(&["calibrate", "landmarks", "--method", "em", "--json"]);
+    assert!(
+        f.contains(&"lidar.target_follows_commands".to_string()),
+        "{f:?}"
+    );
+    let f = checked(&[
+        "calibrate",
+        "board",
+        "--method",
+        "em",
+        "--start-distance",
+        "3.0",
+        "--json",
+    ]);
+    assert!(f.contains(&"lidar.offset_plausible".to_string()), "{f:?}");
+
+    // smooth: the distances are written, the misfit reported, exit 1.
+    let cal = hilsim(
+        tmp.path(),
+        &["calibrate", "board", "--method", "em", "--json"],
+    );
+    std::fs::write(tmp.path().join("cal.json"), stdout(&cal)).unwrap();
+    let o = hilsim(
+        tmp.path(),
+        &[
+            "smooth",
+            "board",
+            "--calibration",
+            "cal.json",
+            "--start-distance",
+            "3.0",
+            "--csv",
+            "d.csv",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("lidar.innovation_size"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(tmp.path().join("d.csv").exists());
+    let o = hilsim(
+        tmp.path(),
+        &[
+            "smooth",
+            "board",
+            "--calibration",
+            "cal.json",
+            "--csv",
+            "d.csv",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+/// Issue 16: the landmark method's and the ground-truth baseline's checks pass on the runs they
+/// are made for.
+#[test]
+fn issue_16_landmarks_and_groundtruth_pass_their_checks_on_their_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "landmarks-5.toml", "landmarks");
+    record(tmp.path(), "straight-board.toml", "board");
+    for (rec, method, expected) in [
+        (
+            "landmarks",
+            "landmarks",
+            &[
+                "landmarks.distance_span_m",
+                "landmarks.triangulation_angle_deg",
+                "landmarks.association_consistent",
+            ][..],
+        ),
+        ("board", "groundtruth", &["lidar.residuals_white"][..]),
+    ] {
+        let v = json(&hilsim(
+            tmp.path(),
+            &["calibrate", rec, "--method", method, "--json"],
+        ));
+        let checks = v["checks"].as_array().unwrap();
+        for name in expected {
+            let c = checks
+                .iter()
+                .find(|c| c["name"] == *name)
+                .unwrap_or_else(|| panic!("{name} missing: {v}"));
+            assert_eq!(c["pass"], true, "{c}");
+        }
+    }
+}

@@ -13,7 +13,7 @@ use super::mstep;
 use super::options::{EmOptions, MIN_LIDAR_READINGS, MIN_SPAN_M};
 use crate::kalman_smoother::RtsSmoother;
 use crate::target_samples::{self, TargetSamples};
-use crate::{Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
+use crate::{checks, Calibration, CalibrationError, Method, Metrics, Sensor, SensorModel};
 
 /// Everything a run of EM produced.
 #[derive(Debug, Clone)]
@@ -52,7 +52,10 @@ pub fn run(
 ) -> Result<EmOutcome, CalibrationError> {
     opts.validate()?;
     let samples = target_samples::extract(rec, &opts.sample_options())?;
-    run_samples(samples, opts)
+    let mut outcome = run_samples(samples, opts)?;
+    // The paper's experiment: straight towards or away from one target.
+    outcome.calibration.checks.extend(checks::on_a_line(rec));
+    Ok(outcome)
 }
 
 /// EM on samples already drawn from a recording.
@@ -78,14 +81,34 @@ pub fn run_samples(
             ..m
         })
     });
+    let sensors = sensor_models(&fit.params);
+    let mut checks = Vec::new();
+    for (sensor, model) in &sensors {
+        checks.extend(checks::bias_plausible(sensor.name(), model));
+    }
+    checks.extend(checks::target_follows_commands(
+        &samples.commanded_m,
+        &samples.lidar_m,
+    ));
+    let innovations = lidar_innovations(&data, &fit.params, &fit.smoother, opts);
+    checks.extend(checks::innovations_sized(
+        "lidar.innovation_size",
+        &innovations,
+    ));
+    checks.extend(checks::white(
+        "lidar.innovations_white",
+        "lidar's standardised innovations",
+        &innovations,
+    ));
     let calibration = Calibration {
         method: Method::Em,
-        sensors: sensor_models(&fit.params),
+        sensors,
         iterations: fit.iterations,
         converged: fit.converged,
         metrics,
         order: None,
         landmarks: None,
+        checks,
         notes,
     };
     Ok(EmOutcome {
@@ -95,6 +118,44 @@ pub fn run_samples(
         log_likelihoods: fit.log_likelihoods,
         process_noise_rel: fit.params.q_rel,
     })
+}
+
+/// The lidar's standardised innovations `ν_k / √S_k` at the fitted parameters, in time order:
+/// the lidar is the first observation of each step, so the prediction `x_{k|k−1}` is its prior.
+/// The noise is linearised at the smoothed state (as the next E-step would).
+pub(crate) fn lidar_innovations(
+    data: &Data,
+    params: &Params,
+    smoother: &RtsSmoother<2>,
+    opts: &EmOptions,
+) -> Vec<f64> {
+    let lidar = &params.sensors[LIDAR];
+    let h = Vector2::new(lidar.alpha[1], lidar.alpha[2]);
+    let moments = smoother
+        .predicted_means()
+        .iter()
+        .zip(smoother.predicted_covs())
+        .zip(
+            smoother
+                .smoothed_means()
+                .iter()
+                .zip(smoother.smoothed_covs()),
+        );
+    data.steps
+        .iter()
+        .zip(moments)
+        .filter(|(step, _)| step.has[LIDAR])
+        .filter_map(|(step, ((m, p), (sm, sp)))| {
+            let r = super::model::noise_variance(
+                &lidar.beta,
+                &Lin::from_smoothed(sm, sp),
+                opts.e_step.second_order(),
+            );
+            let s = h.dot(&(p * h)) + r;
+            let nu = step.y[LIDAR] - lidar.alpha[0] - h.dot(m);
+            (s > 0.0 && s.is_finite()).then(|| nu / s.sqrt())
+        })
+        .collect()
 }
 
 /// Checks the samples can anchor and identify the model: a start distance, enough lidar

@@ -107,6 +107,10 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             beta: model.beta,
         },
     );
+    let mut checks = super::checks::landmark_checks(&set, &est.used, &model.positions);
+    if let Some(lidar) = sensors_out.get(&Sensor::Lidar) {
+        checks.extend(crate::checks::bias_plausible("lidar", lidar));
+    }
     let calibration = Calibration {
         method: Method::Landmarks,
         sensors: sensors_out,
@@ -115,6 +119,7 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         metrics,
         order: Some(model.order),
         landmarks: Some(model.positions.into_iter().flatten().collect()),
+        checks,
         notes,
     };
     Ok(Analysis {

@@ -26,6 +26,7 @@
 
 pub mod association;
 pub mod calibrate;
+pub mod checks;
 pub mod circle_fit;
 pub mod detection;
 pub mod estimate;

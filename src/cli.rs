@@ -140,6 +140,14 @@ pub struct CalibrateArgs {
         allow_negative_numbers = true
     )]
     pub min_revolutions: f64,
+    /// EM: a Gaussian prior on a bias coefficient, e.g. `sonar.alpha1=1.028±0.003` (`+-` for
+    /// `±`); repeatable. A prior on a scale (alpha1) lets EM estimate the drive's speed scale.
+    #[arg(
+        long = "prior",
+        value_name = "SENSOR.COEF=VALUE±SD",
+        allow_hyphen_values = true
+    )]
+    pub priors: Vec<String>,
 }
 
 /// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.

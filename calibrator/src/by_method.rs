@@ -13,6 +13,8 @@ pub struct Settings {
     pub target: SampleOptions,
     /// Finding the stand-still stops (landmarks).
     pub stops: landmarks::StopOptions,
+    /// Priors on bias coefficients (EM).
+    pub priors: em::Priors,
 }
 
 /// Calibrates `rec` with `method`, each method with its default options but the target (the beam
@@ -46,7 +48,13 @@ pub fn calibrate_with(
 ) -> Result<Calibration, CalibrationError> {
     let target = settings.target;
     match method {
-        Method::Em => em::calibrate(rec, &em_options(target)),
+        Method::Em => em::calibrate(
+            rec,
+            &em::EmOptions {
+                priors: settings.priors,
+                ..em_options(target)
+            },
+        ),
         Method::Groundtruth => groundtruth::calibrate(
             rec,
             &groundtruth::Options {

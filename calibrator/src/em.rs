@@ -38,12 +38,14 @@ pub mod experiment;
 mod model;
 mod mstep;
 mod options;
+mod prior;
 mod run;
 #[cfg(test)]
 mod tests;
 
 pub use estimate::Estimate;
 pub use options::{EStep, EmOptions, MIN_AUX_READINGS, MIN_LIDAR_READINGS, MIN_SPAN_M};
+pub use prior::{Prior, Priors};
 pub use run::{calibrate, run, run_samples, EmOutcome};
 
 pub(crate) use estep::{build_data, e_step};

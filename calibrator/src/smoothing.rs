@@ -113,6 +113,8 @@ fn smooth_samples_checked(
             SensorParams::paper(SONAR),
         ],
         q_rel: opts.process_noise_rel,
+        // The speed scale EM estimated belongs to the training run's drive, not this one's.
+        speed_scale: 1.0,
     };
     let (start, prior_var) = match samples.start_distance_m {
         Some(d0) => (d0, 0.0),

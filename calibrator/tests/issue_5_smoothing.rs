@@ -85,9 +85,11 @@ fn smoothing_the_training_run_reproduces_em() {
     // evaluates it at a smoothed state of the same parameters, as EM's last E-step: the two
     // agree to rounding and the convergence tolerance (1e-6), far below 1e-3 sd.
     for (e_step, bound) in [(EStep::Paper, 0.1), (EStep::Relinearized, 1e-3)] {
+        // The smoother takes q as given: EM must keep the same one.
         let opts = EmOptions {
             e_step,
             use_odometer: false,
+            estimate_process_noise: false,
             ..EmOptions::default()
         };
         let outcome = em::run(&rec, &opts).expect("calibrates");
@@ -105,7 +107,10 @@ fn smoothing_the_training_run_reproduces_em() {
     }
     // With the odometer, smoothing replaces EM's fitted offset α0 by (1 − α1) d0 (the encoders
     // read 0 at t = 0), which moves the estimates by at most the offset's change over α1.
-    let opts = EmOptions::default();
+    let opts = EmOptions {
+        estimate_process_noise: false,
+        ..EmOptions::default()
+    };
     let outcome = em::run(&rec, &opts).expect("calibrates");
     let odo = &outcome.calibration.sensors[&Sensor::Odometer];
     let shift = (odo.alpha[0] - (1.0 - odo.alpha[1]) * 0.5).abs() / odo.alpha[1];

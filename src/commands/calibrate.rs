@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
 use hilsim_calibrator::smoothing;
-use hilsim_calibrator::{Calibration, SampleOptions, Settings};
+use hilsim_calibrator::{em, Calibration, Method, SampleOptions, Settings};
 use hilsim_recording::{is_same_file, write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
@@ -23,6 +23,14 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     if !(args.min_revolutions.is_finite() && args.min_revolutions >= 1.0) {
         bail!("--min-revolutions: expected a number of revolutions, 1 or more");
     }
+    if !args.priors.is_empty() && args.method != Method::Em {
+        bail!("--prior: priors are for --method em");
+    }
+    let priors: Vec<em::Prior> = args
+        .priors
+        .iter()
+        .map(|p| p.parse())
+        .collect::<Result<_, _>>()?;
     let settings = Settings {
         target,
         stops: StopOptions {
@@ -30,6 +38,7 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
             min_revolutions: args.min_revolutions,
             ..StopOptions::default()
         },
+        priors: em::Priors::new(&priors)?,
     };
     let rec = Recording::read_dir(&args.recording)?;
     let method = args.method;

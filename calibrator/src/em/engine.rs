@@ -30,6 +30,8 @@ impl Engine<'_> {
             &mut self.lin,
             self.opts.e_step,
         )?;
+        // MAP-EM climbs the log-posterior: the log-likelihood plus the priors' log-density.
+        let ll = ll + log_prior(params, &self.opts.priors);
         self.log_likelihoods.push(ll);
         self.iterations += 1;
         let post = mstep::Posterior {
@@ -43,7 +45,8 @@ impl Engine<'_> {
             &post,
             &self.lin,
             self.opts.e_step.second_order(),
-            self.opts.estimate_process_noise,
+            self.opts.free(),
+            &self.opts.priors,
         )?;
         update_lin(&mut self.lin, &self.smoother);
         Ok((next, ll))
@@ -51,7 +54,7 @@ impl Engine<'_> {
 
     fn flat(&self, p: &Params) -> Vec<f64> {
         let mut v = Vec::new();
-        p.flat(self.opts.estimate_process_noise, &mut v);
+        p.flat(self.opts.free(), &mut v);
         v
     }
 
@@ -85,7 +88,7 @@ impl Engine<'_> {
     /// step length is not bounded: bounding it (as the authors' R package can) tripled the
     /// iterations here.
     pub(super) fn squarem(&mut self, params: &mut Params) -> Result<bool, CalibrationError> {
-        let with_q = self.opts.estimate_process_noise;
+        let free = self.opts.free();
         while self.iterations + 2 <= self.opts.max_iterations {
             let theta0 = *params;
             let (theta1, ll0) = self.step(&theta0)?;
@@ -120,7 +123,7 @@ impl Engine<'_> {
                 .zip(&v)
                 .map(|((t, r), v)| t - 2.0 * a * r + a * a * v)
                 .collect();
-            let Some(theta_x) = theta0.with_flat(with_q, &extrapolated) else {
+            let Some(theta_x) = theta0.with_flat(free, &extrapolated) else {
                 continue;
             };
             let saved_lin = self.lin.clone();
@@ -150,4 +153,20 @@ fn relative_change(old: &[f64], new: &[f64]) -> f64 {
         .zip(new)
         .map(|(a, b)| (a - b).abs() / a.abs().max(1e-4))
         .fold(0.0, f64::max)
+}
+
+/// The priors' log-density at `params` (up to a constant): `−Σ (α_i − μ_i)² / (2 s_i²)`.
+pub(super) fn log_prior(params: &Params, priors: &super::prior::Priors) -> f64 {
+    let mut sum = 0.0;
+    for (slot, sensor) in params.sensors.iter().enumerate() {
+        if !sensor.active {
+            continue;
+        }
+        for (i, alpha) in sensor.alpha.iter().enumerate() {
+            if let Some((mean, sd)) = priors.get(slot, i) {
+                sum -= (alpha - mean).powi(2) / (2.0 * sd * sd);
+            }
+        }
+    }
+    sum
 }

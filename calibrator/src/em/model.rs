@@ -81,25 +81,31 @@ pub(crate) struct Params {
     /// `σ_k = q |u_k|`: sd of the distance's deviation from the commanded motion per metre
     /// commanded.
     pub q_rel: f64,
+    /// The commands' speed scale `s`: the distance changes by `s u_k` (1, the paper's model,
+    /// unless a prior makes it identifiable).
+    pub speed_scale: f64,
 }
 
 impl Params {
-    /// The parameters as one vector (active sensors' alpha and beta, then q when estimated),
-    /// for the convergence test.
-    pub(crate) fn flat(&self, with_q: bool, out: &mut Vec<f64>) {
+    /// The parameters as one vector (active sensors' alpha and beta, then q and the speed scale
+    /// when estimated), for the convergence test.
+    pub(crate) fn flat(&self, free: Free, out: &mut Vec<f64>) {
         out.clear();
         for s in self.sensors.iter().filter(|s| s.active) {
             out.extend_from_slice(&s.alpha[..s.n_alpha]);
             out.push(s.beta[s.power]);
         }
-        if with_q {
+        if free.q {
             out.push(self.q_rel);
+        }
+        if free.speed_scale {
+            out.push(self.speed_scale);
         }
     }
 
     /// The inverse of [`Params::flat`]; `None` when a noise level or `q` would not be positive
     /// and finite (an extrapolation that left the parameter space).
-    pub(crate) fn with_flat(&self, with_q: bool, flat: &[f64]) -> Option<Params> {
+    pub(crate) fn with_flat(&self, free: Free, flat: &[f64]) -> Option<Params> {
         let mut out = *self;
         let mut it = flat.iter().copied();
         for s in out.sensors.iter_mut().filter(|s| s.active) {
@@ -111,14 +117,29 @@ impl Params {
                 return None;
             }
         }
-        if with_q {
+        if free.q {
             out.q_rel = it.next()?;
             if out.q_rel.is_nan() || out.q_rel <= 0.0 {
                 return None;
             }
         }
+        if free.speed_scale {
+            out.speed_scale = it.next()?;
+            if out.speed_scale.is_nan() || out.speed_scale <= 0.0 {
+                return None;
+            }
+        }
         flat.iter().all(|v| v.is_finite()).then_some(out)
     }
+}
+
+/// Which parameters beside the sensors' the M-step estimates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct Free {
+    /// The process-noise scale `q`.
+    pub q: bool,
+    /// The commands' speed scale.
+    pub speed_scale: bool,
 }
 
 /// One step's data.
@@ -254,8 +275,13 @@ impl StateSpaceModel<2> for EmModel<'_> {
     fn prior(&self) -> Gaussian<2> {
         // d_0 = start + u_first + ν with ν from the motion before the first sample; its d² entry
         // gets the Gaussian's exact second moments.
-        let m = self.data.prior_mean;
-        let (s2, mut cov) = process_noise(self.params.q_rel, self.data.prior_u, m);
+        // The commanded displacement to the first sample, at the speed scale.
+        let m = self.data.prior_mean + (self.params.speed_scale - 1.0) * self.data.prior_u;
+        let (s2, mut cov) = process_noise(
+            self.params.q_rel,
+            self.params.speed_scale * self.data.prior_u,
+            m,
+        );
         let v = self.data.prior_var;
         cov += Matrix2::new(
             v,
@@ -267,7 +293,7 @@ impl StateSpaceModel<2> for EmModel<'_> {
     }
 
     fn transition(&self, k: usize) -> Transition<2> {
-        let u = self.data.steps[k].u;
+        let u = self.params.speed_scale * self.data.steps[k].u;
         let a = self.lin[k].m + u;
         let (s2, q) = process_noise(self.params.q_rel, u, a);
         Transition {

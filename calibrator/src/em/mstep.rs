@@ -17,8 +17,12 @@
 
 use nalgebra::{Cholesky, Matrix2, Matrix3, Vector2, Vector3};
 
-use super::model::{moment, Data, Lin, Params, SensorParams, StepData, FLOOR_D_M, SENSORS};
+use super::model::{moment, Data, Free, Lin, Params, SensorParams, StepData, FLOOR_D_M, SENSORS};
+use super::prior::Priors;
 use crate::CalibrationError;
+
+/// Conditional maximisations of (α, β) per M-step under a prior (they converge in two or three).
+const PRIOR_CYCLES: usize = 8;
 
 /// Sensor names for messages, by slot.
 pub(crate) const NAMES: [&str; SENSORS] = ["lidar", "odometer", "sonar"];
@@ -41,7 +45,8 @@ pub(crate) fn m_step(
     post: &Posterior<'_>,
     lin: &[Lin],
     second_order: bool,
-    estimate_q: bool,
+    free: Free,
+    priors: &Priors,
 ) -> Result<Params, CalibrationError> {
     let mut next = *params;
     let sums = Sums::over(data, params, post, lin, second_order);
@@ -49,12 +54,47 @@ pub(crate) fn m_step(
         if !sensor.active {
             continue;
         }
-        fit_sensor(sensor, slot, &sums)?;
+        fit_sensor(sensor, slot, &sums, priors)?;
     }
-    if estimate_q {
+    if free.q {
         next.q_rel = q_step(data, post, params.q_rel)?;
     }
+    if free.speed_scale {
+        next.speed_scale = speed_scale_step(data, post, params)?;
+    }
     Ok(next)
+}
+
+/// The commands' speed scale: the `s` that maximises the expected log-density of the
+/// transitions, `Σ_k −E[(d_{k+1} − d_k − s u_k)²] / (2 σ_k²)`, i.e. the weighted regression of
+/// the smoothed displacements on the commanded ones,
+/// `s = Σ u_k (E[d_{k+1}] − E[d_k]) / σ_k²  /  Σ u_k² / σ_k²`, with `σ_k² = (q s u_k)² + Q_floor`
+/// at the current `s` (an ECM step, Meng & Rubin 1993: it still never lowers the likelihood).
+/// Only the `d` row of the transition is used; its `d²` row is the same motion squared.
+fn speed_scale_step(
+    data: &Data,
+    post: &Posterior<'_>,
+    params: &Params,
+) -> Result<f64, CalibrationError> {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, step) in data.steps.iter().enumerate().take(data.steps.len() - 1) {
+        let u = step.u;
+        if u == 0.0 {
+            continue;
+        }
+        let sigma = params.q_rel * params.speed_scale * u;
+        let w = 1.0 / (sigma * sigma + FLOOR_D_M * FLOOR_D_M);
+        num += w * u * (post.means[k + 1][0] - post.means[k][0]);
+        den += w * u * u;
+    }
+    let s = num / den;
+    if !(s.is_finite() && s > 0.0) {
+        return Err(CalibrationError::Diverged(format!(
+            "the commands' speed scale came out {s:e}: the smoothed distance does not follow \
+             the commanded motion"
+        )));
+    }
+    Ok(s)
 }
 
 /// The sums of the closed forms, per sensor slot: S_φφ (full 3×3, of which each sensor uses its
@@ -166,7 +206,19 @@ impl Sums {
 
 /// One sensor's α and β from the sums: `α = S_yφ S_φφ⁻¹` (an affine sensor's d² coefficient
 /// pinned to 0), `β² = (Σ y² E[w] − α · S_yφ) / N`.
-fn fit_sensor(sensor: &mut SensorParams, slot: usize, sums: &Sums) -> Result<(), CalibrationError> {
+///
+/// With priors `alpha_i ~ N(μ_i, s_i²)` on some coefficients (MAP-EM) the M-step maximises the
+/// expected log-likelihood plus the log prior. For a fixed β that is the ridge-like system
+/// `(S_φφ + β² Λ) α = S_yφ + β² Λ μ`, Λ = diag(1/s_i²) on the coefficients with a prior; for a
+/// fixed α, `β² = (Σ w y² − 2 α·S_yφ + αᵀ S_φφ α) / N` (equal to the unpenalised form when
+/// there is no prior). The two are alternated from the current β to a fixed point (a few
+/// conditional maximisations: ECM, Meng & Rubin 1993).
+fn fit_sensor(
+    sensor: &mut SensorParams,
+    slot: usize,
+    sums: &Sums,
+    priors: &Priors,
+) -> Result<(), CalibrationError> {
     let (n_alpha, n, name) = (sensor.n_alpha, sums.count[slot], NAMES[slot]);
     if n <= n_alpha {
         return Err(CalibrationError::TooFewSamples(format!(
@@ -183,17 +235,48 @@ fn fit_sensor(sensor: &mut SensorParams, slot: usize, sums: &Sums) -> Result<(),
         a[(i, i)] = 1.0;
         b[i] = 0.0;
     }
-    let alpha = Cholesky::new(a).map(|c| c.solve(&b)).ok_or_else(|| {
+    let singular = || {
         CalibrationError::Diverged(format!(
             "the {name} normal equations are singular (the distances do not vary enough to \
              separate the bias coefficients)"
         ))
-    })?;
-    let beta2 = (sums.syy[slot] - alpha.dot(&b)) / n as f64;
-    if !(beta2 > 0.0 && beta2.is_finite() && alpha.iter().all(|a| a.is_finite())) {
-        return Err(CalibrationError::Diverged(format!(
-            "the {name} noise variance came out {beta2:e} (non-positive or non-finite)"
-        )));
+    };
+    let prior: Vec<(usize, f64, f64)> = (0..n_alpha)
+        .filter_map(|i| priors.get(slot, i).map(|(mean, sd)| (i, mean, sd)))
+        .collect();
+    let residual_sq = |alpha: &Vector3<f64>| {
+        (sums.syy[slot] - 2.0 * alpha.dot(&sums.sxy[slot]) + alpha.dot(&(sums.sxx[slot] * alpha)))
+            / n as f64
+    };
+    let mut alpha = Cholesky::new(a).map(|c| c.solve(&b)).ok_or_else(singular)?;
+    let mut beta2 = (sums.syy[slot] - alpha.dot(&b)) / n as f64;
+    if !prior.is_empty() {
+        // Start from the current β (θ^(t)); θ^(0)'s is 0, where the prior has no weight yet.
+        let current = sensor.beta[sensor.power];
+        let mut b2 = if current > 0.0 {
+            current * current
+        } else {
+            beta2
+        };
+        for _ in 0..PRIOR_CYCLES {
+            let (mut ap, mut bp) = (a, b);
+            for &(i, mean, sd) in &prior {
+                let weight = b2 / (sd * sd);
+                ap[(i, i)] += weight;
+                bp[i] += weight * mean;
+            }
+            let next = Cholesky::new(ap)
+                .map(|c| c.solve(&bp))
+                .ok_or_else(singular)?;
+            let next_b2 = residual_sq(&next);
+            let done = (next - alpha).amax() < 1e-12 && (next_b2 - b2).abs() < 1e-15;
+            alpha = next;
+            b2 = next_b2;
+            if done {
+                break;
+            }
+        }
+        beta2 = b2;
     }
     sensor.alpha = [alpha[0], alpha[1], alpha[2]];
     sensor.beta = [0.0; 3];

@@ -1,5 +1,7 @@
 //! What EM does: its options, the E-step variants, and the least data it accepts.
 
+use super::model::Free;
+use super::prior::Priors;
 use crate::target_samples::SampleOptions;
 use crate::CalibrationError;
 
@@ -83,12 +85,18 @@ pub struct EmOptions {
     /// reproduction's simulated drive error (`scale_sd = 0.02`); with such an error the result
     /// hardly depends on it from 0.005 to 0.05 (`docs/reproduce-em.md`, "Process-noise scale").
     pub process_noise_rel: f64,
-    /// Estimate `q` in the M-step (Shumway–Stoffer, with the lag-one covariances) instead of
-    /// keeping it fixed, as the paper does.
+    /// Estimate `q` in the M-step (Shumway–Stoffer, with the lag-one covariances) from
+    /// `process_noise_rel`, instead of keeping it fixed as the paper does (its σ_d is "assumed
+    /// known"). On by default: a real drive's error is not known, and with q fixed too small
+    /// the innovations of a wandering drive are correlated (the foreign em-reverse run: Ljung–Box
+    /// Q(10) 33 fixed, 8 estimated) while the lidar model hardly changes.
     pub estimate_process_noise: bool,
     /// Accelerate EM with SQUAREM extrapolation (beyond the paper); the fixed point is the
     /// same, reached in fewer iterations. Plain EM when false.
     pub accelerate: bool,
+    /// Gaussian priors on bias coefficients (MAP-EM, docs/em-calibration.md Sec. 12); with one
+    /// on a scale (`alpha1`), the commands' speed scale is estimated too.
+    pub priors: Priors,
 }
 
 impl Default for EmOptions {
@@ -102,8 +110,9 @@ impl Default for EmOptions {
             tolerance: 1e-6,
             e_step: EStep::default(),
             process_noise_rel: 0.02,
-            estimate_process_noise: false,
+            estimate_process_noise: true,
             accelerate: true,
+            priors: Priors::default(),
         }
     }
 }
@@ -128,6 +137,20 @@ impl EmOptions {
             )));
         }
         Ok(())
+    }
+
+    /// The parameters beside the sensors' that the M-step estimates.
+    pub(crate) fn free(&self) -> Free {
+        Free {
+            q: self.estimate_process_noise,
+            speed_scale: self.estimates_speed_scale(),
+        }
+    }
+
+    /// Whether the commands' speed scale is a parameter: when a prior pins a sensor's scale.
+    #[must_use]
+    pub fn estimates_speed_scale(&self) -> bool {
+        self.priors.pins_a_scale()
     }
 
     /// The target these options name.

@@ -8,7 +8,7 @@ use nalgebra::Vector2;
 use super::engine::Engine;
 use super::estep::{build_data, e_step};
 use super::estimate::{estimates, Estimate};
-use super::model::{Data, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
+use super::model::{Data, Free, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
 use super::mstep;
 use super::options::{EmOptions, MIN_LIDAR_READINGS, MIN_SPAN_M};
 use crate::kalman_smoother::RtsSmoother;
@@ -210,6 +210,7 @@ fn initial_params(
             SensorParams::paper(SONAR),
         ],
         q_rel: opts.process_noise_rel,
+        speed_scale: 1.0,
     };
     params.sensors[LIDAR].active = true;
     let mut data = build_data(samples, start, &mut params, opts, notes);
@@ -226,7 +227,17 @@ fn initial_params(
         covs: &zeros,
         lag_one: &zeros,
     };
-    let params = mstep::m_step(&data, &params, &dead_reckoning, &lin, true, false)?;
+    // θ^(0): the speed scale stays 1 (the commands taken as truth).
+    let free = Free::default();
+    let params = mstep::m_step(
+        &data,
+        &params,
+        &dead_reckoning,
+        &lin,
+        true,
+        free,
+        &opts.priors,
+    )?;
     Ok((data, params, lin))
 }
 
@@ -321,6 +332,17 @@ fn push_notes(
         samples.len(),
         opts.beam_deg.round().rem_euclid(360.0)
     ));
+    if !opts.priors.is_empty() {
+        let list: Vec<String> = opts.priors.list().iter().map(ToString::to_string).collect();
+        notes.push(format!("priors (MAP-EM): {}", list.join(", ")));
+    }
+    if opts.estimates_speed_scale() {
+        notes.push(format!(
+            "the commands' speed scale: {:.4} (estimated: a prior pins a sensor's scale, so a \
+             speed error of the drive is told from the sensors' scales)",
+            params.speed_scale
+        ));
+    }
     if samples.turns {
         notes.push(
             "warning: the commands turn the robot; EM assumes motion along a line".to_string(),

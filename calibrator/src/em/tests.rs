@@ -2,8 +2,11 @@
 
 use nalgebra::Vector2;
 
-use super::model::{Data, EmModel, Lin, Params, SensorParams, StepData, LIDAR, ODOMETER, SONAR};
+use super::model::{
+    Data, EmModel, Free, Lin, Params, SensorParams, StepData, LIDAR, ODOMETER, SONAR,
+};
 use super::mstep;
+use super::prior::Priors;
 use crate::kalman_smoother::RtsSmoother;
 
 /// A deterministic standard normal sequence (Box–Muller on a 64-bit LCG), so that the
@@ -39,6 +42,7 @@ fn the_paper_m_step_is_exact_em_for_the_frozen_model() {
             SensorParams::paper(SONAR),
         ],
         q_rel: 0.01,
+        speed_scale: 1.0,
     };
     params.sensors[LIDAR].active = true;
     params.sensors[ODOMETER].active = true;
@@ -70,7 +74,16 @@ fn the_paper_m_step_is_exact_em_for_the_frozen_model() {
         covs: &zeros,
         lag_one: &zeros,
     };
-    params = mstep::m_step(&data, &params, &init, &lin, false, false).unwrap();
+    params = mstep::m_step(
+        &data,
+        &params,
+        &init,
+        &lin,
+        false,
+        Free::default(),
+        &Priors::default(),
+    )
+    .unwrap();
     let mut smoother = RtsSmoother::<2>::new();
     fn model<'a>(data: &'a Data, params: &'a Params, lin: &'a [Lin]) -> EmModel<'a> {
         EmModel {
@@ -88,7 +101,16 @@ fn the_paper_m_step_is_exact_em_for_the_frozen_model() {
             covs: smoother.smoothed_covs(),
             lag_one: smoother.lag_one_covs(),
         };
-        let next = mstep::m_step(&data, &params, &post, &lin, false, false).unwrap();
+        let next = mstep::m_step(
+            &data,
+            &params,
+            &post,
+            &lin,
+            false,
+            Free::default(),
+            &Priors::default(),
+        )
+        .unwrap();
         let ll_next = smoother.run(&model(&data, &next, &lin)).unwrap();
         // Rounding: ~1e-13 relative per operation over a few thousand.
         assert!(
@@ -110,16 +132,25 @@ fn the_paper_m_step_is_exact_em_for_the_frozen_model() {
             covs: smoother.smoothed_covs(),
             lag_one: smoother.lag_one_covs(),
         };
-        params = mstep::m_step(&data, &params, &post, &lin, false, false).unwrap();
+        params = mstep::m_step(
+            &data,
+            &params,
+            &post,
+            &lin,
+            false,
+            Free::default(),
+            &Priors::default(),
+        )
+        .unwrap();
         ll = smoother.run(&model(&data, &params, &lin)).unwrap();
     }
     let mut flat = Vec::new();
-    params.flat(false, &mut flat);
+    params.flat(Free::default(), &mut flat);
     for i in 0..flat.len() {
         for sign in [-1.0, 1.0] {
             let mut moved = flat.clone();
             moved[i] += sign * (1e-3 * flat[i].abs()).max(1e-6);
-            let p = params.with_flat(false, &moved).unwrap();
+            let p = params.with_flat(Free::default(), &moved).unwrap();
             let ll_moved = smoother.run(&model(&data, &p, &lin)).unwrap();
             assert!(
                 ll_moved <= ll + 1e-9 * ll.abs(),
@@ -138,18 +169,23 @@ fn parameters_round_trip_through_their_flat_form() {
             SensorParams::paper(SONAR),
         ],
         q_rel: 0.02,
+        speed_scale: 1.0,
     };
     p.sensors[LIDAR].active = true;
     p.sensors[LIDAR].beta[2] = 0.004;
     p.sensors[SONAR].active = true;
     p.sensors[SONAR].beta[0] = 0.008;
     let mut flat = Vec::new();
-    p.flat(true, &mut flat);
+    let with_q = Free {
+        q: true,
+        speed_scale: false,
+    };
+    p.flat(with_q, &mut flat);
     assert_eq!(flat.len(), 3 + 1 + 2 + 1 + 1);
-    assert_eq!(p.with_flat(true, &flat), Some(p));
+    assert_eq!(p.with_flat(with_q, &flat), Some(p));
     flat[3] = -1.0;
     assert_eq!(
-        p.with_flat(true, &flat),
+        p.with_flat(with_q, &flat),
         None,
         "a negative noise level is outside"
     );

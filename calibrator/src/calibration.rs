@@ -17,6 +17,26 @@ pub struct SensorModel {
     pub alpha: Vec<f64>,
     /// Noise coefficients beta_0..
     pub beta: Vec<f64>,
+    /// One standard error per alpha coefficient (each method's own: see its docs); empty when
+    /// unknown (a model read back from JSON without them).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub alpha_sd: Vec<f64>,
+    /// One standard error per beta coefficient (0 for a coefficient the method holds at 0).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub beta_sd: Vec<f64>,
+}
+
+impl SensorModel {
+    /// A model whose standard errors are not known.
+    #[must_use]
+    pub fn without_sd(alpha: Vec<f64>, beta: Vec<f64>) -> Self {
+        Self {
+            alpha,
+            beta,
+            alpha_sd: Vec::new(),
+            beta_sd: Vec::new(),
+        }
+    }
 }
 
 /// Distance-estimate quality against the truth, when the recording has truth.

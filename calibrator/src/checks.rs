@@ -363,15 +363,9 @@ mod tests {
 
     #[test]
     fn the_emitted_bias_of_a_wrong_start_fails_plausibility() {
-        let garbage = SensorModel {
-            alpha: vec![-1.68, 1.84, -0.07],
-            beta: vec![0.0, 0.0, 0.015],
-        };
+        let garbage = SensorModel::without_sd(vec![-1.68, 1.84, -0.07], vec![0.0, 0.0, 0.015]);
         assert!(bias_plausible("lidar", &garbage).iter().all(|c| !c.pass));
-        let xv11 = SensorModel {
-            alpha: vec![0.0525, 0.8838, 0.0584],
-            beta: vec![0.0, 0.0, 0.004],
-        };
+        let xv11 = SensorModel::without_sd(vec![0.0525, 0.8838, 0.0584], vec![0.0, 0.0, 0.004]);
         assert!(bias_plausible("lidar", &xv11).iter().all(|c| c.pass));
     }
 }

@@ -32,8 +32,8 @@ impl Calibration {
                 s,
                 "  {:<9} alpha {}  beta {}",
                 format!("{sensor:?}").to_lowercase(),
-                coefficients(&model.alpha),
-                coefficients(&model.beta)
+                coefficients(&model.alpha, &model.alpha_sd),
+                coefficients(&model.beta, &model.beta_sd)
             )?;
         }
         if let Some(order) = self.order {
@@ -121,10 +121,7 @@ impl Calibration {
                         ))
                     })
             };
-            let model = SensorModel {
-                alpha: coeffs("alpha")?,
-                beta: coeffs("beta")?,
-            };
+            let model = SensorModel::without_sd(coeffs("alpha")?, coeffs("beta")?);
             sensors.insert(sensor, model);
         }
         Ok(Calibration {
@@ -141,7 +138,15 @@ impl Calibration {
     }
 }
 
-fn coefficients(c: &[f64]) -> String {
-    let parts: Vec<String> = c.iter().map(|v| format!("{v:.5}")).collect();
+/// `[a, b]`, or `[a ± sa, b ± sb]` with standard errors (a coefficient held at 0 has none).
+fn coefficients(c: &[f64], sd: &[f64]) -> String {
+    let parts: Vec<String> = c
+        .iter()
+        .enumerate()
+        .map(|(i, v)| match sd.get(i) {
+            Some(sd) if *sd > 0.0 => format!("{v:.5} ± {sd:.5}"),
+            _ => format!("{v:.5}"),
+        })
+        .collect();
     format!("[{}]", parts.join(", "))
 }

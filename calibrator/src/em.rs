@@ -35,6 +35,7 @@ mod engine;
 mod estep;
 mod estimate;
 pub mod experiment;
+mod information;
 mod model;
 mod mstep;
 mod options;

@@ -96,6 +96,12 @@ pub struct PolyFit {
     pub aic: f64,
     /// Number of samples.
     pub n: usize,
+    /// Standard errors of `alpha`: `β (Φᵀ W Φ)^(−½)` diagonal, the weighted least-squares
+    /// covariance `β² (Φᵀ W Φ)⁻¹` (exact for Gaussian noise of known shape, the distances known).
+    pub alpha_sd: Vec<f64>,
+    /// Standard error of `beta`: `β / √(2N)`, the ML estimate's asymptotic sd (Fisher
+    /// information of a Gaussian sd: 2N/β²).
+    pub beta_sd: f64,
 }
 
 impl PolyFit {
@@ -110,9 +116,13 @@ impl PolyFit {
     pub fn model(&self) -> SensorModel {
         let mut beta = vec![0.0; self.noise_power + 1];
         beta[self.noise_power] = self.beta;
+        let mut beta_sd = vec![0.0; self.noise_power + 1];
+        beta_sd[self.noise_power] = self.beta_sd;
         SensorModel {
             alpha: self.alpha.clone(),
             beta,
+            alpha_sd: self.alpha_sd.clone(),
+            beta_sd,
         }
     }
 }
@@ -181,6 +191,19 @@ pub fn fit_ml(
         0.0
     };
     let nf = n as f64;
+    // (Φᵀ W Φ)⁻¹ = V Σ⁻² Vᵀ from the weighted design's SVD.
+    let v_t = svd
+        .v_t
+        .as_ref()
+        .ok_or_else(|| CalibrationError::Unidentifiable("the design's SVD has no V".into()))?;
+    let alpha_sd: Vec<f64> = (0..=order)
+        .map(|i| {
+            let var: f64 = (0..svd.singular_values.len())
+                .map(|j| (v_t[(j, i)] / svd.singular_values[j]).powi(2))
+                .sum();
+            (beta2 * var).sqrt()
+        })
+        .collect();
     let log_likelihood =
         -0.5 * (nf * (LN_2PI + beta2.ln()) + 2.0 * noise_power as f64 * sum_ln_d + nf);
     Ok(PolyFit {
@@ -190,6 +213,8 @@ pub fn fit_ml(
         log_likelihood,
         aic: 2.0 * (order as f64 + 2.0) - 2.0 * log_likelihood,
         n,
+        alpha_sd,
+        beta_sd: (beta2 / (2.0 * nf)).sqrt(),
     })
 }
 

@@ -201,10 +201,7 @@ fn smoothing_rejects_calibrations_it_cannot_use() {
     let mut quartic = trained.clone();
     quartic.sensors.insert(
         Sensor::Lidar,
-        SensorModel {
-            alpha: vec![0.05, 0.9, 0.05, 0.001, 0.0001],
-            beta: vec![0.0, 0.0, 0.004],
-        },
+        SensorModel::without_sd(vec![0.05, 0.9, 0.05, 0.001, 0.0001], vec![0.0, 0.0, 0.004]),
     );
     let err = smoothing::smooth(&rec, &quartic, &EmOptions::default()).expect_err("fails");
     assert!(matches!(err, CalibrationError::Invalid(_)), "{err}");

@@ -8,6 +8,7 @@ use nalgebra::Vector2;
 use super::engine::Engine;
 use super::estep::{build_data, e_step};
 use super::estimate::{estimates, Estimate};
+use super::information;
 use super::model::{Data, Free, Lin, Params, SensorParams, LIDAR, ODOMETER, SONAR};
 use super::mstep;
 use super::options::{EmOptions, MIN_LIDAR_READINGS, MIN_SPAN_M};
@@ -81,7 +82,15 @@ pub fn run_samples(
             ..m
         })
     });
-    let sensors = sensor_models(&fit.params);
+    let standard_errors = information::standard_errors(&data, &fit.params, &fit.lin, opts);
+    if standard_errors.is_none() {
+        notes.push(
+            "standard errors unavailable: the observed information is not positive definite \
+             (a parameter the data does not determine)"
+                .into(),
+        );
+    }
+    let sensors = sensor_models(&fit.params, standard_errors.as_deref());
     let mut checks = Vec::new();
     for (sensor, model) in &sensors {
         checks.extend(checks::bias_plausible(sensor.name(), model));
@@ -250,6 +259,8 @@ struct Fit {
     ll: f64,
     /// The smoother after that E-step (the smoothed distances under the final parameters).
     smoother: RtsSmoother<2>,
+    /// The linearisation of that E-step.
+    lin: Vec<Lin>,
     log_likelihoods: Vec<f64>,
 }
 
@@ -287,6 +298,7 @@ fn iterate(
     let Engine {
         smoother,
         log_likelihoods,
+        lin,
         ..
     } = engine;
     Ok(Fit {
@@ -295,6 +307,7 @@ fn iterate(
         iterations,
         ll,
         smoother,
+        lin,
         log_likelihoods,
     })
 }
@@ -350,23 +363,28 @@ fn push_notes(
     }
 }
 
-/// The active sensors' models in the interface's form.
-fn sensor_models(params: &Params) -> BTreeMap<Sensor, SensorModel> {
+/// The active sensors' models in the interface's form, with their standard errors (`sds`, in
+/// the order of [`Params::flat`]) when known.
+fn sensor_models(params: &Params, sds: Option<&[f64]>) -> BTreeMap<Sensor, SensorModel> {
     let mut out = BTreeMap::new();
+    let mut next = sds.map(|s| s.iter().copied());
     for (slot, sensor) in [Sensor::Lidar, Sensor::Odometer, Sensor::Sonar]
         .into_iter()
         .enumerate()
     {
         let p = &params.sensors[slot];
-        if p.active {
-            out.insert(
-                sensor,
-                SensorModel {
-                    alpha: p.alpha[..p.n_alpha].to_vec(),
-                    beta: p.beta[..=p.power].to_vec(),
-                },
-            );
+        if !p.active {
+            continue;
         }
+        let mut model =
+            SensorModel::without_sd(p.alpha[..p.n_alpha].to_vec(), p.beta[..=p.power].to_vec());
+        if let Some(it) = next.as_mut() {
+            model.alpha_sd = it.by_ref().take(p.n_alpha).collect();
+            // Only beta[power] is fitted; the lower coefficients are held at 0.
+            model.beta_sd = vec![0.0; p.power + 1];
+            model.beta_sd[p.power] = it.next().unwrap_or(f64::NAN);
+        }
+        out.insert(sensor, model);
     }
     out
 }

@@ -17,6 +17,7 @@ use super::estimate::{Estimate, Observation, ObservationSet};
 use super::options::Options;
 use super::scan::{average_stop, StopScan};
 use super::stops::{find_stops, Stop};
+use crate::landmarks::regression::beta_sd;
 use crate::stats::median;
 use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
 use hilsim_recording::Pose;
@@ -103,8 +104,13 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
     sensors_out.insert(
         Sensor::Lidar,
         SensorModel {
+            beta_sd: beta_sd(
+                &reading_distances(&set, &est.used, &model.distances),
+                &model.beta,
+            ),
             alpha: model.alpha,
             beta: model.beta,
+            alpha_sd: model.alpha_sd,
         },
     );
     let mut checks = super::checks::landmark_checks(&set, &est.used, &model.positions);
@@ -134,6 +140,18 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         truth_distances: truth,
         calibration,
     })
+}
+
+/// One distance per reading behind the used observations (an averaged range stands for its
+/// `count` readings), as the noise polynomial was fitted.
+fn reading_distances(set: &ObservationSet, used: &[usize], distances: &[f64]) -> Vec<f64> {
+    used.iter()
+        .zip(distances)
+        .flat_map(|(&i, &d)| {
+            let count = set.observations.get(i).map_or(1, |o| o.count.max(1));
+            std::iter::repeat_n(d, count)
+        })
+        .collect()
 }
 
 /// Check the lidar: readings present and in time order.

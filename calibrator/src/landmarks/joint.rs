@@ -75,6 +75,10 @@ pub struct JointSolution {
     /// Covariance of each landmark centre, (JᵀJ)⁻¹ at the solution (the weights being inverse
     /// variances), m².
     pub landmark_cov: Vec<[[f64; 2]; 2]>,
+    /// Standard errors of α: the square roots of (JᵀJ)⁻¹'s α block, scaled by the residual
+    /// variance per degree of freedom (cost / (m − n); about 1 when the weights are right), so
+    /// they carry the landmarks' and the stops' uncertainty (infinite when JᵀJ is singular).
+    pub alpha_sd: Vec<f64>,
 }
 
 impl JointProblem {
@@ -248,7 +252,17 @@ impl JointProblem {
         }
         let (landmarks, stops, alpha) = self.unpack(&p);
         let info = jac.transpose() * &jac;
-        let landmark_cov = match info.try_inverse() {
+        let inverse = info.clone().try_inverse();
+        let dof = m.saturating_sub(np).max(1) as f64;
+        let alpha_sd = (0..alpha.len())
+            .map(|i| {
+                let j = 2 * l + 2 * k + i;
+                inverse.as_ref().map_or(f64::INFINITY, |inv| {
+                    (inv[(j, j)] * cost / dof).max(0.0).sqrt()
+                })
+            })
+            .collect();
+        let landmark_cov = match inverse {
             Some(inv) => (0..l)
                 .map(|i| {
                     let j = 2 * i;
@@ -268,6 +282,7 @@ impl JointProblem {
             converged,
             cost: (cost0, cost),
             landmark_cov,
+            alpha_sd,
         })
     }
 }

@@ -182,6 +182,52 @@ pub fn nnls(x: &[Vec<f64>], y: &[f64], w: Option<&[f64]>) -> Option<Vec<f64>> {
     best.map(|(_, c)| c)
 }
 
+/// Standard errors of the coefficients of a least-squares polynomial of `order` through points
+/// at `x` with residuals `e`: `s² (ΦᵀΦ)⁻¹` diagonal, `s² = Σ e² / (N − order − 1)`. The `x` are
+/// taken as known, so for estimated distances this is a lower bound.
+#[must_use]
+pub fn coefficient_sd(x: &[f64], e: &[f64], order: usize) -> Vec<f64> {
+    let p = order + 1;
+    let n = x.len().min(e.len());
+    if n <= p {
+        return vec![f64::INFINITY; p];
+    }
+    let phi = nalgebra::DMatrix::from_fn(n, p, |i, j| x[i].powi(j as i32));
+    let s2 = e[..n].iter().map(|v| v * v).sum::<f64>() / (n - p) as f64;
+    match (phi.transpose() * &phi).try_inverse() {
+        Some(inv) => (0..p).map(|j| (s2 * inv[(j, j)]).max(0.0).sqrt()).collect(),
+        None => vec![f64::INFINITY; p],
+    }
+}
+
+/// Standard errors of [`fit_beta`]'s coefficients: its weighted regression of `√(π/2)|e|` on
+/// the Vandermonde rows at `d` (one row per reading), whose responses have variance
+/// `(π/2 − 1) σ(d)²` for Gaussian noise, so `cov = (π/2 − 1) (Rᵀ W R)⁻¹`, `W = 1/σ̂(d)²`.
+/// (The non-negativity constraint is ignored: a coefficient at 0 gets the unconstrained sd.)
+#[must_use]
+pub fn beta_sd(d: &[f64], beta: &[f64]) -> Vec<f64> {
+    let p = beta.len();
+    if d.len() <= p || p == 0 {
+        return vec![f64::INFINITY; p];
+    }
+    let mut info = nalgebra::DMatrix::<f64>::zeros(p, p);
+    for &x in d {
+        let w = 1.0 / horner(beta, x).max(1e-6).powi(2);
+        for i in 0..p {
+            for j in 0..p {
+                info[(i, j)] += w * x.powi((i + j) as i32);
+            }
+        }
+    }
+    let factor = std::f64::consts::FRAC_PI_2 - 1.0;
+    match info.try_inverse() {
+        Some(inv) => (0..p)
+            .map(|j| (factor * inv[(j, j)]).max(0.0).sqrt())
+            .collect(),
+        None => vec![f64::INFINITY; p],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

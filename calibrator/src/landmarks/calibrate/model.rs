@@ -7,6 +7,7 @@ use crate::landmarks::estimate::{
 };
 use crate::landmarks::options::{Estimator, Options, OrderSelection};
 use crate::landmarks::positions::{PositionError, MIN_BEARING_SPREAD_RAD};
+use crate::landmarks::regression::coefficient_sd;
 use crate::CalibrationError;
 
 /// The model the calibration reports, with the figures that go with it.
@@ -25,6 +26,9 @@ pub(super) struct Model {
     pub iterations: usize,
     /// Whether the joint refinement converged (true without it).
     pub converged: bool,
+    /// Standard errors of α: the joint refinement's (landmark and stop positions' uncertainty
+    /// included), else the regression's at the estimated distances (a lower bound).
+    pub alpha_sd: Vec<f64>,
 }
 
 /// Estimate: run the estimator on the observations, noting the landmarks dropped and the paper
@@ -102,6 +106,10 @@ pub(super) fn choose_model(est: &Estimate, opts: &Options, notes: &mut Vec<Strin
                     (1, false)
                 }
             };
+            let alpha_sd = match &r.joint {
+                Some(j) => j.alpha_sd.clone(),
+                None => stage_alpha_sd(&r.wls),
+            };
             Model {
                 order: r.wls.order,
                 alpha: r.alpha().to_vec(),
@@ -110,6 +118,7 @@ pub(super) fn choose_model(est: &Estimate, opts: &Options, notes: &mut Vec<Strin
                 distances: r.distances.clone(),
                 iterations,
                 converged,
+                alpha_sd,
             }
         }
         _ => Model {
@@ -120,7 +129,16 @@ pub(super) fn choose_model(est: &Estimate, opts: &Options, notes: &mut Vec<Strin
             distances: est.paper.distances.clone(),
             iterations: 1,
             converged: true,
+            alpha_sd: stage_alpha_sd(&est.paper),
         },
+    }
+}
+
+/// A stage's α standard errors from its regression's residuals at its distances.
+fn stage_alpha_sd(stage: &crate::landmarks::estimate::Stage) -> Vec<f64> {
+    match stage.scan.fits.get(stage.order) {
+        Some(fit) => coefficient_sd(&stage.distances, &fit.residuals, stage.order),
+        None => vec![f64::INFINITY; stage.alpha.len()],
     }
 }
 

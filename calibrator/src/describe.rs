@@ -68,9 +68,18 @@ impl Calibration {
                 )?;
             }
         }
-        for check in &self.checks {
-            let verdict = if check.pass { "ok" } else { "FAILED" };
-            writeln!(s, "  check {verdict}: {}: {}", check.name, check.detail)?;
+        // The passed checks in one line, each failed one with what it means.
+        let passed: Vec<&str> = self
+            .checks
+            .iter()
+            .filter(|c| c.pass)
+            .map(|c| c.name.as_str())
+            .collect();
+        if !passed.is_empty() {
+            writeln!(s, "  checks passed: {}", passed.join(", "))?;
+        }
+        for check in self.checks.iter().filter(|c| !c.pass) {
+            writeln!(s, "  check FAILED: {}: {}", check.name, check.detail)?;
         }
         for note in &self.notes {
             writeln!(s, "  note: {note}")?;

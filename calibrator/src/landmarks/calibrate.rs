@@ -179,15 +179,9 @@ fn stand_still_stops(
 ) -> Result<Vec<Stop>, CalibrationError> {
     let (stops, report) = find_stops(rec, &opts.stops)?;
     for (t, v) in &report.moving {
-        notes.push(match v {
-            Some(v) => format!(
-                "warning: stop at t = {t:.2} s skipped: the odometry shows motion ({v:.3} m/s)"
-            ),
-            None => format!(
-                "warning: stop at t = {t:.2} s skipped: the odometry shows the wheels never \
-                 stopped"
-            ),
-        });
+        notes.push(format!(
+            "warning: stop at t = {t:.2} s skipped: the odometry shows motion ({v:.3} m/s)"
+        ));
     }
     for (t, revolutions) in &report.too_short {
         notes.push(format!(

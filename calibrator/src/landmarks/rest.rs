@@ -76,8 +76,10 @@ pub fn revolution_period_s(lidar: &[LidarSample]) -> f64 {
     crate::stats::median(&mut periods)
 }
 
-/// When the robot came to rest in the zero-command interval `[t0, t1]`, and how that was found;
-/// `None` when dense odometry shows the wheels never stopped in it.
+/// When the robot came to rest in the zero-command interval `[t0, t1]`, and how that was found.
+/// Dense odometry that never shows the wheels stopped (noisy encoders, a short stop) leaves the
+/// answer to the scans; whether the robot really stood is the stop finder's own test over the
+/// whole window.
 #[must_use]
 pub fn rest_start(
     (t0, t1): (f64, f64),
@@ -85,24 +87,26 @@ pub fn rest_start(
     still_speed_mps: f64,
     odometry: Option<&[OdometrySample]>,
     lidar: Option<&[LidarSample]>,
-) -> Option<(f64, RestFrom)> {
+) -> (f64, RestFrom) {
     if let Some(settle) = settle_s {
-        return Some((t0 + settle, RestFrom::Given));
+        return (t0 + settle, RestFrom::Given);
     }
-    if let Some(odo) = odometry.filter(|o| is_dense(o, t0, t1)) {
-        return odo
-            .iter()
+    let from_odometry = odometry.filter(|o| is_dense(o, t0, t1)).and_then(|odo| {
+        odo.iter()
             .filter(|s| s.t_s >= t0 && s.t_s < t1)
             .find(|s| {
                 let window = (s.t_s, (s.t_s + SPEED_WINDOW_S).min(t1));
                 wheel_speed(odo, window).is_some_and(|v| v <= still_speed_mps)
             })
-            .map(|s| (s.t_s, RestFrom::Odometry));
+            .map(|s| (s.t_s, RestFrom::Odometry))
+    });
+    if let Some(rest) = from_odometry {
+        return rest;
     }
     if let Some(t) = lidar.and_then(|l| scans_settle(l, t0, t1)) {
-        return Some((t, RestFrom::ScanStability));
+        return (t, RestFrom::ScanStability);
     }
-    Some((t0 + DEFAULT_SETTLE_S, RestFrom::DefaultSettling))
+    (t0 + DEFAULT_SETTLE_S, RestFrom::DefaultSettling)
 }
 
 /// Whether the odometry has at least three readings in `[t0, t1]`, at most
@@ -254,7 +258,7 @@ mod tests {
             let drift = 0.15 * (t.min(1.5) - 1.0).max(0.0);
             2.0 + drift * f64::from(a).to_radians().cos() + noise(t, a, 0.004)
         });
-        let (t, from) = rest_start((1.0, 3.0), None, 0.01, None, Some(&l)).unwrap();
+        let (t, from) = rest_start((1.0, 3.0), None, 0.01, None, Some(&l));
         assert_eq!(from, RestFrom::ScanStability);
         assert!((1.4..=1.81).contains(&t), "{t}");
     }
@@ -263,7 +267,7 @@ mod tests {
     #[test]
     fn a_robot_already_at_rest_is_used_from_the_first_whole_revolution() {
         let l = lidar(0.0, 2.0, |t, a| 2.0 + noise(t, a, 0.004));
-        let (t, from) = rest_start((1.0, 2.0), None, 0.01, None, Some(&l)).unwrap();
+        let (t, from) = rest_start((1.0, 2.0), None, 0.01, None, Some(&l));
         assert_eq!(from, RestFrom::ScanStability);
         assert!((1.0..=1.2).contains(&t), "{t}");
     }
@@ -282,23 +286,26 @@ mod tests {
                 }
             })
             .collect();
-        let (t, from) = rest_start((1.0, 3.0), None, 0.01, Some(&odo), None).unwrap();
+        let (t, from) = rest_start((1.0, 3.0), None, 0.01, Some(&odo), None);
         assert_eq!(from, RestFrom::Odometry);
         // Within the speed window's reach of the stop (3 mm of travel left at most).
         assert!((1.35..=1.41).contains(&t), "{t}");
-        // Never at rest in the interval: none.
-        assert!(rest_start((0.5, 1.3), None, 0.01, Some(&odo), None).is_none());
+        // Never at rest in the interval: left to the scans (here none: the default).
+        assert_eq!(
+            rest_start((0.5, 1.3), None, 0.01, Some(&odo), None).1,
+            RestFrom::DefaultSettling
+        );
     }
 
     #[test]
     fn a_given_settling_time_wins_and_nothing_falls_back_to_the_default() {
         assert_eq!(
             rest_start((1.0, 3.0), Some(0.5), 0.01, None, None),
-            Some((1.5, RestFrom::Given))
+            (1.5, RestFrom::Given)
         );
         assert_eq!(
             rest_start((1.0, 3.0), None, 0.01, None, None),
-            Some((1.0 + DEFAULT_SETTLE_S, RestFrom::DefaultSettling))
+            (1.0 + DEFAULT_SETTLE_S, RestFrom::DefaultSettling)
         );
     }
 }

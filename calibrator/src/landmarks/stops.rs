@@ -33,9 +33,8 @@ pub struct Stop {
 /// What the stop finder saw besides the stops, for the notes.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct StopReport {
-    /// Candidate stops dropped because the odometry showed motion: their start and the speed
-    /// (`None`: the wheels never stopped in the interval).
-    pub moving: Vec<(f64, Option<f64>)>,
+    /// Candidate stops dropped because the odometry showed motion: their start and the speed.
+    pub moving: Vec<(f64, f64)>,
     /// Candidate stops dropped for holding too few revolutions at rest: the interval's start and
     /// the revolutions it held.
     pub too_short: Vec<(f64, f64)>,
@@ -83,8 +82,8 @@ pub fn find_stops(
     let mut stops = Vec::new();
     for (t0, t1, moved_before) in intervals {
         // Intervals found in the odometry are at rest from their start.
-        let rest = if rec.commands.is_empty() {
-            Some((t0, RestFrom::Odometry))
+        let (a, rest_from) = if rec.commands.is_empty() {
+            (t0, RestFrom::Odometry)
         } else {
             rest_start(
                 (t0, t1),
@@ -93,10 +92,6 @@ pub fn find_stops(
                 odometry,
                 lidar,
             )
-        };
-        let Some((a, rest_from)) = rest else {
-            report.moving.push((t0, None));
-            continue;
         };
         let b = t1;
         let revolutions = (b - a) / report.revolution_s;
@@ -107,7 +102,7 @@ pub fn find_stops(
         }
         if let Some(odo) = odometry {
             if let Some(speed) = wheel_speed(odo, (a, b)).filter(|v| *v > opts.still_speed_mps) {
-                report.moving.push((a, Some(speed)));
+                report.moving.push((a, speed));
                 continue;
             }
         }

@@ -395,6 +395,8 @@ fn issue_16_a_prior_on_the_sonar_scale_recovers_the_lidar_model() {
     let (without, _) = ratio(&[]);
     let (with, v) = ratio(&["--prior", "sonar.alpha1=1.028±0.003"]);
     assert!(with >= 1.5 * without && with >= 50.0, "{without} -> {with}");
+    // q and the speed scale estimated together still converge (they once crept along a ridge).
+    assert_eq!(v["converged"], true, "{v}");
     let notes = v["notes"].to_string();
     assert!(notes.contains("the commands' speed scale"), "{notes}");
     assert!(notes.contains("sonar.alpha1=1.028±0.003"), "{notes}");

@@ -57,7 +57,7 @@ pub(crate) fn m_step(
         fit_sensor(sensor, slot, &sums, priors)?;
     }
     if free.q {
-        next.q_rel = q_step(data, post, params.q_rel)?;
+        next.q_rel = q_step(data, post, params.q_rel, params.speed_scale)?;
     }
     if free.speed_scale {
         next.speed_scale = speed_scale_step(data, post, params)?;
@@ -285,16 +285,23 @@ fn fit_sensor(
 }
 
 /// The M-step for `q` in `σ_k = q |u_k|` (Shumway–Stoffer's `Q` update, restricted to this
-/// structure): `q² = mean over moving steps of (E[(d_{k+1} − d_k − u_k)²] − f²) / u_k²`, where
+/// structure): `q² = mean over moving steps of (E[(d_{k+1} − d_k − u_k)²] − f²) / u_k²`, with
+/// `u_k` the commanded motion at the speed scale (`s u_k`: the motion the model expects), where
 /// the expectation needs the lag-one covariance:
 /// `E[(Δ)²] = (m_{k+1} − m_k − u_k)² + P_{k+1} + P_k − 2 P_{k+1,k}`. The floor `f²` is
 /// subtracted so that it is not counted twice; this is the exact M-step when every `|u_k|` is
 /// equal (constant speed, the paper's runs) and a moment estimate otherwise.
-fn q_step(data: &Data, post: &Posterior<'_>, previous: f64) -> Result<f64, CalibrationError> {
+fn q_step(
+    data: &Data,
+    post: &Posterior<'_>,
+    previous: f64,
+    speed_scale: f64,
+) -> Result<f64, CalibrationError> {
     let f2 = FLOOR_D_M * FLOOR_D_M;
     let (mut sum, mut count) = (0.0, 0usize);
     for k in 0..data.steps.len().saturating_sub(1) {
-        let u = data.steps[k].u;
+        // The motion the model expects: the command at the speed scale.
+        let u = speed_scale * data.steps[k].u;
         // Steps shorter than the floor carry no information about a speed-scale error.
         if u.abs() < 10.0 * FLOOR_D_M {
             continue;

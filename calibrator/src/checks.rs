@@ -295,6 +295,19 @@ fn quadratic_r2(pairs: &[(f64, f64)]) -> Option<f64> {
 /// noise model is off by a factor √2 or more.
 pub const INNOVATION_SIZE: [f64; 2] = [0.5, 2.0];
 
+/// The lidar's standardised innovations are of the fitted size and white (EM and `smooth`).
+#[must_use]
+pub fn lidar_innovations(standardised: &[f64]) -> Vec<Check> {
+    innovations_sized("lidar.innovation_size", standardised)
+        .into_iter()
+        .chain(white(
+            "lidar.innovations_white",
+            "lidar's standardised innovations",
+            standardised,
+        ))
+        .collect()
+}
+
 /// The innovations are of the fitted size: the mean of ν²/S.
 #[must_use]
 pub fn innovations_sized(name: &str, standardised: &[f64]) -> Option<Check> {

@@ -160,15 +160,7 @@ fn smooth_samples_checked(
         checks::target_follows_commands(&samples.commanded_m, &samples.lidar_m)
             .into_iter()
             .collect();
-    checks.extend(checks::innovations_sized(
-        "lidar.innovation_size",
-        &innovations,
-    ));
-    checks.extend(checks::white(
-        "lidar.innovations_white",
-        "lidar's standardised innovations",
-        &innovations,
-    ));
+    checks.extend(checks::lidar_innovations(&innovations));
     Ok((em::estimates(samples, &smoother), checks))
 }
 

@@ -100,15 +100,7 @@ pub fn run_samples(
         &samples.lidar_m,
     ));
     let innovations = lidar_innovations(&data, &fit.params, &fit.smoother, opts);
-    checks.extend(checks::innovations_sized(
-        "lidar.innovation_size",
-        &innovations,
-    ));
-    checks.extend(checks::white(
-        "lidar.innovations_white",
-        "lidar's standardised innovations",
-        &innovations,
-    ));
+    checks.extend(checks::lidar_innovations(&innovations));
     let calibration = Calibration {
         method: Method::Em,
         sensors,

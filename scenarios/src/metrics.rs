@@ -3,8 +3,9 @@
 
 use std::collections::BTreeMap;
 
+use hilsim_hil::hil_run::HilReport;
 use hilsim_lidar_emulator::Run;
-use hilsim_sim::scenario::Expect;
+use hilsim_sim::scenario::{self, Expect, ExpectWhen};
 
 /// Metric name → value. Only metrics that could be computed are present.
 pub type Metrics = BTreeMap<String, f64>;
@@ -131,8 +132,12 @@ pub struct Outcome {
     pub at_least: Option<f64>,
     /// The assertion's upper bound.
     pub at_most: Option<f64>,
-    /// Whether the value was computed and within the bounds.
+    /// Whether the value was computed and within the bounds (true when skipped).
     pub passed: bool,
+    /// Why the assertion was not checked in this kind of run, when it was not: a metric of
+    /// another kind (a firmware's session under `run`, a calibration under `hil`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skipped: Option<&'static str>,
 }
 
 impl Outcome {
@@ -146,6 +151,13 @@ impl Outcome {
         .into_iter()
         .flatten()
         .collect();
+        if let Some(why) = self.skipped {
+            return format!(
+                "SKIP {} (expected {}): {why}",
+                self.metric,
+                bounds.join(" and ")
+            );
+        }
         let value = self
             .value
             .map_or_else(|| "not computed".to_string(), |v| format!("{v:.6}"));
@@ -158,23 +170,95 @@ impl Outcome {
     }
 }
 
-/// Checks every assertion; a metric that was not computed fails its assertion.
+/// The kind of run an assertion is checked in: each skips the metrics of the other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunKind {
+    /// `hilsim run` and `scenario test`: the drive program, then the calibrations.
+    Scripted,
+    /// `hilsim hil`: a firmware drives; there is no calibration.
+    FirmwareInTheLoop,
+}
+
+impl RunKind {
+    /// Why the assertion `e` is not checked in this kind of run, if it is not.
+    fn skips(self, e: &Expect) -> Option<&'static str> {
+        let metric = e.metric.as_str();
+        match (self, e.when) {
+            (Self::Scripted, ExpectWhen::Hil) => {
+                return Some("`when = \"hil\"`: checked under `hilsim hil`")
+            }
+            (Self::FirmwareInTheLoop, ExpectWhen::Run) => {
+                return Some("`when = \"run\"`: checked under `hilsim run` and `scenario test`")
+            }
+            _ => {}
+        }
+        match self {
+            Self::Scripted if scenario::metrics::is_hil(metric) => {
+                Some("a firmware's session metric; checked under `hilsim hil`")
+            }
+            Self::FirmwareInTheLoop if scenario::metrics::is_calibration(metric) => {
+                Some("a calibration metric; `hilsim hil` runs no calibration")
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Checks every assertion; a metric that was not computed fails its assertion, unless it
+/// belongs to another kind of run (then the assertion is skipped, and says so).
 #[must_use]
-pub fn check(expects: &[Expect], metrics: &Metrics) -> Vec<Outcome> {
+pub fn check(expects: &[Expect], metrics: &Metrics, kind: RunKind) -> Vec<Outcome> {
     expects
         .iter()
         .map(|e| {
+            let skipped = kind.skips(e);
             let value = metrics.get(&e.metric).copied();
-            let passed = value.is_some_and(|v| {
-                e.at_least.is_none_or(|lo| v >= lo) && e.at_most.is_none_or(|hi| v <= hi)
-            });
+            let passed = skipped.is_some()
+                || value.is_some_and(|v| {
+                    e.at_least.is_none_or(|lo| v >= lo) && e.at_most.is_none_or(|hi| v <= hi)
+                });
             Outcome {
                 metric: e.metric.clone(),
                 value,
                 at_least: e.at_least,
                 at_most: e.at_most,
                 passed,
+                skipped,
             }
         })
         .collect()
+}
+
+/// Bytes of one revolution on the wire: 90 packets of 22 bytes (docs/formats/neato-xv11.md).
+const REVOLUTION_BYTES: u64 = 90 * 22;
+
+/// The metrics of a firmware-in-the-loop run: the run's own ([`of_run`]; its recording is the
+/// truth and what the sensors took) and the firmware's session ([`scenario::metrics::HIL_METRICS`]).
+#[must_use]
+pub fn of_hil(report: &HilReport) -> Metrics {
+    let mut m = of_run(&report.run);
+    let mut put = |name: &str, value: f64| {
+        if value.is_finite() {
+            m.insert(name.to_string(), value);
+        }
+    };
+    if let Some(read) = report.lidar_bytes_read {
+        put(
+            "hil.lidar_revolutions_read",
+            (read / REVOLUTION_BYTES) as f64,
+        );
+        put(
+            "hil.lidar_revolutions_dropped",
+            report.stream.revolutions_dropped as f64,
+        );
+    }
+    let c = &report.commands;
+    put("hil.requests", c.requests as f64);
+    put("hil.command_errors", c.errors as f64);
+    put("hil.set_motor", c.set_motor as f64);
+    put("hil.fault", f64::from(u8::from(report.fault().is_some())));
+    if let Some(code) = report.firmware.as_ref().and_then(|f| f.status.code()) {
+        put("hil.firmware_exit_code", f64::from(code));
+    }
+    m
 }

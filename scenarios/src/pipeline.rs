@@ -103,7 +103,7 @@ pub fn execute(scenario: Scenario, origin: &str, via: Via) -> Result<Report, Run
         metrics.extend(metrics::of_calibration(&calibration));
         calibrations.push(calibration);
     }
-    let outcomes = metrics::check(&scenario.expect, &metrics);
+    let outcomes = metrics::check(&scenario.expect, &metrics, metrics::RunKind::Scripted);
     Ok(Report {
         scenario,
         run,

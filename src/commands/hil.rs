@@ -1,9 +1,9 @@
 //! `hilsim hil SCENARIO --firmware 'CMD ARGS…' [--out DIR] [--duration S] [--watchdog S]
 //! [--seed N]`: firmware in the loop.
 //!
-//! Exit codes: 0 the run ended on time or the firmware exited with status 0; 1 a firmware fault
-//! (crash, hang, flood, lidar never read) or an interrupted run; 2 bad input, or the harness
-//! itself failed.
+//! Exit codes: 0 the run ended on time or the firmware exited with status 0, and every
+//! `[[expect]]` assertion held; 1 a firmware fault (crash, hang, flood, lidar never read), a
+//! failed assertion or an interrupted run; 2 bad input, or the harness itself failed.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -15,6 +15,7 @@ use std::time::Duration;
 use anyhow::{anyhow, bail, Context, Result};
 use hilsim_hil::firmware::{split_command_line, Firmware};
 use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
+use hilsim_scenarios::metrics;
 use hilsim_sim::scenario::MAX_RUN_S;
 use hilsim_sim::Scenario;
 
@@ -111,12 +112,37 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let report = hil_run::run(world, ports, Some(firmware), &config, &stop)
         .context("firmware in the loop")?;
     out.write_all(report.summary().as_bytes())?;
+    // The scenario's assertions, on the metrics a firmware's run has.
+    let outcomes = metrics::check(
+        &scenario.expect,
+        &metrics::of_hil(&report),
+        metrics::RunKind::FirmwareInTheLoop,
+    );
+    for outcome in &outcomes {
+        writeln!(out, "  {}", outcome.describe())?;
+    }
+    let failed: Vec<&str> = outcomes
+        .iter()
+        .filter(|o| !o.passed)
+        .map(|o| o.metric.as_str())
+        .collect();
+    if !failed.is_empty() {
+        writeln!(
+            out,
+            "{} of {} assertion(s) failed: {}",
+            failed.len(),
+            outcomes.len(),
+            failed.join(", ")
+        )?;
+    }
     if let Some(dir) = &args.out {
         report.run.recording.write_dir(dir)?;
         writeln!(out, "wrote {}", dir.display())?;
     }
     Ok(match report.ending {
-        Ending::TimeUp | Ending::FirmwareExited => ExitCode::SUCCESS,
-        Ending::Fault(_) | Ending::Stopped => ExitCode::from(1),
+        Ending::TimeUp | Ending::FirmwareExited if failed.is_empty() => ExitCode::SUCCESS,
+        Ending::TimeUp | Ending::FirmwareExited | Ending::Fault(_) | Ending::Stopped => {
+            ExitCode::from(1)
+        }
     })
 }

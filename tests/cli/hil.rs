@@ -158,6 +158,15 @@ fn the_example_firmware_stops_half_a_metre_from_the_board_and_misses_no_revoluti
     );
     assert!(text.contains("; 0 collision(s)"), "{text}");
     assert!(text.contains(", 0 error(s)"), "{text}");
+    // Issue 19: the scenario's assertions, checked under hil.
+    for line in [
+        "PASS sim.final_x_m",
+        "PASS hil.command_errors",
+        "PASS hil.fault",
+        "SKIP lidar.revolutions",
+    ] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
     let d = final_distance(&tmp.path().join("rec"));
     assert!((d - 0.50).abs() <= 0.05, "stopped {d:.3} m from the board");
     assert!(gone(firmware_pid(&text)));
@@ -332,7 +341,10 @@ fn bad_hil_input_is_refused_before_anything_starts() {
 fn duration_makes_a_scenario_without_drive_program_or_duration_runnable() {
     let tmp = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(short_approach(tmp.path())).unwrap();
-    let endless = text.replace("duration_s = 30.0\n", "");
+    // Without its `when = "hil"` assertion on where the robot stops (`true` drives nowhere).
+    let endless = text
+        .replace("duration_s = 30.0\n", "")
+        .replace("when = \"hil\"", "when = \"run\"");
     assert_ne!(endless, text);
     std::fs::write(tmp.path().join("endless.toml"), endless).unwrap();
     // Validation refuses it on its own...
@@ -428,4 +440,31 @@ fn issue_18_a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
         stderr(&out)
     );
     assert!(gone(daemon));
+}
+
+/// Issue 19: a firmware that reads the lidar but never drives fails the scenario's `when =
+/// "hil"` assertion on where the robot stops: exit 1, and the summary says which.
+#[test]
+fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--duration",
+            "2",
+            "--firmware",
+            r#"sh -c 'exec cat "$HILSIM_LIDAR_PORT" >/dev/null'"#,
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(1), "{text}{}", stderr(&out));
+    assert!(text.contains("FAIL sim.final_x_m = 2.5"), "{text}");
+    assert!(text.contains("PASS hil.fault = 0"), "{text}");
+    assert!(
+        text.contains("1 of 5 assertion(s) failed: sim.final_x_m"),
+        "{text}"
+    );
 }

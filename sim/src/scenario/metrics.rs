@@ -67,7 +67,63 @@ pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
         "lidar.nmse_calibrated",
         "the same for the calibrated estimates",
     ),
+    (
+        "lidar_model.mse_raw",
+        "MSE of the raw lidar distances scored for the lidar model alone, m²",
+    ),
+    (
+        "lidar_model.mse_calibrated",
+        "MSE of each raw reading inverted through the fitted lidar model, m²",
+    ),
+    (
+        "lidar_model.mse_ratio",
+        "the lidar model alone: raw over inverted MSE (eq. 31 with eq. 30's inversion)",
+    ),
 ];
+
+/// Metrics of a firmware's session under `hilsim hil` (absent from `run` and `scenario test`,
+/// whose assertions on them are skipped, as `hil` skips the calibration metrics).
+pub const HIL_METRICS: &[(&str, &str)] = &[
+    (
+        "hil.lidar_revolutions_read",
+        "whole revolutions of lidar bytes the firmware read from its port",
+    ),
+    (
+        "hil.lidar_revolutions_dropped",
+        "revolutions the stream dropped (a reader that did not keep up)",
+    ),
+    ("hil.requests", "command-port requests the firmware made"),
+    (
+        "hil.command_errors",
+        "command-port requests answered with an error",
+    ),
+    (
+        "hil.set_motor",
+        "SetMotor requests accepted (how often the firmware drove)",
+    ),
+    (
+        "hil.fault",
+        "1 when the run ended on a firmware fault (crash, hang, flood, lidar never read), else 0",
+    ),
+    (
+        "hil.firmware_exit_code",
+        "the firmware's exit code (absent when a signal ended it)",
+    ),
+];
+
+/// Whether `name` is a metric of the firmware's session ([`HIL_METRICS`]).
+#[must_use]
+pub fn is_hil(name: &str) -> bool {
+    HIL_METRICS.iter().any(|(n, _)| *n == name)
+}
+
+/// Whether `name` is a calibration metric (`METHOD.…`).
+#[must_use]
+pub fn is_calibration(name: &str) -> bool {
+    name.split_once('.').is_some_and(|(method, rest)| {
+        METHODS.contains(&method) && CALIBRATION_METRICS.iter().any(|(n, _)| *n == rest)
+    })
+}
 
 /// The calibration methods a calibration metric may be prefixed with.
 pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth"];
@@ -75,8 +131,5 @@ pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth"];
 /// Whether `name` is in the catalogue.
 #[must_use]
 pub fn is_known(name: &str) -> bool {
-    METRICS.iter().any(|(n, _)| *n == name)
-        || name.split_once('.').is_some_and(|(method, rest)| {
-            METHODS.contains(&method) && CALIBRATION_METRICS.iter().any(|(n, _)| *n == rest)
-        })
+    METRICS.iter().any(|(n, _)| *n == name) || is_calibration(name) || is_hil(name)
 }

@@ -470,4 +470,21 @@ pub struct Expect {
     pub at_least: Option<f64>,
     /// The metric must be at most this.
     pub at_most: Option<f64>,
+    /// In which kind of run it is checked: both (the default), only when the scenario's drive
+    /// program runs (`run`, `scenario test`), or only when a firmware drives (`hil`).
+    #[serde(default)]
+    pub when: ExpectWhen,
+}
+
+/// `[[expect]] when`: the kind of run an assertion is checked in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ExpectWhen {
+    /// Every kind.
+    #[default]
+    Always,
+    /// `hilsim run` and `hilsim scenario test`: the drive program drives.
+    Run,
+    /// `hilsim hil`: the firmware drives.
+    Hil,
 }

@@ -92,9 +92,13 @@ pub struct ServeArgs {
     /// Pace the stream as a real unit would (the default).
     #[arg(long, conflicts_with = "fast")]
     pub realtime: bool,
-    /// Stream as fast as the link takes it.
+    /// Stream as fast as the reader takes it: a client that reads loses nothing; one that takes
+    /// nothing for 0.25 s loses whole revolutions (counted).
     #[arg(long)]
     pub fast: bool,
+    /// Start the stream only once a client has opened the pty (the simulation waits for it).
+    #[arg(long, conflicts_with = "port")]
+    pub wait_for_client: bool,
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,

@@ -66,6 +66,39 @@ impl PtyLink {
         &self.client_path
     }
 
+    /// Whether a process other than this one holds the client side open (Linux: `/proc/*/fd`;
+    /// elsewhere `true`, as nothing can tell).
+    #[must_use]
+    pub fn client_connected(&self) -> bool {
+        let Ok(entries) = std::fs::read_dir("/proc") else {
+            return true;
+        };
+        let ours = std::process::id();
+        let client = std::path::Path::new(&self.client_path);
+        entries
+            .filter_map(Result::ok)
+            .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
+            .filter(|&pid| pid != ours)
+            .any(|pid| {
+                std::fs::read_dir(format!("/proc/{pid}/fd")).is_ok_and(|fds| {
+                    fds.filter_map(Result::ok)
+                        .any(|fd| std::fs::read_link(fd.path()).is_ok_and(|l| l == client))
+                })
+            })
+    }
+
+    /// Waits until a client has opened the port ([`PtyLink::client_connected`]), or `stop` is
+    /// raised; whether a client came.
+    pub fn wait_for_client(&self, stop: &std::sync::atomic::AtomicBool) -> bool {
+        while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+            if self.client_connected() {
+                return true;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        false
+    }
+
     /// The master side, for reading what a client writes (the robot command port).
     pub fn master(&mut self) -> &mut TTYPort {
         &mut self.master

@@ -49,6 +49,9 @@ pub fn serve<L: SerialLink>(
             break;
         }
     }
+    if !interrupted {
+        streamer.drain()?;
+    }
     Ok(ServeReport {
         stream: streamer.stats().clone(),
         simulated_s: emulation.simulation().time_s(),

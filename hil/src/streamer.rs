@@ -18,8 +18,9 @@ pub enum Pacing {
     /// As a real XV-11: each packet leaves when its last reading has been taken, on the
     /// simulation clock mapped to the wall clock.
     Realtime,
-    /// As fast as the reader takes it; a reader that stalls for longer than
-    /// [`FAST_STALL_GRACE`] loses whole revolutions.
+    /// As fast as the reader takes it: a reader that reads loses nothing, however slowly it
+    /// reads; one that takes nothing for [`FAST_STALL_GRACE`] counts as stalled and loses whole
+    /// revolutions (counted) until it reads again. Before any reader has read, nothing waits.
     Fast,
     /// As fast as the reader takes it, never dropping: for hilsim's own reader
     /// (`hilsim run --via serial`). Fails after [`LOSSLESS_TIMEOUT`] without progress.
@@ -28,8 +29,10 @@ pub enum Pacing {
 
 /// Bytes a reader may leave unread before it counts as fallen behind: one revolution.
 pub const BACKLOG_LIMIT: usize = PACKETS_PER_REVOLUTION * PACKET_LEN;
-/// How long a fast stream waits for a slow reader before dropping revolutions.
-pub const FAST_STALL_GRACE: Duration = Duration::from_millis(50);
+/// How long a reader of a fast stream may take nothing before it counts as stalled: a quarter
+/// of a second, longer than any live reader's pause between reads (a Python driver decoding a
+/// revolution takes milliseconds), short enough that a stalled one costs the simulation little.
+pub const FAST_STALL_GRACE: Duration = Duration::from_millis(250);
 /// How long a reader may take nothing before it counts as stalled.
 pub const STALL_DETECT: Duration = Duration::from_millis(5);
 /// How long a lossless stream waits for its reader before giving up.
@@ -42,7 +45,7 @@ const LATENESS_BUCKETS: usize = 1000;
 /// What the stream did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StreamStats {
-    /// Revolutions written whole.
+    /// Revolutions written whole (less those later thrown away unread).
     pub revolutions_sent: u64,
     /// Revolutions thrown away because the reader was absent, stalled or too slow.
     pub revolutions_dropped: u64,
@@ -114,6 +117,9 @@ pub struct Streamer<L: SerialLink> {
     /// For [`Streamer::send_packet`]: inside a revolution, whether all its packets so far went
     /// out (`None` before the first revolution start and after each revolution's end).
     packets_whole: Option<bool>,
+    /// Whether a reader has taken data since the stream last found it stalled or absent: only
+    /// then does a fast stream wait for it.
+    reader_reading: bool,
 }
 
 impl<L: SerialLink> Streamer<L> {
@@ -126,6 +132,7 @@ impl<L: SerialLink> Streamer<L> {
             stats: StreamStats::default(),
             bytes: Vec::with_capacity(BACKLOG_LIMIT),
             packets_whole: None,
+            reader_reading: false,
         }
     }
 
@@ -165,6 +172,47 @@ impl<L: SerialLink> Streamer<L> {
             self.stats.revolutions_sent += 1;
         } else {
             self.stats.revolutions_dropped += 1;
+        }
+        Ok(())
+    }
+
+    /// Counts `backlog` bytes written but never read as lost: their whole revolutions move from
+    /// sent to dropped, so that every revolution is counted once.
+    fn lost(&mut self, backlog: usize) {
+        let revolutions = (backlog / BACKLOG_LIMIT) as u64;
+        self.stats.bytes_discarded += backlog as u64;
+        self.stats.revolutions_sent = self.stats.revolutions_sent.saturating_sub(revolutions);
+        self.stats.revolutions_dropped += revolutions;
+    }
+
+    /// Tells the stream that a reader has connected (`--wait-for-client`): it is waited for as
+    /// a reading one from the start, before its first read.
+    pub fn reader_connected(&mut self) {
+        self.reader_reading = true;
+    }
+
+    /// Lets a reader that is reading take what is still in the link before the stream ends (the
+    /// link closing would throw it away): waits while the backlog shrinks, giving up after
+    /// [`FAST_STALL_GRACE`] without progress. Nothing waits when no reader has been reading.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn drain(&mut self) -> io::Result<()> {
+        let mut backlog = self.link.backlog()?;
+        let mut progress_at = Instant::now();
+        while backlog > 0 && self.reader_reading {
+            if progress_at.elapsed() >= FAST_STALL_GRACE {
+                // What the closing link will throw away.
+                self.lost(backlog);
+                self.reader_reading = false;
+                break;
+            }
+            thread::sleep(Duration::from_millis(1));
+            let now_backlog = self.link.backlog()?;
+            if now_backlog < backlog {
+                progress_at = Instant::now();
+            }
+            backlog = now_backlog;
         }
         Ok(())
     }
@@ -216,20 +264,21 @@ impl<L: SerialLink> Streamer<L> {
     /// (as the pacing allows), and discards what a stalled or absent one left. Returns `false`
     /// when this revolution must be dropped.
     fn make_room(&mut self) -> io::Result<bool> {
-        let give_up = Instant::now()
-            + match self.pacing {
-                Pacing::Realtime => Duration::ZERO,
-                Pacing::Fast => FAST_STALL_GRACE,
-                Pacing::Lossless => LOSSLESS_TIMEOUT,
-            };
         let mut backlog = self.link.backlog()?;
         let mut progress_at = Instant::now();
         while backlog > BACKLOG_LIMIT {
             let now = Instant::now();
-            // A reader that took nothing for STALL_DETECT is stalled or gone: waiting longer
-            // would only slow the simulation down.
-            let stalled = self.pacing != Pacing::Lossless && now - progress_at >= STALL_DETECT;
-            if now >= give_up || stalled {
+            // How long a reader may take nothing before its backlog is thrown away: none in
+            // real time (live data first), the grace for a fast stream's reader that has been
+            // reading, [`STALL_DETECT`] for one that never has (absent: do not hold the
+            // simulation up), the timeout for hilsim's own lossless reader.
+            let patience = match self.pacing {
+                Pacing::Realtime => Duration::ZERO,
+                Pacing::Fast if self.reader_reading => FAST_STALL_GRACE,
+                Pacing::Fast => STALL_DETECT,
+                Pacing::Lossless => LOSSLESS_TIMEOUT,
+            };
+            if now - progress_at >= patience {
                 if self.pacing == Pacing::Lossless {
                     return Err(io::Error::new(
                         ErrorKind::TimedOut,
@@ -239,14 +288,15 @@ impl<L: SerialLink> Streamer<L> {
                 // The stale data would reach a late reader first: throw it away, counting the
                 // whole revolutions it held.
                 self.link.discard_backlog()?;
-                self.stats.bytes_discarded += backlog as u64;
-                self.stats.revolutions_dropped += (backlog / BACKLOG_LIMIT) as u64;
+                self.lost(backlog);
+                self.reader_reading = false;
                 return Ok(true);
             }
             thread::sleep(Duration::from_millis(1));
             let now_backlog = self.link.backlog()?;
             if now_backlog < backlog {
                 progress_at = Instant::now();
+                self.reader_reading = true;
             }
             backlog = now_backlog;
         }
@@ -258,7 +308,8 @@ impl<L: SerialLink> Streamer<L> {
     fn write_all(&mut self, mut bytes: &[u8]) -> io::Result<bool> {
         let wait = match self.pacing {
             Pacing::Realtime => Duration::from_millis(2),
-            Pacing::Fast => FAST_STALL_GRACE,
+            Pacing::Fast if self.reader_reading => FAST_STALL_GRACE,
+            Pacing::Fast => STALL_DETECT,
             Pacing::Lossless => LOSSLESS_TIMEOUT,
         };
         let mut deadline = Instant::now() + wait;

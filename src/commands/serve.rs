@@ -1,4 +1,5 @@
-//! `hilsim serve SCENARIO [--pty | --port PATH] [--realtime | --fast] [--seed N]`.
+//! `hilsim serve SCENARIO [--pty | --port PATH] [--realtime | --fast] [--wait-for-client]
+//! [--seed N]`.
 
 use std::io::Write;
 use std::sync::atomic::AtomicBool;
@@ -32,20 +33,25 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
                 .with_context(|| format!("{}: cannot open", path.display()))?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
-            run(emulation, link, pacing, &stop)?
+            run(emulation, link, pacing, &stop, false)?
         }
         None => {
             let link = PtyLink::open().context("cannot create a pseudo-terminal")?;
             // The client's path on its own line, before any data: scripts wait for it.
             writeln!(out, "serial: {}", link.client_path())?;
             out.flush()?;
-            run(emulation, link, pacing, &stop)?
+            let connected = args.wait_for_client && link.wait_for_client(&stop);
+            if connected {
+                writeln!(out, "client connected: streaming")?;
+                out.flush()?;
+            }
+            run(emulation, link, pacing, &stop, connected)?
         }
     };
     let s = &report.stream;
     write!(
         out,
-        "served {:.1} s: {} revolutions sent, {} dropped (no reader or a stalled one), {} bytes",
+        "served {:.1} s: {} revolutions sent, {} dropped (no reader yet, or one that stalled), {} bytes",
         report.simulated_s, s.revolutions_sent, s.revolutions_dropped, s.bytes_written
     )?;
     if let Some(lateness) = s.lateness_summary() {
@@ -60,7 +66,11 @@ fn run<L: SerialLink>(
     link: L,
     pacing: Pacing,
     stop: &AtomicBool,
+    client_connected: bool,
 ) -> Result<ServeReport> {
     let mut streamer = Streamer::new(link, pacing);
+    if client_connected {
+        streamer.reader_connected();
+    }
     stream(emulation, &mut streamer, stop).context("the serial link failed")
 }

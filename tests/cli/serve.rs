@@ -33,7 +33,7 @@ struct Server {
     child: Child,
     port: String,
     /// Kept open: a closed pipe would fail the server's final summary.
-    _stdout: BufReader<std::process::ChildStdout>,
+    stdout: BufReader<std::process::ChildStdout>,
 }
 
 impl Drop for Server {
@@ -63,7 +63,7 @@ fn serve(dir: &std::path::Path, args: &[&str]) -> Server {
     Server {
         child,
         port,
-        _stdout: stdout,
+        stdout,
     }
 }
 
@@ -253,4 +253,82 @@ fn decode_counts_the_real_capture_and_writes_csv() {
     let bad = hilsim(tmp.path(), &["decode", "nothing.bin", "--json"]);
     let err = assert_bad_input(&bad);
     assert!(err.contains("nothing.bin"), "{err}");
+}
+
+/// Issue 19: `--fast --wait-for-client` streams nothing until the client opens the port, and a
+/// client that reads, however slowly (here 2 KB every 20 ms, far behind the simulation), loses
+/// no revolution: it gets every one of the run's, equal to the recording's.
+#[test]
+fn issue_19_a_late_slow_client_of_a_fast_stream_gets_every_revolution() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("short.toml"), SHORT).unwrap();
+    let expected = recorded_revolutions(tmp.path(), "4");
+    let mut server = serve(tmp.path(), &["short.toml", "--fast", "--wait-for-client"]);
+    // Late: the run (3 s of lidar, a few milliseconds of work) would be over long before.
+    std::thread::sleep(Duration::from_millis(300));
+    let mut port = open(&server.port);
+    let mut bytes = Vec::new();
+    let mut chunk = [0u8; 2048];
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while bytes.len() < expected.len() * 1980 && Instant::now() < deadline {
+        match port.read(&mut chunk) {
+            Ok(n) => bytes.extend_from_slice(&chunk[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+            Err(e) => {
+                let mut rest = String::new();
+                let _ = server.stdout.read_to_string(&mut rest);
+                panic!("{e} after {} bytes; serve said: {rest}", bytes.len());
+            }
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let mut decoder = hilsim_lidar_emulator::neato_packet::Decoder::new();
+    let packets: Vec<_> = decoder.feed(&bytes).collect();
+    assert_eq!(packets.len(), expected.len() * 90, "{} bytes", bytes.len());
+    let got: Vec<Vec<u16>> = packets
+        .chunks(90)
+        .map(|rev| {
+            rev.iter()
+                .flat_map(|p| {
+                    p.readings.iter().map(|r| {
+                        if r.invalid || r.strength_warning {
+                            0
+                        } else {
+                            r.distance_mm
+                        }
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    assert_eq!(got, expected);
+    let status = server.child.wait().unwrap();
+    assert!(status.success());
+}
+
+/// Issue 19: a client of a fast stream that stops reading for a second loses whole
+/// revolutions, and the summary counts them: every revolution is either sent or dropped.
+#[test]
+fn issue_19_what_a_stalled_client_loses_is_counted() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("short.toml"), SHORT).unwrap();
+    let mut server = serve(tmp.path(), &["short.toml", "--fast", "--wait-for-client"]);
+    let mut port = open(&server.port);
+    let mut chunk = [0u8; 1980];
+    port.read_exact(&mut chunk).unwrap();
+    // Stalled: the stream drops what it cannot deliver and ends without waiting.
+    let status = server.child.wait().unwrap();
+    assert!(status.success());
+    drop(port);
+    let mut text = String::new();
+    server.stdout.read_to_string(&mut text).unwrap();
+    let count = |key: &str| -> u64 {
+        let (before, _) = text
+            .split_once(key)
+            .unwrap_or_else(|| panic!("{key}: {text}"));
+        before.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    let (sent, dropped) = (count(" revolutions sent"), count(" dropped"));
+    assert!(dropped > 0, "{text}");
+    assert_eq!(sent + dropped, 15, "{text}");
 }

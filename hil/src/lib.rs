@@ -9,6 +9,7 @@ pub mod command_port;
 pub mod decode;
 mod device;
 pub mod escaped;
+pub mod faults;
 pub mod firmware;
 pub mod hil_run;
 mod link;

@@ -18,6 +18,8 @@ pub struct ServeReport {
     pub simulated_s: f64,
     /// Whether it ended because `stop` was raised.
     pub interrupted: bool,
+    /// What the scenario's `[link]` faults did (`None`: it has none).
+    pub link_faults: Option<crate::faults::FaultCounts>,
 }
 
 /// Streams the emulation's lidar until the scenario ends or `stop` is raised. Only whole
@@ -56,5 +58,6 @@ pub fn serve<L: SerialLink>(
         stream: streamer.stats().clone(),
         simulated_s: emulation.simulation().time_s(),
         interrupted,
+        link_faults: streamer.fault_counts(),
     })
 }

@@ -10,6 +10,7 @@ use hilsim_lidar_emulator::neato_packet::{
 };
 use hilsim_lidar_emulator::wire::RevolutionFrame;
 
+use crate::faults::{FaultCounts, WireFaults};
 use crate::link::SerialLink;
 
 /// How the stream is paced.
@@ -120,6 +121,12 @@ pub struct Streamer<L: SerialLink> {
     /// Whether a reader has taken data since the stream last found it stalled or absent: only
     /// then does a fast stream wait for it.
     reader_reading: bool,
+    /// The scenario's wire faults, when it has any.
+    faults: Option<WireFaults>,
+    /// Where each of the revolution's packets lies in `bytes` (empty when the wire lost it).
+    packet_spans: Vec<(usize, usize)>,
+    /// A packet as the faults leave it (`send_packet`).
+    packet_bytes: Vec<u8>,
 }
 
 impl<L: SerialLink> Streamer<L> {
@@ -133,7 +140,23 @@ impl<L: SerialLink> Streamer<L> {
             bytes: Vec::with_capacity(BACKLOG_LIMIT),
             packets_whole: None,
             reader_reading: false,
+            faults: None,
+            packet_spans: Vec::with_capacity(PACKETS_PER_REVOLUTION),
+            packet_bytes: Vec::with_capacity(PACKET_LEN),
         }
+    }
+
+    /// The stream with a scenario's wire faults applied to every packet it writes.
+    #[must_use]
+    pub fn with_faults(mut self, faults: Option<WireFaults>) -> Self {
+        self.faults = faults;
+        self
+    }
+
+    /// What the wire's faults did so far (`None` without faults).
+    #[must_use]
+    pub fn fault_counts(&self) -> Option<FaultCounts> {
+        self.faults.as_ref().map(WireFaults::counts)
     }
 
     /// The link.
@@ -154,6 +177,7 @@ impl<L: SerialLink> Streamer<L> {
     pub fn send(&mut self, frame: &RevolutionFrame) -> io::Result<()> {
         self.bytes.clear();
         frame.encode(&mut self.bytes);
+        self.apply_faults(frame);
         self.link.allow_reconnect()?;
         if !self.make_room()? {
             self.stats.revolutions_dropped += 1;
@@ -174,6 +198,25 @@ impl<L: SerialLink> Streamer<L> {
             self.stats.revolutions_dropped += 1;
         }
         Ok(())
+    }
+
+    /// Lays the revolution's packets out in `bytes` as the wire delivers them, noting each one's
+    /// span (the spans of an unfaulted stream are the 22-byte packets).
+    fn apply_faults(&mut self, frame: &RevolutionFrame) {
+        self.packet_spans.clear();
+        let Some(faults) = self.faults.as_mut() else {
+            self.packet_spans.extend(
+                (0..self.bytes.len() / PACKET_LEN).map(|k| (k * PACKET_LEN, (k + 1) * PACKET_LEN)),
+            );
+            return;
+        };
+        let clean = std::mem::take(&mut self.bytes);
+        for (k, packet) in clean.chunks_exact(PACKET_LEN).enumerate() {
+            let start = self.bytes.len();
+            let done_s = frame.reading_time_s(((k + 1) * READINGS_PER_PACKET) as u16);
+            faults.apply(packet, done_s, &mut self.bytes);
+            self.packet_spans.push((start, self.bytes.len()));
+        }
     }
 
     /// Counts `backlog` bytes written but never read as lost: their whole revolutions move from
@@ -220,7 +263,8 @@ impl<L: SerialLink> Streamer<L> {
     /// Sends one packet of a realtime stream now, never waiting for its time: for a caller
     /// that paces the simulation itself and must not be held up (firmware in the loop), and
     /// hands over each packet once its last reading's instant has passed. `due` is that
-    /// instant on the wall clock, for the lateness statistics.
+    /// instant on the wall clock, for the lateness statistics, and `due_s` in simulated time,
+    /// for the link's faults.
     ///
     /// Revolutions are still the unit: a packet with index 0 starts one and gets what
     /// [`Streamer::send`] gives a whole revolution (the reader may reconnect; a reader that fell
@@ -231,7 +275,7 @@ impl<L: SerialLink> Streamer<L> {
     ///
     /// # Errors
     /// The link failed.
-    pub fn send_packet(&mut self, packet: &Packet, due: Instant) -> io::Result<()> {
+    pub fn send_packet(&mut self, packet: &Packet, due: Instant, due_s: f64) -> io::Result<()> {
         let index = usize::from(packet.index) % PACKETS_PER_REVOLUTION;
         if index == 0 {
             if self.packets_whole.take() == Some(true) {
@@ -245,7 +289,15 @@ impl<L: SerialLink> Streamer<L> {
         if self.packets_whole != Some(true) {
             return Ok(());
         }
-        if !self.write_all(&packet.encode())? {
+        let mut bytes = std::mem::take(&mut self.packet_bytes);
+        bytes.clear();
+        match self.faults.as_mut() {
+            Some(faults) => faults.apply(&packet.encode(), due_s, &mut bytes),
+            None => bytes.extend_from_slice(&packet.encode()),
+        }
+        let written = self.write_all(&bytes)?;
+        self.packet_bytes = bytes;
+        if !written {
             self.packets_whole = Some(false);
             self.stats.revolutions_dropped += 1;
             return Ok(());
@@ -348,13 +400,14 @@ impl<L: SerialLink> Streamer<L> {
             Instant::now() - Duration::from_secs_f64(frame.start_s.max(0.0))
         });
         let bytes = std::mem::take(&mut self.bytes);
+        let spans = std::mem::take(&mut self.packet_spans);
         let mut all_sent = true;
-        for (k, packet) in bytes.chunks_exact(PACKET_LEN).enumerate() {
+        for (k, &(start, end)) in spans.iter().enumerate() {
             // The packet is complete once its fourth reading's instant has passed.
             let last_angle = ((k + 1) * READINGS_PER_PACKET) as u16;
             let due = origin + Duration::from_secs_f64(frame.reading_time_s(last_angle).max(0.0));
             sleep_until(due);
-            if !self.write_all(packet)? {
+            if !self.write_all(&bytes[start..end])? {
                 all_sent = false;
                 break;
             }
@@ -362,6 +415,7 @@ impl<L: SerialLink> Streamer<L> {
             let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
             self.stats.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
         }
+        self.packet_spans = spans;
         self.bytes = bytes;
         Ok(all_sent)
     }
@@ -417,9 +471,10 @@ mod tests {
             s.send(&frame(rev)).unwrap();
         }
         let stats = s.stats().clone();
-        // Every revolution is either sent or counted as dropped; the backlog never exceeds two
-        // revolutions, so of 50 at most 2 can still be waiting.
-        assert_eq!(stats.revolutions_sent, 50);
+        // Every revolution is counted once, sent or dropped (a revolution written and then
+        // thrown away unread is dropped); the backlog never exceeds two revolutions, so of 50
+        // at most 2 can still be waiting.
+        assert_eq!(stats.revolutions_sent + stats.revolutions_dropped, 50);
         assert!(stats.revolutions_dropped >= 48 - 2, "{stats:?}");
         // What a reader connecting now finds is at most two revolutions, the newest ones.
         let backlog = s.link().take();
@@ -439,7 +494,8 @@ mod tests {
 
     fn send_revolution(s: &mut Streamer<MemoryLink>, rev: u64) {
         for index in 0..90 {
-            s.send_packet(&packet(rev, index), Instant::now()).unwrap();
+            s.send_packet(&packet(rev, index), Instant::now(), 0.0)
+                .unwrap();
         }
     }
 
@@ -451,7 +507,8 @@ mod tests {
         );
         // The tail of a revolution before the first start is not sent.
         for index in 45..90 {
-            s.send_packet(&packet(0, index), Instant::now()).unwrap();
+            s.send_packet(&packet(0, index), Instant::now(), 0.0)
+                .unwrap();
         }
         assert_eq!(s.stats().bytes_written, 0);
         send_revolution(&mut s, 1);
@@ -463,7 +520,8 @@ mod tests {
             send_revolution(&mut s, rev);
         }
         let stats = s.stats().clone();
-        assert_eq!(stats.revolutions_sent, 5);
+        // Two written and then thrown away unread count as dropped, not sent.
+        assert_eq!(stats.revolutions_sent, 3);
         assert_eq!(stats.revolutions_dropped, 2);
         assert_eq!(stats.bytes_written, 5 * BACKLOG_LIMIT as u64);
         assert_eq!(stats.bytes_discarded, 2 * BACKLOG_LIMIT as u64);

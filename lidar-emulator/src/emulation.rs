@@ -90,7 +90,9 @@ impl Emulation {
             .lidar
             .as_ref()
             .map(|c| Lidar::with_effects(c, e, seed))
-            .transpose()?;
+            .transpose()?
+            // Validation has checked the table: its faults resolve.
+            .map(|l| l.with_link(&scenario.link.faults().unwrap_or_default()));
         let sonar = s
             .sonar
             .as_ref()

@@ -101,6 +101,9 @@ pub struct Lidar {
     snapshot: bool,
     /// The lidar's origin and 0° direction at the current revolution's start (snapshot only).
     rev_pose: Option<([f64; 2], f64)>,
+    /// The motor's speed of each revolution while it spins up (`[link] spin_up_s`); empty when
+    /// it starts at speed.
+    spin_up_rpm: Vec<f64>,
 }
 
 impl Lidar {
@@ -147,6 +150,7 @@ impl Lidar {
             snapshot: config.timing == scenario::LidarTiming::PerRevolution
                 && effects.lidar_motion_skew.is_none(),
             rev_pose: None,
+            spin_up_rpm: Vec::new(),
         };
         lidar.rev_rpm = lidar.rpm_of_revolution(0);
         Ok(lidar)
@@ -190,8 +194,35 @@ impl Lidar {
     #[must_use]
     pub fn rpm_of_revolution(&self, rev: u64) -> f64 {
         let phase = std::f64::consts::TAU * rev as f64 / WOBBLE_PERIOD_REVS + self.wobble_phase;
-        let rpm = self.rpm + self.rpm_wobble * phase.sin();
+        let speed = usize::try_from(rev)
+            .ok()
+            .and_then(|r| self.spin_up_rpm.get(r))
+            .copied()
+            .unwrap_or(self.rpm);
+        let rpm = speed + self.rpm_wobble * phase.sin();
         (rpm * 64.0).round() / 64.0
+    }
+
+    /// The unit's motor as the scenario's `[link]` table has it: a spin-up from
+    /// [`scenario::SPIN_UP_FROM_RPM`] to the lidar's speed, linear in time over `spin_up_s`
+    /// (each revolution at the speed of its start), and the rpm wobble when the table sets it.
+    #[must_use]
+    pub fn with_link(mut self, faults: &scenario::LinkFaults) -> Self {
+        if let Some(wobble) = faults.rpm_wobble {
+            self.rpm_wobble = wobble;
+        }
+        self.spin_up_rpm.clear();
+        if faults.spin_up_s > 0.0 && self.rpm > scenario::SPIN_UP_FROM_RPM {
+            let (from, to) = (scenario::SPIN_UP_FROM_RPM, self.rpm);
+            let mut t = 0.0;
+            while t < faults.spin_up_s {
+                let rpm = from + (to - from) * t / faults.spin_up_s;
+                self.spin_up_rpm.push(rpm);
+                t += 60.0 / rpm;
+            }
+        }
+        self.rev_rpm = self.rpm_of_revolution(self.rev);
+        self
     }
 
     /// Takes every reading whose instant falls in `[step.t0, step.t1)`.

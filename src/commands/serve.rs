@@ -5,6 +5,7 @@ use std::io::Write;
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result};
+use hilsim_hil::faults::WireFaults;
 use hilsim_hil::serve::{serve as stream, ServeReport};
 use hilsim_hil::{DeviceLink, Pacing, PtyLink, SerialLink, Streamer};
 use hilsim_lidar_emulator::Emulation;
@@ -27,13 +28,16 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
     let stop = AtomicBool::new(false);
+    // Validation has checked the table: its faults resolve.
+    let link_faults = scenario.link.faults().unwrap_or_default();
+    let wire_faults = || WireFaults::new(&link_faults, scenario.seed);
     let report = match &args.port {
         Some(path) => {
             let link = DeviceLink::open(&path.to_string_lossy())
                 .with_context(|| format!("{}: cannot open", path.display()))?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
-            run(emulation, link, pacing, &stop, false)?
+            run(emulation, link, pacing, &stop, false, wire_faults())?
         }
         None => {
             let link = PtyLink::open().context("cannot create a pseudo-terminal")?;
@@ -45,7 +49,7 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
                 writeln!(out, "client connected: streaming")?;
                 out.flush()?;
             }
-            run(emulation, link, pacing, &stop, connected)?
+            run(emulation, link, pacing, &stop, connected, wire_faults())?
         }
     };
     let s = &report.stream;
@@ -58,6 +62,9 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         write!(out, "; {lateness}")?;
     }
     writeln!(out)?;
+    if let Some(faults) = &report.link_faults {
+        writeln!(out, "{}", faults.describe())?;
+    }
     Ok(())
 }
 
@@ -67,8 +74,9 @@ fn run<L: SerialLink>(
     pacing: Pacing,
     stop: &AtomicBool,
     client_connected: bool,
+    faults: Option<WireFaults>,
 ) -> Result<ServeReport> {
-    let mut streamer = Streamer::new(link, pacing);
+    let mut streamer = Streamer::new(link, pacing).with_faults(faults);
     if client_connected {
         streamer.reader_connected();
     }

@@ -332,3 +332,45 @@ fn issue_19_what_a_stalled_client_loses_is_counted() {
     assert!(dropped > 0, "{text}");
     assert_eq!(sent + dropped, 15, "{text}");
 }
+
+/// Issue 19: a scenario's `[link]` faults reach a client of `serve`, seeded: the same run gives
+/// the same bytes. The motor spins up from 50 rpm (the rpm field follows), packets fail their
+/// checksum at the rate asked (5 %: 0.05 × ~1,100 packets ≈ 55, binomial sd 7) and the summary
+/// counts them as the decoder does.
+#[test]
+fn issue_19_link_faults_reach_the_client_and_are_counted() {
+    let tmp = tempfile::tempdir().unwrap();
+    let faulty = format!("{SHORT}\n[link]\nspin_up_s = 1.0\ncorrupt_packet_rate = 0.05\n");
+    std::fs::write(tmp.path().join("faulty.toml"), faulty).unwrap();
+    let capture = |name: &str| -> (Vec<u8>, String) {
+        let mut server = serve(tmp.path(), &["faulty.toml", "--fast", "--wait-for-client"]);
+        let mut port = open(&server.port);
+        let mut bytes = Vec::new();
+        let mut chunk = [0u8; 4096];
+        loop {
+            match port.read(&mut chunk) {
+                Ok(n) => bytes.extend_from_slice(&chunk[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                // The server closed the port: everything has been read.
+                Err(_) => break,
+            }
+        }
+        assert!(server.child.wait().unwrap().success());
+        let mut text = String::new();
+        server.stdout.read_to_string(&mut text).unwrap();
+        std::fs::write(tmp.path().join(name), &bytes).unwrap();
+        (bytes, text)
+    };
+    let (bytes, text) = capture("a.bin");
+    assert_eq!(capture("b.bin").0, bytes, "the same seed, the same faults");
+    let decoded = hilsim(tmp.path(), &["decode", "a.bin", "--json"]);
+    let counts: serde_json::Value = serde_json::from_str(&stdout(&decoded)).unwrap();
+    let bad = counts["bad_checksum"].as_u64().unwrap();
+    assert!((25..=90).contains(&bad), "{counts}");
+    assert!(
+        text.contains(&format!("link faults: {bad} packet(s) corrupted")),
+        "{text}"
+    );
+    let rpm_min = counts["rpm_min"].as_f64().unwrap();
+    assert!((50.0..60.0).contains(&rpm_min), "{counts}");
+}

@@ -103,6 +103,8 @@ pub struct HilReport {
     pub replies_dropped: u64,
     /// The lidar stream's counts.
     pub stream: StreamStats,
+    /// What the scenario's `[link]` faults did to the stream (`None`: it has none).
+    pub link_faults: Option<crate::faults::FaultCounts>,
     /// Bytes of the lidar stream the firmware took (`None` without a lidar).
     pub lidar_bytes_read: Option<u64>,
     /// How late the latest physics step was computed after its start time: real-time health.

@@ -55,7 +55,8 @@ pub fn run(
 ) -> io::Result<HilReport> {
     let HilPorts { lidar, robot } = ports;
     let mut firmware = firmware;
-    let streamer = Streamer::new(lidar, Pacing::Realtime);
+    let mut world = world;
+    let streamer = Streamer::new(lidar, Pacing::Realtime).with_faults(world.wire_faults.take());
     let mut session = Session::new(world, streamer, robot, config);
     let ending = session.run(firmware.as_mut(), stop)?;
     session.finish(ending, firmware)
@@ -100,6 +101,7 @@ impl<'c> Session<'c> {
             emulation,
             sonar_period_s,
             odometer,
+            ..
         } = world;
         let step_s = emulation.simulation().step_s();
         let sensors = Sensors {
@@ -251,7 +253,7 @@ impl<'c> Session<'c> {
                 break;
             }
             self.due_packets.pop_front();
-            self.streamer.send_packet(&packet, due)?;
+            self.streamer.send_packet(&packet, due, due_s)?;
         }
         Ok(())
     }
@@ -381,6 +383,7 @@ impl<'c> Session<'c> {
             None => None,
         };
         let stream = self.streamer.stats().clone();
+        let link_faults = self.streamer.fault_counts();
         // The ports close before the firmware is asked to leave: a firmware blocked on one sees
         // it go and can exit by itself.
         drop(self.streamer);
@@ -416,6 +419,7 @@ impl<'c> Session<'c> {
             },
             commands: self.port.stats().clone(),
             replies_dropped: self.replies_dropped,
+            link_faults,
             stream,
             lidar_bytes_read,
             max_step_lateness: self.max_step_lateness,

@@ -50,6 +50,8 @@ pub struct HilWorld {
     pub(super) emulation: Emulation,
     pub(super) sonar_period_s: Option<f64>,
     pub(super) odometer: bool,
+    /// The scenario's `[link]` faults on the lidar's wire.
+    pub(super) wire_faults: Option<crate::faults::WireFaults>,
 }
 
 impl HilWorld {
@@ -64,6 +66,11 @@ impl HilWorld {
             emulation: Emulation::with_simulation(scenario, seed, sim)?,
             sonar_period_s: scenario.sensors.sonar.as_ref().map(|s| 1.0 / s.rate_hz),
             odometer: scenario.sensors.odometer.is_some(),
+            // Validation has checked the table: its faults resolve.
+            wire_faults: crate::faults::WireFaults::new(
+                &scenario.link.faults().unwrap_or_default(),
+                seed,
+            ),
         })
     }
 }

@@ -93,6 +93,9 @@ impl HilReport {
             }
             writeln!(out)?;
         }
+        if let Some(faults) = &self.link_faults {
+            writeln!(out, "{}", faults.describe())?;
+        }
         writeln!(
             out,
             "real time: physics steps computed at most {:.1} ms late",

@@ -24,6 +24,7 @@
 mod check;
 mod effects;
 mod error;
+mod link;
 mod load;
 mod locate;
 pub mod metrics;
@@ -33,6 +34,7 @@ mod validate_effects;
 
 pub use effects::*;
 pub use error::ScenarioError;
+pub use link::{Link, LinkFaults, SPARSE_BELOW_RPM, SPIN_UP_FROM_RPM, XV11_CAPTURE};
 pub use load::read_scenario_text;
 pub use schema::*;
 pub use validate::{MAX_ANGLE_DEG, MAX_RUN_S, MAX_SENSOR_RATE_HZ, MAX_WORLD_M};

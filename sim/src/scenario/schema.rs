@@ -46,6 +46,9 @@ pub struct Scenario {
     /// Physics switched on beyond the nominal models (the mismatch catalogue); default: none.
     #[serde(default)]
     pub effects: super::effects::Effects,
+    /// How the serial link and the unit's motor fail (`serve`, `hil`); default: they do not.
+    #[serde(default)]
+    pub link: super::link::Link,
 }
 
 impl Scenario {

@@ -159,6 +159,9 @@ pub(super) fn validate(s: &Scenario) -> Check {
     drive(s)?;
     sensors(s)?;
     validate_effects::validate(s)?;
+    if let Err((key, message)) = s.link.validate() {
+        return fail(key_path!["link", key], message);
+    }
     for (i, e) in s.expect.iter().enumerate() {
         if !metrics::is_known(&e.metric) {
             return fail(

@@ -1,0 +1,181 @@
+//! `[link]`: how the serial link and the unit's motor fail as a real XV-11's do, for `hilsim
+//! serve` and `hilsim hil` (off by default: a perfect stream). The wire faults (corrupted
+//! packets, dropped bytes and packets, a disconnection) touch only the bytes on the wire; the
+//! motor's spin-up is the unit's physics, so a recording of the scenario carries it too.
+
+use serde::Deserialize;
+
+/// The `[link]` table as written.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Link {
+    /// A named set of the values below (`"xv11-capture"`: [`XV11_CAPTURE`]); keys given beside
+    /// it override its values.
+    pub profile: Option<String>,
+    /// Fraction of packets with a byte flipped so that their checksum fails.
+    pub corrupt_packet_rate: Option<f64>,
+    /// Fraction of bytes lost on the wire.
+    pub dropped_byte_rate: Option<f64>,
+    /// Fraction of whole packets the unit does not send.
+    pub dropped_packet_rate: Option<f64>,
+    /// The motor spins up from [`SPIN_UP_FROM_RPM`] to its speed over this many seconds after
+    /// power-on; the rpm field and the packets' timing follow, and below [`SPARSE_BELOW_RPM`] the
+    /// unit sends every other packet.
+    pub spin_up_s: Option<f64>,
+    /// Amplitude of the slow rpm variation, rpm (the same quantity as `[sensors.lidar]
+    /// rpm_wobble`, which it replaces when given).
+    pub rpm_wobble: Option<f64>,
+    /// The link goes silent at this simulated time (a USB adapter unplugged) …
+    pub disconnect_at_s: Option<f64>,
+    /// … and comes back this many seconds later (default: never).
+    pub reconnect_after_s: Option<f64>,
+}
+
+/// The speed a spinning-up XV-11 first reports packets at: the real capture's lowest rpm field,
+/// 49.8 (`hilsim decode tests/data/captures/xv11-hand-in-box.bin`).
+pub const SPIN_UP_FROM_RPM: f64 = 50.0;
+
+/// The faults in force, every value resolved.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LinkFaults {
+    /// See [`Link::corrupt_packet_rate`].
+    pub corrupt_packet_rate: f64,
+    /// See [`Link::dropped_byte_rate`].
+    pub dropped_byte_rate: f64,
+    /// See [`Link::dropped_packet_rate`].
+    pub dropped_packet_rate: f64,
+    /// See [`Link::spin_up_s`].
+    pub spin_up_s: f64,
+    /// See [`Link::rpm_wobble`]; `None`: the lidar's own.
+    pub rpm_wobble: Option<f64>,
+    /// The silent interval `[from, until)`, simulated seconds.
+    pub silent: Option<(f64, f64)>,
+}
+
+/// Below this motor speed a spinning-up unit sends only every other packet: in the real capture
+/// the first index gap comes at 206.8 rpm, and below it the indices jump by 44–46 (half a
+/// revolution) from one packet to the next.
+pub const SPARSE_BELOW_RPM: f64 = 210.0;
+
+/// The profile fitted to the real capture in the repository (`tests/data/captures/
+/// xv11-hand-in-box.bin`, 252,146 bytes, 11,451 packets; `hilsim decode … --json` and `--csv`):
+/// - 1 packet of 11,451 fails its checksum: `corrupt_packet_rate` 8.7e-5;
+/// - the first 10,827 packets come at 295–298 rpm with no index gap and no skipped byte: no
+///   dropped bytes or packets (`dropped_byte_rate`, `dropped_packet_rate` 0);
+/// - the last 608 come while the motor runs between 297 and 50 rpm, over about 3 s; below
+///   [`SPARSE_BELOW_RPM`] the unit sends every other packet, which gives all 512 index gaps (and
+///   the 224 skipped bytes): `spin_up_s` 3 (the same ramp at power-on, where a firmware meets
+///   it), with the every-other-packet behaviour below 210 rpm.
+pub const XV11_CAPTURE: LinkFaults = LinkFaults {
+    corrupt_packet_rate: 1.0 / 11_451.0,
+    dropped_byte_rate: 0.0,
+    dropped_packet_rate: 0.0,
+    spin_up_s: 3.0,
+    rpm_wobble: None,
+    silent: None,
+};
+
+impl Link {
+    /// The faults in force: the profile's values, overridden by the keys given.
+    ///
+    /// # Errors
+    /// An unknown profile, in words.
+    pub fn faults(&self) -> Result<LinkFaults, String> {
+        let base = match self.profile.as_deref() {
+            None => LinkFaults::default(),
+            Some("xv11-capture") => XV11_CAPTURE,
+            Some(other) => {
+                return Err(format!(
+                    "unknown profile `{other}` (known: \"xv11-capture\")"
+                ))
+            }
+        };
+        let silent = self.disconnect_at_s.map(|from| {
+            (
+                from,
+                self.reconnect_after_s.map_or(f64::INFINITY, |d| from + d),
+            )
+        });
+        Ok(LinkFaults {
+            corrupt_packet_rate: self.corrupt_packet_rate.unwrap_or(base.corrupt_packet_rate),
+            dropped_byte_rate: self.dropped_byte_rate.unwrap_or(base.dropped_byte_rate),
+            dropped_packet_rate: self.dropped_packet_rate.unwrap_or(base.dropped_packet_rate),
+            spin_up_s: self.spin_up_s.unwrap_or(base.spin_up_s),
+            rpm_wobble: self.rpm_wobble.or(base.rpm_wobble),
+            silent: silent.or(base.silent),
+        })
+    }
+
+    /// Checks every value: rates in [0, 0.5] (beyond, the stream is noise), times finite and
+    /// non-negative, a reconnection only after a disconnection.
+    ///
+    /// # Errors
+    /// The first bad key and why.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        self.faults().map_err(|e| ("profile", e))?;
+        for (key, value) in [
+            ("corrupt_packet_rate", self.corrupt_packet_rate),
+            ("dropped_byte_rate", self.dropped_byte_rate),
+            ("dropped_packet_rate", self.dropped_packet_rate),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && (0.0..=0.5).contains(&v)) {
+                    return Err((key, format!("expected a fraction in [0, 0.5], found {v}")));
+                }
+            }
+        }
+        for (key, value) in [
+            ("spin_up_s", self.spin_up_s),
+            ("rpm_wobble", self.rpm_wobble),
+            ("disconnect_at_s", self.disconnect_at_s),
+            ("reconnect_after_s", self.reconnect_after_s),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && (0.0..=super::MAX_RUN_S).contains(&v)) {
+                    return Err((
+                        key,
+                        format!("expected 0 to {} , found {v}", super::MAX_RUN_S),
+                    ));
+                }
+            }
+        }
+        if self.reconnect_after_s.is_some() && self.disconnect_at_s.is_none() {
+            return Err((
+                "reconnect_after_s",
+                "a reconnection needs `disconnect_at_s`".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_override_the_profile_and_nothing_is_on_by_default() {
+        assert_eq!(Link::default().faults().unwrap(), LinkFaults::default());
+        let link = Link {
+            profile: Some("xv11-capture".into()),
+            corrupt_packet_rate: Some(0.01),
+            disconnect_at_s: Some(5.0),
+            reconnect_after_s: Some(2.0),
+            ..Link::default()
+        };
+        let f = link.faults().unwrap();
+        assert_eq!(f.corrupt_packet_rate, 0.01);
+        assert_eq!(f.spin_up_s, XV11_CAPTURE.spin_up_s);
+        assert_eq!(f.silent, Some((5.0, 7.0)));
+        let bad = Link {
+            profile: Some("perfect".into()),
+            ..Link::default()
+        };
+        assert!(bad.validate().is_err());
+        let bad = Link {
+            dropped_byte_rate: Some(0.9),
+            ..Link::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "dropped_byte_rate");
+    }
+}

@@ -57,6 +57,9 @@ pub struct RunArgs {
     /// How the lidar data reaches the calibrator.
     #[arg(long, value_enum, default_value_t = Via::Memory)]
     pub via: Via,
+    /// Print the results as one JSON object (`results.json`'s) instead of the summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -194,4 +197,11 @@ pub struct ScenarioTestArgs {
     /// Scenario files or directories of them (`*.toml`, searched recursively); default
     /// `scenarios/`.
     pub paths: Vec<PathBuf>,
+    /// Print the results as one JSON object instead of a line per scenario.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the results as JUnit XML (a test suite per scenario, a test case per
+    /// assertion) for CI systems.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
 }

@@ -2,7 +2,7 @@
 //! `hilsim diagnose --self-test N [--seed S] [--sim SCENARIO] [--json]`.
 //!
 //! Exit codes: 0 when a verdict is reached (`none`, an effect, or `unexplained`: each is an
-//! answer); 2 on bad input, including a recording the diagnosis refuses (too short, no sensor in
+//! answer; with `--fail-on-mismatch` only `none`, else 1); 2 on bad input, including a recording the diagnosis refuses (too short, no sensor in
 //! common, not a run of the scenario), with one line naming the file and the reason. The
 //! self-test exits 1 when it misses one of its goals.
 
@@ -50,6 +50,10 @@ pub struct DiagnoseArgs {
     /// write its report and its "real" recording (`DIR/recording`).
     #[arg(long, value_name = "I", requires = "self_test")]
     pub trial: Option<u64>,
+    /// Exit 1 when the verdict is not `none` (a mismatch was found), for CI jobs; the result is
+    /// still printed.
+    #[arg(long, conflicts_with = "self_test")]
+    pub fail_on_mismatch: bool,
 }
 
 pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
@@ -146,6 +150,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         if let Some(dir) = &args.report {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
         }
+    }
+    if args.fail_on_mismatch && diagnosis.verdict.name() != "none" {
+        return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)
 }

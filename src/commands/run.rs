@@ -1,4 +1,4 @@
-//! `hilsim run [SCENARIO] [--out DIR] [--seed N] [--via memory|serial]`: the main job.
+//! `hilsim run [SCENARIO] [--out DIR] [--seed N] [--via memory|serial] [--json]`: the main job.
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -20,7 +20,11 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         cli::Via::Serial => Via::Serial,
     };
     let report = hilsim_scenarios::execute(scenario, &origin, via)?;
-    out.write_all(report.summary().as_bytes())?;
+    if args.json {
+        out.write_all(report.results_json().as_bytes())?;
+    } else {
+        out.write_all(report.summary().as_bytes())?;
+    }
     if let Some(dir) = &args.out {
         let results = report.results_json();
         hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
@@ -28,7 +32,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
             Ok(())
         })?;
-        writeln!(out, "wrote {}", dir.display())?;
+        if !args.json {
+            writeln!(out, "wrote {}", dir.display())?;
+        }
     }
     Ok(if report.passed() {
         ExitCode::SUCCESS

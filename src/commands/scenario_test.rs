@@ -1,10 +1,13 @@
-//! `hilsim scenario test [DIR|FILE…]`: run scenario files and check their assertions.
+//! `hilsim scenario test [DIR|FILE…] [--json] [--junit FILE]`: run scenario files and check
+//! their assertions.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
+use hilsim_recording::write_file_atomically;
+use hilsim_scenarios::Report;
 use hilsim_sim::Scenario;
 
 use crate::cli::ScenarioTestArgs;
@@ -38,32 +41,110 @@ pub fn test(args: &ScenarioTestArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .zip(hilsim_scenarios::execute_all(&named, workers))
         .map(|((path, _), report)| report.map(|r| (path, r)))
         .collect::<Result<Vec<_>, _>>()?;
-    let (mut passed, mut failed) = (0, 0);
-    for (path, report) in &reports {
-        let ok = report.passed();
-        writeln!(
-            out,
-            "{} {} ({}, {} assertion(s))",
-            if ok { "PASS" } else { "FAIL" },
-            report.scenario.name,
-            path,
-            report.outcomes.len()
-        )?;
-        for o in report.outcomes.iter().filter(|o| !o.passed) {
-            writeln!(out, "    {}", o.describe())?;
-        }
-        if ok {
-            passed += 1;
-        } else {
-            failed += 1;
-        }
+    let failed = reports.iter().filter(|(_, r)| !r.passed()).count();
+    let passed = reports.len() - failed;
+    if let Some(file) = &args.junit {
+        write_file_atomically(file, junit(&reports).as_bytes())?;
     }
-    writeln!(out, "{passed} passed, {failed} failed")?;
+    if args.json {
+        let scenarios: Vec<serde_json::Value> = reports
+            .iter()
+            .map(|(path, r)| {
+                serde_json::json!({
+                    "scenario": r.scenario.name,
+                    "path": path,
+                    "passed": r.passed(),
+                    "expectations": r.outcomes,
+                })
+            })
+            .collect();
+        let summary = serde_json::json!({
+            "passed": passed,
+            "failed": failed,
+            "scenarios": scenarios,
+        });
+        writeln!(out, "{summary}")?;
+    } else {
+        for (path, report) in &reports {
+            writeln!(
+                out,
+                "{} {} ({}, {} assertion(s))",
+                if report.passed() { "PASS" } else { "FAIL" },
+                report.scenario.name,
+                path,
+                report.outcomes.len()
+            )?;
+            for o in report.outcomes.iter().filter(|o| !o.passed) {
+                writeln!(out, "    {}", o.describe())?;
+            }
+        }
+        writeln!(out, "{passed} passed, {failed} failed")?;
+    }
     Ok(if failed == 0 {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     })
+}
+
+/// JUnit XML (the Ant schema CI systems read): a `testsuite` per scenario, a `testcase` per
+/// assertion, failed ones with a `failure`, skipped ones with `skipped`.
+fn junit(reports: &[(&String, Report)]) -> String {
+    let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let total: usize = reports.iter().map(|(_, r)| r.outcomes.len()).sum();
+    let failures: usize = reports
+        .iter()
+        .map(|(_, r)| r.outcomes.iter().filter(|o| !o.passed).count())
+        .sum();
+    xml.push_str(&format!(
+        "<testsuites name=\"hilsim scenario test\" tests=\"{total}\" failures=\"{failures}\">\n"
+    ));
+    for (path, report) in reports {
+        let failed = report.outcomes.iter().filter(|o| !o.passed).count();
+        let skipped = report
+            .outcomes
+            .iter()
+            .filter(|o| o.skipped.is_some())
+            .count();
+        xml.push_str(&format!(
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{failed}\" skipped=\"{skipped}\" \
+             file=\"{}\">\n",
+            escape(&report.scenario.name),
+            report.outcomes.len(),
+            escape(path)
+        ));
+        for o in &report.outcomes {
+            xml.push_str(&format!(
+                "    <testcase classname=\"{}\" name=\"{}\">",
+                escape(&report.scenario.name),
+                escape(&o.metric)
+            ));
+            if let Some(why) = o.skipped {
+                xml.push_str(&format!("<skipped message=\"{}\"/>", escape(why)));
+            } else if !o.passed {
+                xml.push_str(&format!("<failure message=\"{}\"/>", escape(&o.describe())));
+            }
+            xml.push_str("</testcase>\n");
+        }
+        xml.push_str("  </testsuite>\n");
+    }
+    xml.push_str("</testsuites>\n");
+    xml
+}
+
+/// Text as an XML attribute value.
+fn escape(text: &str) -> String {
+    text.chars()
+        .map(|c| match c {
+            '&' => "&amp;".to_string(),
+            '<' => "&lt;".to_string(),
+            '>' => "&gt;".to_string(),
+            '"' => "&quot;".to_string(),
+            '\'' => "&apos;".to_string(),
+            c if (c as u32) < 0x20 && c != '\t' && c != '\n' => " ".to_string(),
+            c => c.to_string(),
+        })
+        .collect()
 }
 
 fn display(paths: &[PathBuf]) -> String {

@@ -94,6 +94,24 @@ fn a_concealed_effect_is_named_in_the_interface_json() {
     }
     assert_eq!(j["mismatch"], true);
     assert_eq!(j["effect"], "sonar_speed_of_sound", "{j}");
+    // Issue 20: `--fail-on-mismatch` fails a CI job on it, the result still printed.
+    let failing = hilsim(
+        tmp.path(),
+        &[
+            "diagnose",
+            "--sim",
+            &nominal,
+            "--real",
+            "real",
+            "--json",
+            "--fail-on-mismatch",
+        ],
+    );
+    assert_eq!(failing.status.code(), Some(1));
+    assert_eq!(
+        serde_json::from_str::<serde_json::Value>(&stdout(&failing)).unwrap()["effect"],
+        "sonar_speed_of_sound"
+    );
     assert_eq!(j["located"]["sensor"], "sonar");
     assert!(j["located"]["where"].is_string() && j["located"]["evidence"].is_string());
     assert_eq!(j["fit"]["metric"], "heldout_rmse_m");
@@ -130,6 +148,18 @@ fn the_nominal_run_is_none_and_the_report_renders() {
     let j = json(&out);
     assert_eq!(j["effect"], "none", "{j}");
     assert_eq!(j["mismatch"], false);
+    let passing = hilsim(
+        tmp.path(),
+        &[
+            "diagnose",
+            "--sim",
+            &nominal,
+            "--real",
+            "real",
+            "--fail-on-mismatch",
+        ],
+    );
+    assert_eq!(passing.status.code(), Some(0), "{}", stderr(&passing));
     assert!(j["located"].is_null());
     let page = std::fs::read_to_string(tmp.path().join("rep/index.html")).unwrap();
     assert!(page.starts_with("<!DOCTYPE html>"));

@@ -37,6 +37,63 @@ fn a_failing_scenario_fails_the_whole_test_with_exit_1() {
     assert!(text.contains("FAIL too-far"), "{text}");
     assert!(text.contains("PASS room-tour"), "{text}");
     assert!(text.ends_with("1 passed, 1 failed\n"), "{text}");
+
+    // Issue 20: the same as one JSON object, and as JUnit XML for CI systems.
+    let out = hilsim(
+        tmp.path(),
+        &["scenario", "test", ".", "--json", "--junit", "junit.xml"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let j: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(
+        (j["passed"].as_u64(), j["failed"].as_u64()),
+        (Some(1), Some(1))
+    );
+    let scenarios = j["scenarios"].as_array().unwrap();
+    let bad = scenarios
+        .iter()
+        .find(|s| s["scenario"] == "too-far")
+        .unwrap();
+    assert_eq!(bad["passed"], false);
+    assert!(bad["expectations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|e| e["passed"] == false && e["value"].is_number()));
+    let xml = std::fs::read_to_string(tmp.path().join("junit.xml")).unwrap();
+    assert!(
+        xml.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>"),
+        "{xml}"
+    );
+    assert_eq!(xml.matches("<testsuite ").count(), 2, "{xml}");
+    assert_eq!(xml.matches("<failure ").count(), 1, "{xml}");
+    assert!(xml.contains("<testsuite name=\"too-far\""), "{xml}");
+    assert!(
+        xml.contains("failure message=\"FAIL sim.distance_m"),
+        "{xml}"
+    );
+}
+
+/// Issue 20: `run --json` prints results.json's object instead of the summary.
+#[test]
+fn run_json_prints_the_results_object() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "run",
+            repo_file("scenarios/straight-board-0.3.toml")
+                .to_str()
+                .unwrap(),
+            "--json",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(j["scenario"], "straight-board-0.3");
+    assert_eq!(j["passed"], true);
+    assert!(j["metrics"]["em.lidar_model.mse_ratio"].is_number(), "{j}");
+    assert!(j["calibrations"][0]["checks"].is_array(), "{j}");
 }
 
 #[test]

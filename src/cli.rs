@@ -96,12 +96,16 @@ pub struct ServeArgs {
     #[arg(long, conflicts_with = "fast")]
     pub realtime: bool,
     /// Stream as fast as the reader takes it: a client that reads loses nothing; one that takes
-    /// nothing for 0.25 s loses whole revolutions (counted).
+    /// nothing for 1 s loses whole revolutions (counted).
     #[arg(long)]
     pub fast: bool,
     /// Start the stream only once a client has opened the pty (the simulation waits for it).
     #[arg(long, conflicts_with = "port")]
     pub wait_for_client: bool,
+    /// End with one JSON object on its own line (what was sent and dropped, the faults)
+    /// instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,

@@ -7,8 +7,8 @@ use hilsim_sim::rng;
 use hilsim_sim::scenario::{LinkFaults, SPARSE_BELOW_RPM};
 use rand::Rng as _;
 
-/// What the faults did, for the summaries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// What the faults did, for the summaries (and `--json`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct FaultCounts {
     /// Packets sent with a flipped byte (their checksum fails).
     pub corrupted_packets: u64,

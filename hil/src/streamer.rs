@@ -30,10 +30,11 @@ pub enum Pacing {
 
 /// Bytes a reader may leave unread before it counts as fallen behind: one revolution.
 pub const BACKLOG_LIMIT: usize = PACKETS_PER_REVOLUTION * PACKET_LEN;
-/// How long a reader of a fast stream may take nothing before it counts as stalled: a quarter
-/// of a second, longer than any live reader's pause between reads (a Python driver decoding a
-/// revolution takes milliseconds), short enough that a stalled one costs the simulation little.
-pub const FAST_STALL_GRACE: Duration = Duration::from_millis(250);
+/// How long a reader of a fast stream may take nothing before it counts as stalled: a second,
+/// far longer than a live reader's pause between reads (a Python driver decoding a revolution
+/// takes milliseconds; a process descheduled on a busy machine, tens), and paid once per stall:
+/// a stalled reader is not waited for again until it reads.
+pub const FAST_STALL_GRACE: Duration = Duration::from_secs(1);
 /// How long a reader may take nothing before it counts as stalled.
 pub const STALL_DETECT: Duration = Duration::from_millis(5);
 /// How long a lossless stream waits for its reader before giving up.

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
-use hilsim_hil::firmware::{split_command_line, Firmware};
+use hilsim_hil::firmware::{split_command_line, Ended, Firmware};
 use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
 use hilsim_scenarios::metrics;
 use hilsim_sim::scenario::MAX_RUN_S;
@@ -40,6 +40,10 @@ pub struct HilArgs {
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// End with one JSON object on its own line (how it ended, the metrics, the assertions, the
+    /// stream and the firmware) instead of the summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
 fn seconds(flag: &str, value: f64) -> Result<Duration> {
@@ -111,38 +115,91 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     out.flush()?;
     let report = hil_run::run(world, ports, Some(firmware), &config, &stop)
         .context("firmware in the loop")?;
-    out.write_all(report.summary().as_bytes())?;
     // The scenario's assertions, on the metrics a firmware's run has.
+    let hil_metrics = metrics::of_hil(&report);
     let outcomes = metrics::check(
         &scenario.expect,
-        &metrics::of_hil(&report),
+        &hil_metrics,
         metrics::RunKind::FirmwareInTheLoop,
     );
-    for outcome in &outcomes {
-        writeln!(out, "  {}", outcome.describe())?;
-    }
     let failed: Vec<&str> = outcomes
         .iter()
         .filter(|o| !o.passed)
         .map(|o| o.metric.as_str())
         .collect();
-    if !failed.is_empty() {
-        writeln!(
-            out,
-            "{} of {} assertion(s) failed: {}",
-            failed.len(),
-            outcomes.len(),
-            failed.join(", ")
-        )?;
-    }
     if let Some(dir) = &args.out {
         report.run.recording.write_dir(dir)?;
-        writeln!(out, "wrote {}", dir.display())?;
+    }
+    if args.json {
+        let json = report_json(&report, &hil_metrics, &outcomes);
+        writeln!(out, "{json}")?;
+    } else {
+        out.write_all(report.summary().as_bytes())?;
+        for outcome in &outcomes {
+            writeln!(out, "  {}", outcome.describe())?;
+        }
+        if !failed.is_empty() {
+            writeln!(
+                out,
+                "{} of {} assertion(s) failed: {}",
+                failed.len(),
+                outcomes.len(),
+                failed.join(", ")
+            )?;
+        }
+        if let Some(dir) = &args.out {
+            writeln!(out, "wrote {}", dir.display())?;
+        }
     }
     Ok(match report.ending {
         Ending::TimeUp | Ending::FirmwareExited if failed.is_empty() => ExitCode::SUCCESS,
         Ending::TimeUp | Ending::FirmwareExited | Ending::Fault(_) | Ending::Stopped => {
             ExitCode::from(1)
         }
+    })
+}
+
+/// `hil --json`: how the run ended, its metrics and assertions, the stream and the firmware.
+fn report_json(
+    report: &hil_run::HilReport,
+    metrics: &metrics::Metrics,
+    outcomes: &[metrics::Outcome],
+) -> serde_json::Value {
+    let ending = match &report.ending {
+        Ending::TimeUp => "time_up",
+        Ending::FirmwareExited => "firmware_exited",
+        Ending::Fault(_) => "fault",
+        Ending::Stopped => "stopped",
+    };
+    let firmware = report.firmware.as_ref().map(|f| {
+        serde_json::json!({
+            "status": hilsim_hil::firmware::describe_status(f.status),
+            "exit_code": f.status.code(),
+            "ended": match f.ended {
+                Ended::ByItself => "by_itself",
+                Ended::Terminated => "terminated",
+                Ended::Killed => "killed",
+            },
+            "escaped": f.escaped.iter().map(|p| serde_json::json!({"pid": p.pid, "command": p.command})).collect::<Vec<_>>(),
+        })
+    });
+    let s = &report.stream;
+    serde_json::json!({
+        "ending": ending,
+        "fault": report.fault().map(ToString::to_string),
+        "ended_at_s": report.ended_at_s,
+        "simulated_s": report.simulated_s,
+        "passed": matches!(report.ending, Ending::TimeUp | Ending::FirmwareExited)
+            && outcomes.iter().all(|o| o.passed),
+        "metrics": metrics,
+        "expectations": outcomes,
+        "stream": {
+            "revolutions_sent": s.revolutions_sent,
+            "revolutions_dropped": s.revolutions_dropped,
+            "bytes_written": s.bytes_written,
+            "lidar_bytes_read": report.lidar_bytes_read,
+        },
+        "link_faults": report.link_faults,
+        "firmware": firmware,
     })
 }

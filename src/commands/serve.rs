@@ -53,6 +53,22 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         }
     };
     let s = &report.stream;
+    if args.json {
+        let json = serde_json::json!({
+            "served_s": report.simulated_s,
+            "revolutions_sent": s.revolutions_sent,
+            "revolutions_dropped": s.revolutions_dropped,
+            "bytes_written": s.bytes_written,
+            "bytes_discarded": s.bytes_discarded,
+            "lateness_ms": {
+                "median": s.lateness_quantile(0.5).map(|d| d.as_secs_f64() * 1e3),
+                "p99": s.lateness_quantile(0.99).map(|d| d.as_secs_f64() * 1e3),
+            },
+            "link_faults": report.link_faults,
+        });
+        writeln!(out, "{json}")?;
+        return Ok(());
+    }
     write!(
         out,
         "served {:.1} s: {} revolutions sent, {} dropped (no reader yet, or one that stalled), {} bytes",

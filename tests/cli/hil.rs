@@ -467,6 +467,34 @@ fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
         text.contains("1 of 5 assertion(s) failed: sim.final_x_m"),
         "{text}"
     );
+    // Issue 20: `--json` ends with one object saying the same.
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--duration",
+            "2",
+            "--json",
+            "--firmware",
+            r#"sh -c 'exec cat "$HILSIM_LIDAR_PORT" >/dev/null'"#,
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let last = stdout(&out).lines().last().unwrap().to_string();
+    let j: serde_json::Value = serde_json::from_str(&last).unwrap();
+    assert_eq!(j["ending"], "time_up", "{j}");
+    assert_eq!(j["passed"], false, "{j}");
+    assert_eq!(j["metrics"]["sim.final_x_m"], 2.5, "{j}");
+    let failed: Vec<_> = j["expectations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["passed"] == false)
+        .map(|e| e["metric"].as_str().unwrap())
+        .collect();
+    assert_eq!(failed, ["sim.final_x_m"]);
+    assert!(j["firmware"]["status"].is_string(), "{j}");
 }
 
 /// Issue 19: both example firmwares, over a link that fails as the real capture does (spin-up

@@ -141,7 +141,8 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// One line for people: `PASS lidar.readings = 72000 (≥ 1000)`.
+    /// One line for people: `PASS lidar.readings = 72000 (expected ≥ 1000)`, with the value's
+    /// unit.
     #[must_use]
     pub fn describe(&self) -> String {
         let bounds: Vec<String> = [
@@ -158,9 +159,10 @@ impl Outcome {
                 bounds.join(" and ")
             );
         }
-        let value = self
-            .value
-            .map_or_else(|| "not computed".to_string(), |v| format!("{v:.6}"));
+        let value = self.value.map_or_else(
+            || "not computed".to_string(),
+            |v| format!("{}{}", readable(v), unit(&self.metric)),
+        );
         format!(
             "{} {} = {value} (expected {})",
             if self.passed { "PASS" } else { "FAIL" },
@@ -201,6 +203,42 @@ impl RunKind {
             }
             _ => None,
         }
+    }
+}
+
+/// A value for people: a count as a whole number, anything else to six significant digits
+/// without trailing zeros (`150`, `0.0123457`, `4.12409`).
+fn readable(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        return format!("{v:.0}");
+    }
+    let magnitude = if v == 0.0 {
+        0
+    } else {
+        v.abs().log10().floor() as i32
+    };
+    let decimals = usize::try_from((5 - magnitude).max(0)).unwrap_or(0);
+    let text = format!("{v:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+/// The unit a metric's name says it is in (the catalogue's convention: `_m`, `_s`, `_deg`, MSEs
+/// in m²), with a leading space; none for counts and ratios.
+fn unit(metric: &str) -> &'static str {
+    if metric.ends_with("mse_raw") || metric.ends_with("mse_calibrated") {
+        " m²"
+    } else if metric.ends_with("_m") {
+        " m"
+    } else if metric.ends_with("_s") {
+        " s"
+    } else if metric.ends_with("_deg") {
+        "°"
+    } else {
+        ""
     }
 }
 
@@ -261,4 +299,23 @@ pub fn of_hil(report: &HilReport) -> Metrics {
         put("hil.firmware_exit_code", f64::from(code));
     }
     m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_read_as_counts_or_six_significant_digits_with_their_unit() {
+        assert_eq!(readable(0.0), "0");
+        assert_eq!(readable(150.0), "150");
+        assert_eq!(readable(4.124_093_2), "4.12409");
+        assert_eq!(readable(0.012_345_678), "0.0123457");
+        assert_eq!(readable(-179.999_991), "-180");
+        assert_eq!(readable(2.5), "2.5");
+        assert_eq!(unit("sim.final_x_m"), " m");
+        assert_eq!(unit("em.lidar.mse_raw"), " m²");
+        assert_eq!(unit("em.lidar.mse_ratio"), "");
+        assert_eq!(unit("sim.final_yaw_deg"), "°");
+    }
 }

@@ -17,11 +17,11 @@ use crate::cli::{CalibrateArgs, SmoothArgs};
 /// Prints the calibration; exit 1 when one of its checks failed (the result is still printed).
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let target = target_options(args.beam, args.start_distance)?;
-    if args.settle_s.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
-        bail!("--settle-s: expected a settling time in seconds, 0 or more");
+    if args.settle_s.is_some_and(|s| !(s.is_finite() && (0.0..=86_400.0).contains(&s))) {
+        bail!("--settle-s: expected a settling time in seconds, from 0 to 86400");
     }
-    if !(args.min_revolutions.is_finite() && args.min_revolutions >= 1.0) {
-        bail!("--min-revolutions: expected a number of revolutions, 1 or more");
+    if !(args.min_revolutions.is_finite() && (1.0..=1e6).contains(&args.min_revolutions)) {
+        bail!("--min-revolutions: expected a number of revolutions from 1 to 1000000");
     }
     if !args.priors.is_empty() && args.method != Method::Em {
         bail!("--prior: priors are for --method em");

@@ -32,6 +32,50 @@ pub fn diagnose(
     recording: &Recording,
     options: &Options,
 ) -> Result<Diagnosis, MismatchError> {
+    diagnose_with_progress(physics, recording, options, &mut |_| {})
+}
+
+/// The stages of a diagnosis, as [`diagnose_with_progress`] reports them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Aligning the recording with the simulation (the trajectory: truth, or estimated).
+    Aligning,
+    /// Predicting every reading from the simulation.
+    Gathering,
+    /// Looking for where the two disagree.
+    Locating,
+    /// Fitting each catalogued effect.
+    Fitting,
+    /// Choosing the verdict and drawing the plots.
+    Concluding,
+}
+
+impl Stage {
+    /// In words.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Aligning => "aligning the recording with the simulation",
+            Self::Gathering => "predicting every reading from the simulation",
+            Self::Locating => "locating where they disagree",
+            Self::Fitting => "fitting the catalogued effects",
+            Self::Concluding => "concluding",
+        }
+    }
+}
+
+/// As [`diagnose`], telling `progress` as each stage starts (for a long diagnosis's status
+/// line; the library itself prints nothing).
+///
+/// # Errors
+/// As [`diagnose`].
+pub fn diagnose_with_progress(
+    physics: &dyn Physics,
+    recording: &Recording,
+    options: &Options,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Diagnosis, MismatchError> {
+    progress(Stage::Aligning);
     let aligned = align::align(physics, recording)?;
     let ctx = Context {
         physics,
@@ -43,10 +87,14 @@ pub fn diagnose(
         estimated: aligned.alignment == Alignment::Estimated,
     };
     let mut notes = aligned.notes.clone();
+    progress(Stage::Gathering);
     let mut data = gather(&ctx, &mut notes)?;
+    progress(Stage::Locating);
     let nominal = nominal_evidence(&ctx, &data, options);
+    progress(Stage::Fitting);
     let mut candidates = fit_candidates(&ctx, &data, options);
     let best = best_candidate(&ctx, &candidates, options);
+    progress(Stage::Concluding);
     let (best, realigned) =
         realign_lidar(&ctx, &aligned, best, &mut candidates, &mut data, options)?;
     let realigned_ctx = realigned.as_ref().map(|a| Context {

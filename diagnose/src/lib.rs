@@ -37,7 +37,7 @@ mod trajectory;
 
 pub use align::Alignment;
 pub use catalogue::{DrawSource, Effect, ParamSpec, SelfTestRange, Sensor};
-pub use diagnosis::diagnose;
+pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
 pub use explain::CandidateFit;
 pub use hilsim_recording::Pose;

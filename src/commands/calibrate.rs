@@ -17,7 +17,10 @@ use crate::cli::{CalibrateArgs, SmoothArgs};
 /// Prints the calibration; exit 1 when one of its checks failed (the result is still printed).
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let target = target_options(args.beam, args.start_distance)?;
-    if args.settle_s.is_some_and(|s| !(s.is_finite() && (0.0..=86_400.0).contains(&s))) {
+    if args
+        .settle_s
+        .is_some_and(|s| !(s.is_finite() && (0.0..=86_400.0).contains(&s)))
+    {
         bail!("--settle-s: expected a settling time in seconds, from 0 to 86400");
     }
     if !(args.min_revolutions.is_finite() && (1.0..=1e6).contains(&args.min_revolutions)) {

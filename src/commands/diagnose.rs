@@ -6,14 +6,16 @@
 //! common, not a run of the scenario), with one line naming the file and the reason. The
 //! self-test exits 1 when it misses one of its goals.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan};
-use hilsim_diagnose::{show, Effect, Options, SimPhysics};
+use hilsim_diagnose::{show, Effect, Options, SimPhysics, Stage};
 use hilsim_recording::{write_file_atomically, Recording};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// Compare a simulation with a real recording: locate the mismatch, name the physics left out,
 /// fit it, show the held-out improvement. Or prove it blind with `--self-test N`.
@@ -119,7 +121,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             command += &format!(" --strength {}", args.strength);
         }
         let started = std::time::Instant::now();
-        let result = self_test::run(&scenario, plan)?;
+        let progress = TrialProgress::new(n, !args.json);
+        let result = self_test::run_with_progress(&scenario, plan, &|| progress.trial_done())?;
+        drop(progress);
         let wall_s = started.elapsed().as_secs_f64();
         if args.json {
             writeln!(out, "{}", result.to_json(&command, wall_s))?;
@@ -138,8 +142,17 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let scenario = super::load_scenario(Some(sim), None)?;
     let recording = Recording::read_dir(real)?;
     let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
-    let diagnosis = hilsim_diagnose::diagnose(&physics, &recording, &Options::default())
-        .with_context(|| real.display().to_string())?;
+    // The stages on a terminal only: stdout starts with the verdict and stderr holds one line
+    // for an error, as scripts expect.
+    let status = StageStatus::new();
+    let diagnosis = hilsim_diagnose::diagnose_with_progress(
+        &physics,
+        &recording,
+        &Options::default(),
+        &mut |stage| status.stage(stage),
+    )
+    .with_context(|| real.display().to_string())?;
+    drop(status);
     if let Some(dir) = &args.report {
         write_report(dir, &diagnosis, sim, real)?;
     }
@@ -180,4 +193,90 @@ fn write_report(dir: &Path, d: &hilsim_diagnose::Diagnosis, sim: &Path, real: &P
         show::html(d, &title, &files).as_bytes(),
     )?;
     Ok(())
+}
+
+/// The diagnosis's stages: a spinner on stderr when it is a terminal (cleared when done, or on
+/// an error).
+struct StageStatus {
+    spinner: Option<ProgressBar>,
+}
+
+impl StageStatus {
+    fn new() -> Self {
+        let spinner = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            if let Ok(style) = ProgressStyle::with_template("{spinner} diagnose: {msg} ({elapsed})")
+            {
+                bar.set_style(style);
+            }
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        });
+        Self { spinner }
+    }
+
+    fn stage(&self, stage: Stage) {
+        if let Some(bar) = &self.spinner {
+            bar.set_message(stage.describe());
+        }
+    }
+}
+
+impl Drop for StageStatus {
+    fn drop(&mut self) {
+        if let Some(bar) = &self.spinner {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// The self-test's trials: a bar on stderr when it is a terminal, else (without `--json`) a
+/// line on stderr at every tenth.
+struct TrialProgress {
+    bar: Option<ProgressBar>,
+    lines: bool,
+    total: u64,
+    done: AtomicU64,
+}
+
+impl TrialProgress {
+    fn new(total: u64, lines: bool) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+            if let Ok(style) =
+                ProgressStyle::with_template("{bar:40} {pos}/{len} trials  eta {eta}")
+            {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Self {
+            bar,
+            lines,
+            total,
+            done: AtomicU64::new(0),
+        }
+    }
+
+    fn trial_done(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        match &self.bar {
+            Some(bar) => bar.inc(1),
+            None if self.lines => {
+                let tenth = (self.total / 10).max(1);
+                if done % tenth == 0 || done == self.total {
+                    eprintln!("self-test: {done}/{} trials", self.total);
+                }
+            }
+            None => {}
+        }
+    }
+}
+
+impl Drop for TrialProgress {
+    fn drop(&mut self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
 }

@@ -55,6 +55,18 @@ impl SelfTest {
 /// [`MismatchError::Input`] when the nominal scenario's sensor models are invalid or more than
 /// [`super::MAX_TRIALS`] trials are asked for.
 pub fn run(nominal: &Scenario, plan: Plan) -> Result<SelfTest, MismatchError> {
+    run_with_progress(nominal, plan, &|| {})
+}
+
+/// As [`run`], calling `trial_done` as each trial ends (from the worker threads).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with_progress(
+    nominal: &Scenario,
+    plan: Plan,
+    trial_done: &(dyn Fn() + Sync),
+) -> Result<SelfTest, MismatchError> {
     if plan.trials > super::MAX_TRIALS {
         return Err(MismatchError::Input(format!(
             "at most {} trials, asked for {}",
@@ -65,7 +77,11 @@ pub fn run(nominal: &Scenario, plan: Plan) -> Result<SelfTest, MismatchError> {
     SimPhysics::new(nominal)?;
     let outcomes: Vec<Outcome> = (0..plan.trials)
         .into_par_iter()
-        .map(|i| trial(nominal, plan.seed, i, plan.strength, plan.only))
+        .map(|i| {
+            let outcome = trial(nominal, plan.seed, i, plan.strength, plan.only);
+            trial_done();
+            outcome
+        })
         .collect();
     let score = Score::of(&outcomes);
     Ok(SelfTest {

@@ -68,7 +68,7 @@ impl LidarReading {
     #[must_use]
     pub fn to_sample(&self) -> LidarSample {
         LidarSample {
-            t_s: self.t_s,
+            t_s: hilsim_sim::exact_time_s(self.t_s),
             rev: self.rev,
             angle_deg: self.angle_deg,
             range_m: f64::from(self.distance_mm) / 1000.0,

@@ -50,7 +50,15 @@ impl Odometer {
     fn report(&mut self, travel_m: f64) -> f64 {
         let e: f64 = StandardNormal.sample(&mut self.rng);
         let value = travel_m * self.scale + self.noise_m * e;
-        (value / self.tick_m).round() * self.tick_m
+        let ticks = (value / self.tick_m).round();
+        // Whole ticks per metre (1000 for the Neato's millimetres): dividing gives the exact
+        // decimal (`0.018`, not `0.018000000000000002` as multiplying by 0.001 does).
+        let per_m = (1.0 / self.tick_m).round();
+        if (per_m * self.tick_m - 1.0).abs() < 1e-12 {
+            ticks / per_m
+        } else {
+            ticks * self.tick_m
+        }
     }
 
     /// Readings whose instant falls in `[step.t0, step.t1)`.
@@ -72,7 +80,7 @@ impl Odometer {
                 right += slip_travel_m(gain, (step.wheels1[1] - step.wheels0[1]) / dt);
             }
             out.push(OdometrySample {
-                t_s: t,
+                t_s: hilsim_sim::exact_time_s(t),
                 left_m: self.report(left),
                 right_m: self.report(right),
             });

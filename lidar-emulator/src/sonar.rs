@@ -131,7 +131,7 @@ impl Sonar {
                 let ranged = d * self.range_scale;
                 let range = (self.model.sample(ranged, &mut self.rng) * 1000.0).round() / 1000.0;
                 out.push(SonarSample {
-                    t_s: t,
+                    t_s: hilsim_sim::exact_time_s(t),
                     range_m: range.max(0.0),
                     true_range_m: Some(d),
                 });

@@ -116,7 +116,7 @@ impl WireTimeline {
         let (rev, start_s) = (self.next_rev, self.next_start_s);
         for (angle, reading) in revolution.readings() {
             out.push(LidarSample {
-                t_s: reading_time_s(start_s, angle, rpm),
+                t_s: hilsim_sim::exact_time_s(reading_time_s(start_s, angle, rpm)),
                 rev,
                 angle_deg: angle,
                 range_m: reading.range_m().unwrap_or(0.0),

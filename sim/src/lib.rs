@@ -37,5 +37,5 @@ pub use drive::{DriveProgram, WheelCommand};
 pub use hilsim_recording::pose::{self, Pose};
 pub use motor_lag::MotorLag;
 pub use scenario::{Scenario, ScenarioError};
-pub use simulation::{Collision, Simulation, StepState};
+pub use simulation::{exact_time_s, Collision, Simulation, StepState};
 pub use world::{Obstacle, RayHit, World};

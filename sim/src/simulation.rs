@@ -160,7 +160,7 @@ impl Simulation {
     /// The simulated time now, seconds.
     #[must_use]
     pub fn time_s(&self) -> f64 {
-        self.steps_done as f64 * self.step_s
+        exact_time_s(self.steps_done as f64 * self.step_s)
     }
 
     /// The physics step, seconds.
@@ -341,6 +341,15 @@ impl Simulation {
             std::mem::take(&mut self.collisions),
         )
     }
+}
+
+/// A time as a recording writes it: to the microsecond, so that it reads as the exact decimal
+/// it is (`0.15`, not `0.15000000000000002`: the integer count of microseconds over a million is
+/// the double nearest that decimal). A microsecond is far below any sensor's timing (the XV-11
+/// takes a reading every 556 µs).
+#[must_use]
+pub fn exact_time_s(t: f64) -> f64 {
+    (t * 1e6).round() / 1e6
 }
 
 fn truth(t_s: f64, pose: Pose) -> TruthSample {

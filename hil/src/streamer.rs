@@ -37,6 +37,9 @@ pub const BACKLOG_LIMIT: usize = PACKETS_PER_REVOLUTION * PACKET_LEN;
 pub const FAST_STALL_GRACE: Duration = Duration::from_secs(1);
 /// How long a reader may take nothing before it counts as stalled.
 pub const STALL_DETECT: Duration = Duration::from_millis(5);
+/// How long the reader's queue must stay empty before a draining stream takes it as read: a
+/// pty hands written bytes over in the background, later on a busy machine.
+const DRAIN_QUIET: Duration = Duration::from_millis(100);
 /// How long a lossless stream waits for its reader before giving up.
 pub const LOSSLESS_TIMEOUT: Duration = Duration::from_secs(10);
 /// Packet lateness histogram resolution.
@@ -242,14 +245,28 @@ impl<L: SerialLink> Streamer<L> {
     /// # Errors
     /// The link failed.
     pub fn drain(&mut self) -> io::Result<()> {
+        if !self.reader_reading {
+            return Ok(());
+        }
         let mut backlog = self.link.backlog()?;
         let mut progress_at = Instant::now();
-        while backlog > 0 && self.reader_reading {
-            if progress_at.elapsed() >= FAST_STALL_GRACE {
-                // What the closing link will throw away.
-                self.lost(backlog);
-                self.reader_reading = false;
-                break;
+        let mut empty_since: Option<Instant> = None;
+        loop {
+            // A pty moves written bytes into the reader's queue in the background: an empty
+            // queue is only the end once it has stayed empty for a while.
+            if backlog == 0 {
+                let since = *empty_since.get_or_insert_with(Instant::now);
+                if since.elapsed() >= DRAIN_QUIET {
+                    break;
+                }
+            } else {
+                empty_since = None;
+                if progress_at.elapsed() >= FAST_STALL_GRACE {
+                    // What the closing link will throw away.
+                    self.lost(backlog);
+                    self.reader_reading = false;
+                    break;
+                }
             }
             thread::sleep(Duration::from_millis(1));
             let now_backlog = self.link.backlog()?;

@@ -28,9 +28,23 @@ pub struct ServeReport {
 /// # Errors
 /// The link failed.
 pub fn serve<L: SerialLink>(
+    emulation: Emulation,
+    streamer: &mut Streamer<L>,
+    stop: &AtomicBool,
+) -> io::Result<ServeReport> {
+    serve_with_progress(emulation, streamer, stop, &mut |_, _| {})
+}
+
+/// As [`serve`], telling `progress` the stream's counts and the simulated time after each
+/// revolution (for a status line; the library prints nothing).
+///
+/// # Errors
+/// The link failed.
+pub fn serve_with_progress<L: SerialLink>(
     mut emulation: Emulation,
     streamer: &mut Streamer<L>,
     stop: &AtomicBool,
+    progress: &mut dyn FnMut(&StreamStats, f64),
 ) -> io::Result<ServeReport> {
     let mut collector = RevolutionCollector::default();
     let mut readings = Vec::new();
@@ -44,6 +58,7 @@ pub fn serve<L: SerialLink>(
                 .map_or(0.0, |l| l.rpm_of_revolution(reading.rev));
             if let Some(frame) = collector.push(reading, rpm) {
                 streamer.send(&frame)?;
+                progress(streamer.stats(), frame.start_s);
             }
         }
         if stop.load(Ordering::Relaxed) {

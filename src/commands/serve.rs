@@ -1,14 +1,15 @@
 //! `hilsim serve SCENARIO [--pty | --port PATH] [--realtime | --fast] [--wait-for-client]
 //! [--seed N]`.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result};
 use hilsim_hil::faults::WireFaults;
-use hilsim_hil::serve::{serve as stream, ServeReport};
+use hilsim_hil::serve::{serve_with_progress, ServeReport};
 use hilsim_hil::{DeviceLink, Pacing, PtyLink, SerialLink, Streamer};
 use hilsim_lidar_emulator::Emulation;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::cli::ServeArgs;
 
@@ -96,5 +97,25 @@ fn run<L: SerialLink>(
     if client_connected {
         streamer.reader_connected();
     }
-    stream(emulation, &mut streamer, stop).context("the serial link failed")
+    // What is sent, as a status line on a terminal (stderr; stdout keeps its lines for scripts).
+    let status = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{spinner} serve: {msg}") {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let report = serve_with_progress(emulation, &mut streamer, stop, &mut |stats, t_s| {
+        if let Some(bar) = &status {
+            bar.set_message(format!(
+                "{:.1} s simulated, {} revolutions sent, {} dropped",
+                t_s, stats.revolutions_sent, stats.revolutions_dropped
+            ));
+            bar.tick();
+        }
+    });
+    if let Some(bar) = &status {
+        bar.finish_and_clear();
+    }
+    report.context("the serial link failed")
 }

@@ -268,26 +268,14 @@ pub fn target_follows_commands(commanded_m: &[f64], lidar_m: &[Option<f64>]) -> 
 /// R² of the least-squares quadratic `y ≈ a + b x + c x²`; `None` with fewer than 10 points or
 /// no spread.
 fn quadratic_r2(pairs: &[(f64, f64)]) -> Option<f64> {
-    use nalgebra::{Matrix3, Vector3};
     if pairs.len() < 10 {
         return None;
     }
-    let mx = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.len() as f64;
-    let (mut a, mut b) = (Matrix3::<f64>::zeros(), Vector3::<f64>::zeros());
-    for &(x, y) in pairs {
-        let phi = Vector3::new(1.0, x - mx, (x - mx).powi(2));
-        a += phi * phi.transpose();
-        b += phi * y;
-    }
-    let coef = a.cholesky()?.solve(&b);
-    let my = pairs.iter().map(|p| p.1).sum::<f64>() / pairs.len() as f64;
-    let (mut ss_res, mut ss_tot) = (0.0, 0.0);
-    for &(x, y) in pairs {
-        let fit = coef[0] + coef[1] * (x - mx) + coef[2] * (x - mx).powi(2);
-        ss_res += (y - fit).powi(2);
-        ss_tot += (y - my).powi(2);
-    }
-    (ss_tot > 0.0).then(|| 1.0 - ss_res / ss_tot)
+    let (x, y): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+    let fit = crate::landmarks::regression::fit_poly(&x, &y, None, 2)?;
+    let mean = y.iter().sum::<f64>() / y.len() as f64;
+    let total: f64 = y.iter().map(|v| (v - mean).powi(2)).sum();
+    (total > 0.0).then(|| 1.0 - fit.rss / total)
 }
 
 /// Bounds on the mean squared standardised innovation: [0.5, 2]. It is 1 when the fitted noise

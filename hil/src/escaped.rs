@@ -43,14 +43,9 @@ pub fn new_lineage() -> String {
 /// Every live process whose environment holds `LINEAGE_VARIABLE=lineage`, zombies left out.
 #[must_use]
 pub fn find(lineage: &str) -> Vec<EscapedProcess> {
-    let Ok(entries) = fs::read_dir("/proc") else {
-        return Vec::new();
-    };
     let wanted = format!("{LINEAGE_VARIABLE}={lineage}");
-    let mut found: Vec<EscapedProcess> = entries
-        .filter_map(Result::ok)
-        .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
-        .filter(|&pid| pid != std::process::id())
+    let mut found: Vec<EscapedProcess> = crate::process::other_pids()
+        .into_iter()
         .filter(|&pid| carries(pid, &wanted) && !crate::process::is_zombie(pid))
         .map(|pid| EscapedProcess {
             pid,

@@ -31,3 +31,19 @@ fn stat_is_zombie(stat: &str) -> bool {
         .next()
         .is_some_and(|s| s.trim_start().starts_with('Z'))
 }
+
+/// The ids of every other process this one can see (`/proc`; Linux; empty elsewhere).
+#[must_use]
+pub fn other_pids() -> Vec<u32> {
+    let ours = std::process::id();
+    std::fs::read_dir("/proc").map_or_else(
+        |_| Vec::new(),
+        |entries| {
+            entries
+                .filter_map(Result::ok)
+                .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
+                .filter(|&pid| pid != ours)
+                .collect()
+        },
+    )
+}

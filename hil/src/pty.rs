@@ -70,21 +70,16 @@ impl PtyLink {
     /// elsewhere `true`, as nothing can tell).
     #[must_use]
     pub fn client_connected(&self) -> bool {
-        let Ok(entries) = std::fs::read_dir("/proc") else {
+        if !std::path::Path::new("/proc/self/fd").is_dir() {
             return true;
-        };
-        let ours = std::process::id();
+        }
         let client = std::path::Path::new(&self.client_path);
-        entries
-            .filter_map(Result::ok)
-            .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
-            .filter(|&pid| pid != ours)
-            .any(|pid| {
-                std::fs::read_dir(format!("/proc/{pid}/fd")).is_ok_and(|fds| {
-                    fds.filter_map(Result::ok)
-                        .any(|fd| std::fs::read_link(fd.path()).is_ok_and(|l| l == client))
-                })
+        crate::process::other_pids().into_iter().any(|pid| {
+            std::fs::read_dir(format!("/proc/{pid}/fd")).is_ok_and(|fds| {
+                fds.filter_map(Result::ok)
+                    .any(|fd| std::fs::read_link(fd.path()).is_ok_and(|l| l == client))
             })
+        })
     }
 
     /// Waits until a client has opened the port ([`PtyLink::client_connected`]), or `stop` is

@@ -37,6 +37,9 @@ pub struct PolyFit {
     pub residuals: Vec<f64>,
     /// Leverages hᵢᵢ.
     pub leverages: Vec<f64>,
+    /// Standard errors of the coefficients: `s² (Aᵀ W A)⁻¹` diagonal with `s² = RSS/(N − n − 1)`
+    /// (the weights relative, their scale from the residuals), the `x` taken as known.
+    pub coeff_sd: Vec<f64>,
 }
 
 /// The fits of orders 0..=n_max and the orders the two criteria pick.
@@ -85,6 +88,17 @@ pub fn fit_poly(x: &[f64], y: &[f64], w: Option<&[f64]>, order: usize) -> Option
         .sum();
     let nf = n as f64;
     let aic = nf * (rss.max(1e-300) / nf).ln() + 2.0 * (p as f64 + 1.0);
+    // (AᵀWA)⁻¹ = V Σ⁻² Vᵀ from the SVD, undoing the column scaling.
+    let v_t = svd.v_t.as_ref()?;
+    let s2 = rss / (n - p) as f64;
+    let coeff_sd = (0..p)
+        .map(|j| {
+            let var: f64 = (0..p)
+                .map(|k| (v_t[(k, j)] / svd.singular_values[k]).powi(2))
+                .sum();
+            (s2 * var).sqrt() / scale.powi(j as i32)
+        })
+        .collect();
     Some(PolyFit {
         coeffs,
         rss,
@@ -92,6 +106,7 @@ pub fn fit_poly(x: &[f64], y: &[f64], w: Option<&[f64]>, order: usize) -> Option
         press,
         residuals,
         leverages,
+        coeff_sd,
     })
 }
 
@@ -180,24 +195,6 @@ pub fn nnls(x: &[Vec<f64>], y: &[f64], w: Option<&[f64]>) -> Option<Vec<f64>> {
         }
     }
     best.map(|(_, c)| c)
-}
-
-/// Standard errors of the coefficients of a least-squares polynomial of `order` through points
-/// at `x` with residuals `e`: `s² (ΦᵀΦ)⁻¹` diagonal, `s² = Σ e² / (N − order − 1)`. The `x` are
-/// taken as known, so for estimated distances this is a lower bound.
-#[must_use]
-pub fn coefficient_sd(x: &[f64], e: &[f64], order: usize) -> Vec<f64> {
-    let p = order + 1;
-    let n = x.len().min(e.len());
-    if n <= p {
-        return vec![f64::INFINITY; p];
-    }
-    let phi = nalgebra::DMatrix::from_fn(n, p, |i, j| x[i].powi(j as i32));
-    let s2 = e[..n].iter().map(|v| v * v).sum::<f64>() / (n - p) as f64;
-    match (phi.transpose() * &phi).try_inverse() {
-        Some(inv) => (0..p).map(|j| (s2 * inv[(j, j)]).max(0.0).sqrt()).collect(),
-        None => vec![f64::INFINITY; p],
-    }
 }
 
 /// Standard errors of [`fit_beta`]'s coefficients: its weighted regression of `√(π/2)|e|` on

@@ -7,7 +7,6 @@ use crate::landmarks::estimate::{
 };
 use crate::landmarks::options::{Estimator, Options, OrderSelection};
 use crate::landmarks::positions::{PositionError, MIN_BEARING_SPREAD_RAD};
-use crate::landmarks::regression::coefficient_sd;
 use crate::CalibrationError;
 
 /// The model the calibration reports, with the figures that go with it.
@@ -134,10 +133,10 @@ pub(super) fn choose_model(est: &Estimate, opts: &Options, notes: &mut Vec<Strin
     }
 }
 
-/// A stage's α standard errors from its regression's residuals at its distances.
+/// A stage's α standard errors: its regression's, at its estimated distances (a lower bound).
 fn stage_alpha_sd(stage: &crate::landmarks::estimate::Stage) -> Vec<f64> {
     match stage.scan.fits.get(stage.order) {
-        Some(fit) => coefficient_sd(&stage.distances, &fit.residuals, stage.order),
+        Some(fit) => fit.coeff_sd.clone(),
         None => vec![f64::INFINITY; stage.alpha.len()],
     }
 }

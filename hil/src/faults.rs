@@ -21,12 +21,6 @@ pub struct FaultCounts {
 }
 
 impl FaultCounts {
-    /// Whether any fault struck.
-    #[must_use]
-    pub fn any(&self) -> bool {
-        *self != Self::default()
-    }
-
     /// One line for people.
     #[must_use]
     pub fn describe(&self) -> String {

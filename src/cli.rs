@@ -143,14 +143,10 @@ pub struct CalibrateArgs {
     /// found from the odometry, else from the scans, else 0.3 s).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub settle_s: Option<f64>,
-    /// Landmarks: a stop is used when it holds at least this many lidar revolutions at rest.
-    #[arg(
-        long,
-        value_name = "N",
-        default_value_t = 2.0,
-        allow_negative_numbers = true
-    )]
-    pub min_revolutions: f64,
+    /// Landmarks: a stop is used when it holds at least this many lidar revolutions at rest
+    /// (default 2).
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub min_revolutions: Option<f64>,
     /// EM: a Gaussian prior on a bias coefficient, e.g. `sonar.alpha1=1.028±0.003` (`+-` for
     /// `±`); repeatable. A prior on a scale (alpha1) lets EM estimate the drive's speed scale.
     #[arg(

@@ -23,11 +23,20 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     {
         bail!("--settle-s: expected a settling time in seconds, from 0 to 86400");
     }
-    if !(args.min_revolutions.is_finite() && (1.0..=1e6).contains(&args.min_revolutions)) {
+    if args
+        .min_revolutions
+        .is_some_and(|n| !(n.is_finite() && (1.0..=1e6).contains(&n)))
+    {
         bail!("--min-revolutions: expected a number of revolutions from 1 to 1000000");
     }
+    // Each method's own options: given to another, they would be silently ignored.
     if !args.priors.is_empty() && args.method != Method::Em {
         bail!("--prior: priors are for --method em");
+    }
+    if (args.settle_s.is_some() || args.min_revolutions.is_some())
+        && args.method != Method::Landmarks
+    {
+        bail!("--settle-s and --min-revolutions are for --method landmarks");
     }
     let priors: Vec<em::Prior> = args
         .priors
@@ -38,7 +47,9 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
         target,
         stops: StopOptions {
             settle_s: args.settle_s,
-            min_revolutions: args.min_revolutions,
+            min_revolutions: args
+                .min_revolutions
+                .unwrap_or(StopOptions::default().min_revolutions),
             ..StopOptions::default()
         },
         priors: em::Priors::new(&priors)?,

@@ -42,6 +42,9 @@ pub enum Command {
     /// simulation left out, fit it and show the held-out improvement (or prove it blind with
     /// `--self-test N`).
     Diagnose(crate::commands::diagnose::DiagnoseArgs),
+    /// Draw a recording as one self-contained HTML page: the world, the paths, the scans, each
+    /// sensor's error against distance and the calibration.
+    Report(crate::commands::report::ReportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -60,6 +63,10 @@ pub struct RunArgs {
     /// Print the results as one JSON object (`results.json`'s) instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Write the run's report (`index.html`: the world, the paths, the scans, the errors
+    /// against distance, the calibration) into this directory.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -33,6 +33,7 @@ fn main() -> ExitCode {
         Command::Dataset(args) => commands::dataset::dataset(args, &mut out),
         Command::Hil(args) => commands::hil::hil(args, &mut out),
         Command::Diagnose(args) => commands::diagnose::diagnose(args, &mut out),
+        Command::Report(args) => commands::report::report(args, &mut out),
     };
     let _ = out.flush();
     match result {

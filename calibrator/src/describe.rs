@@ -3,7 +3,10 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-use crate::{Calibration, CalibrationError, Method, Sensor, SensorModel};
+use crate::checks::Check;
+use crate::{
+    Calibration, CalibrationError, LidarModelMetrics, Method, Metrics, Sensor, SensorModel,
+};
 
 impl Calibration {
     /// One line per sensor, the metrics, the notes.
@@ -87,15 +90,44 @@ impl Calibration {
         Ok(())
     }
 
-    /// The sensor models of a calibration's JSON (as [`Calibration::to_json`] writes it); the
-    /// rest (iterations, metrics, notes) is not read back. `origin` names the text in errors.
+    /// A calibration read back from its JSON (as [`Calibration::to_json`] writes it): the
+    /// sensor models, and what else the JSON holds (standard errors, iterations, metrics,
+    /// checks, notes; each optional). `origin` names the text in errors.
     ///
     /// # Errors
     /// [`CalibrationError::Invalid`] naming `origin` (and the line, for malformed JSON).
     pub fn from_json(text: &str, origin: &str) -> Result<Self, CalibrationError> {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|err| {
+            CalibrationError::Invalid(format!("{origin}:{}: not JSON: {err}", err.line()))
+        })?;
+        Self::from_json_value(&value, origin)
+    }
+
+    /// Every calibration in a JSON text: one `hilsim calibrate --json` object, or a run's
+    /// `results.json` (its `calibrations` list). `origin` names the text in errors.
+    ///
+    /// # Errors
+    /// As [`Calibration::from_json`].
+    pub fn all_from_json(text: &str, origin: &str) -> Result<Vec<Self>, CalibrationError> {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|err| {
+            CalibrationError::Invalid(format!("{origin}:{}: not JSON: {err}", err.line()))
+        })?;
+        match value.get("calibrations") {
+            Some(serde_json::Value::Array(list)) => list
+                .iter()
+                .enumerate()
+                .map(|(i, c)| Self::from_json_value(c, &format!("{origin}: calibrations[{i}]")))
+                .collect(),
+            Some(_) => Err(CalibrationError::Invalid(format!(
+                "{origin}: `calibrations` must be a list"
+            ))),
+            None => Ok(vec![Self::from_json_value(&value, origin)?]),
+        }
+    }
+
+    /// [`Calibration::from_json`] of a parsed value.
+    fn from_json_value(value: &serde_json::Value, origin: &str) -> Result<Self, CalibrationError> {
         let invalid = |message: String| CalibrationError::Invalid(message);
-        let value: serde_json::Value = serde_json::from_str(text)
-            .map_err(|err| invalid(format!("{origin}:{}: not JSON: {err}", err.line())))?;
         let method = match value["method"].as_str() {
             Some("em") => Method::Em,
             Some("landmarks") => Method::Landmarks,
@@ -105,6 +137,12 @@ impl Calibration {
                     "{origin}: `method` must be em, landmarks or groundtruth, found {other:?}"
                 )))
             }
+        };
+        let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
+            v.as_array()?
+                .iter()
+                .map(serde_json::Value::as_f64)
+                .collect::<Option<Vec<_>>>()
         };
         let mut sensors = BTreeMap::new();
         for (name, sensor) in [
@@ -117,32 +155,80 @@ impl Calibration {
                 continue;
             }
             let coeffs = |key: &str| -> Result<Vec<f64>, CalibrationError> {
-                model[key]
-                    .as_array()
-                    .and_then(|a| {
-                        a.iter()
-                            .map(serde_json::Value::as_f64)
-                            .collect::<Option<Vec<_>>>()
-                    })
-                    .ok_or_else(|| {
-                        invalid(format!(
-                            "{origin}: sensors.{name}.{key} must be an array of numbers"
-                        ))
-                    })
+                numbers(&model[key]).ok_or_else(|| {
+                    invalid(format!(
+                        "{origin}: sensors.{name}.{key} must be an array of numbers"
+                    ))
+                })
             };
-            let model = SensorModel::without_sd(coeffs("alpha")?, coeffs("beta")?);
-            sensors.insert(sensor, model);
+            let optional = |key: &str| -> Result<Vec<f64>, CalibrationError> {
+                if model[key].is_null() {
+                    Ok(Vec::new())
+                } else {
+                    coeffs(key)
+                }
+            };
+            let mut m = SensorModel::without_sd(coeffs("alpha")?, coeffs("beta")?);
+            m.alpha_sd = optional("alpha_sd")?;
+            m.beta_sd = optional("beta_sd")?;
+            sensors.insert(sensor, m);
         }
+        let metrics = value.get("metrics").and_then(|m| {
+            let f = |key: &str| m[key].as_f64();
+            Some(Metrics {
+                mse_raw: f("mse_raw")?,
+                mse_calibrated: f("mse_calibrated")?,
+                nmse_raw: f("nmse_raw")?,
+                nmse_calibrated: f("nmse_calibrated")?,
+                lidar_model: m.get("lidar_model").and_then(|l| {
+                    Some(LidarModelMetrics {
+                        mse_raw: l["mse_raw"].as_f64()?,
+                        mse_calibrated: l["mse_calibrated"].as_f64()?,
+                        mse_ratio: l["mse_ratio"].as_f64()?,
+                        readings: usize::try_from(l["readings"].as_u64()?).ok()?,
+                    })
+                }),
+            })
+        });
+        let checks = value["checks"]
+            .as_array()
+            .map(|list| {
+                list.iter()
+                    .filter_map(|c| {
+                        Some(Check {
+                            name: c["name"].as_str()?.to_string(),
+                            value: c["value"].as_f64().unwrap_or(f64::NAN),
+                            threshold: c["threshold"].as_f64().unwrap_or(f64::NAN),
+                            pass: c["pass"].as_bool()?,
+                            detail: c["detail"].as_str().unwrap_or_default().to_string(),
+                        })
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let notes = value["notes"]
+            .as_array()
+            .map(|list| {
+                list.iter()
+                    .filter_map(|n| n.as_str().map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
         Ok(Calibration {
             method,
             sensors,
-            iterations: 0,
-            converged: true,
-            checks: Vec::new(),
-            metrics: None,
-            order: None,
+            iterations: value["iterations"]
+                .as_u64()
+                .and_then(|n| usize::try_from(n).ok())
+                .unwrap_or(0),
+            converged: value["converged"].as_bool().unwrap_or(true),
+            checks,
+            metrics,
+            order: value["order"]
+                .as_u64()
+                .and_then(|n| usize::try_from(n).ok()),
             landmarks: None,
-            notes: Vec::new(),
+            notes,
         })
     }
 }

@@ -36,6 +36,21 @@ impl Pose {
         )
     }
 
+    /// The pose after a differential drive's wheels, `wheel_base_m` apart, travel `left_m` and
+    /// `right_m`: the body moves by their mean along the heading halfway through the turn
+    /// (exact for a constant-curvature arc to second order in the turn).
+    #[must_use]
+    pub fn drive(&self, left_m: f64, right_m: f64, wheel_base_m: f64) -> Self {
+        let forward = (left_m + right_m) / 2.0;
+        let turn = (right_m - left_m) / wheel_base_m;
+        let mid = self.yaw + turn / 2.0;
+        Self::new(
+            self.x + forward * mid.cos(),
+            self.y + forward * mid.sin(),
+            self.yaw + turn,
+        )
+    }
+
     /// Linear interpolation from `self` (u = 0) to `other` (u = 1), the heading along the
     /// shorter arc. Exact for a constant twist over a short step to first order.
     #[must_use]
@@ -92,6 +107,23 @@ pub fn wrap_angle(a: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn driving_a_quarter_circle_ends_where_the_arc_does() {
+        // Wheels 0.2 m apart on a 1 m radius arc, in 1,000 steps: the end is (1, 1), facing +y.
+        let (base, radius, steps) = (0.2, 1.0, 1000);
+        let angle = std::f64::consts::FRAC_PI_2 / steps as f64;
+        let (left, right) = ((radius - base / 2.0) * angle, (radius + base / 2.0) * angle);
+        let mut pose = Pose::new(0.0, 0.0, 0.0);
+        for _ in 0..steps {
+            pose = pose.drive(left, right, base);
+        }
+        assert!(
+            (pose.x - 1.0).abs() < 1e-6 && (pose.y - 1.0).abs() < 1e-6,
+            "{pose:?}"
+        );
+        assert!((pose.yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    }
 
     #[test]
     fn relative_to_inverts_compose() {

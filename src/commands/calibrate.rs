@@ -161,7 +161,14 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
 
 /// Reads the JSON that `hilsim calibrate --json` printed.
 fn read_calibration(path: &Path) -> Result<Calibration> {
-    // A calibration is a few hundred bytes; read at most this much of whatever the path is.
+    let text = read_calibration_text(path)?;
+    Ok(Calibration::from_json(&text, &path.display().to_string())?)
+}
+
+/// The text of a calibration's JSON file (`calibrate --json`'s, or a run's `results.json`),
+/// read within a bound whatever the path is.
+pub(crate) fn read_calibration_text(path: &Path) -> Result<String> {
+    // A calibration is a few hundred bytes and a run's results a few kilobytes.
     const MAX_CALIBRATION_BYTES: u64 = 1 << 20;
     let file =
         std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
@@ -172,5 +179,5 @@ fn read_calibration(path: &Path) -> Result<Calibration> {
     if text.len() as u64 > MAX_CALIBRATION_BYTES {
         bail!("{}: larger than 1 MiB; not a calibration", path.display());
     }
-    Ok(Calibration::from_json(&text, &path.display().to_string())?)
+    Ok(text)
 }

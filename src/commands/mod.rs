@@ -6,6 +6,7 @@ pub mod decode;
 pub mod diagnose;
 pub mod hil;
 pub mod record;
+pub mod report;
 pub mod run;
 mod scenario_file;
 pub mod scenario_test;

@@ -14,6 +14,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         || builtin::STRAIGHT_BOARD_ORIGIN.to_string(),
         |p| p.display().to_string(),
     );
+    if let Some(dir) = &args.report {
+        super::report::check_report_dir(dir)?;
+    }
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
     let via = match args.via {
         cli::Via::Memory => Via::Memory,
@@ -34,6 +37,20 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         })?;
         if !args.json {
             writeln!(out, "wrote {}", dir.display())?;
+        }
+    }
+    if let Some(dir) = &args.report {
+        let title = format!("hilsim run: {}", report.scenario.name);
+        let html = hilsim_report::render(hilsim_report::Inputs {
+            title: &title,
+            recording: &report.run.recording,
+            recording_name: &format!("{origin} (seed {}, in memory)", report.scenario.seed),
+            scenario: Some(&report.scenario),
+            calibrations: &report.calibrations,
+        });
+        super::report::write_report_page(dir, &html)?;
+        if !args.json {
+            writeln!(out, "report: {}", dir.join("index.html").display())?;
         }
     }
     Ok(if report.passed() {

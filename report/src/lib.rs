@@ -1,0 +1,22 @@
+//! The run report (`hilsim report`, `hilsim run --report`): one self-contained HTML page with
+//! the world to scale, the true and the dead-reckoned paths, lidar scans in the world frame
+//! (raw and calibrated), each range sensor's error against the true distance with its declared
+//! and fitted bias curves, the sensors over time and the calibration with its standard errors.
+//!
+//! `svg` is the project's one plotting module (the diagnosis draws with it too). The crate
+//! prints nothing and reads no files: it turns values into a string.
+
+#![warn(missing_docs)]
+
+pub mod colours;
+mod errors;
+pub mod map;
+mod page;
+pub mod svg;
+mod table;
+mod timelines;
+pub mod view;
+
+pub use map::Overlay;
+pub use page::{is_report, render, render_with, GENERATOR};
+pub use view::Inputs;

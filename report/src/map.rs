@@ -1,0 +1,232 @@
+//! The world to scale, in metres: walls, boards and cylinders, the true and the dead-reckoned
+//! paths, and a few lidar revolutions in the world frame, raw and calibrated.
+
+use hilsim_calibrator::{groundtruth::invert, Sensor};
+use hilsim_recording::{LidarSample, Pose};
+use hilsim_sim::Scenario;
+
+use crate::colours;
+use crate::svg::{thin, Chart, Key, Span, Stroke};
+use crate::view::{beam_rad, View};
+
+/// Revolutions drawn on the map: a few, spread over the run, so the page stays readable.
+const SCANS: usize = 3;
+
+/// Points of a path drawn at most.
+const PATH_POINTS: usize = 4000;
+
+/// Extra marks on the map (the diagnosis's located readings, say).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Overlay {
+    /// World points to mark.
+    pub points: Vec<(f64, f64)>,
+    /// What they are, for the legend.
+    pub label: String,
+}
+
+/// The map as an SVG element, and the revolutions it shows.
+#[must_use]
+pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
+    let scenario = view.inputs.scenario;
+    let paths: Vec<(f64, f64)> = view
+        .truth
+        .iter()
+        .chain(&view.odometry)
+        .map(|(_, p)| (p.x, p.y))
+        .collect();
+    let revs = chosen_revolutions(view);
+    let scans: Vec<Scan> = revs.iter().map(|&rev| scan(view, rev)).collect();
+    let mut xs: Vec<f64> = paths.iter().map(|p| p.0).collect();
+    let mut ys: Vec<f64> = paths.iter().map(|p| p.1).collect();
+    if let Some(s) = scenario {
+        let (wx, wy) = world_extent(s);
+        xs.extend(wx);
+        ys.extend(wy);
+    } else {
+        // No world to frame the page: the scans set the extent.
+        for s in &scans {
+            xs.extend(s.raw.iter().map(|p| p.0));
+            ys.extend(s.raw.iter().map(|p| p.1));
+        }
+    }
+    let x = Span::of(xs).padded(0.06);
+    let y = Span::of(ys).padded(0.06);
+    let mut chart = Chart::to_scale("map", 900.0, 760.0, x, y);
+    chart.axes("The world, the paths and the scans", "x (m)", "y (m)");
+    if let Some(s) = scenario {
+        draw_world(&mut chart, s);
+    }
+    let mut keys = Vec::new();
+    if let Some(o) = overlay {
+        chart.dots(&o.points, "#f2b400", 4.0, 0.55);
+        keys.push(Key::Dots("#f2b400", o.label.clone()));
+    }
+    for s in &scans {
+        chart.dots(&thin(&s.raw, 1500), colours::RAW, 1.6, 0.75);
+        chart.dots(&thin(&s.calibrated, 1500), colours::CALIBRATED, 1.6, 0.75);
+    }
+    if !scans.is_empty() {
+        keys.push(Key::Dots(colours::RAW, "lidar, raw readings".into()));
+        if scans.iter().any(|s| !s.calibrated.is_empty()) {
+            keys.push(Key::Dots(
+                colours::CALIBRATED,
+                "lidar, calibrated (bias inverted)".into(),
+            ));
+        }
+    }
+    let line = |path: &[(f64, Pose)]| -> Vec<(f64, f64)> {
+        thin(path, PATH_POINTS)
+            .iter()
+            .map(|(_, p)| (p.x, p.y))
+            .collect()
+    };
+    if !view.odometry.is_empty() {
+        let stroke = Stroke::dashed(colours::ODOMETRY, 2.0);
+        chart.line(&line(&view.odometry), stroke);
+        keys.push(Key::Line(stroke, "path from the odometry".into()));
+    }
+    if !view.truth.is_empty() {
+        let stroke = Stroke::solid(colours::TRUTH, 1.8);
+        chart.line(&line(&view.truth), stroke);
+        keys.push(Key::Line(stroke, "true path".into()));
+    }
+    if let Some(start) = view.truth.first().or(view.odometry.first()) {
+        chart.marker((start.1.x, start.1.y), "#2a9d4b", "start");
+    }
+    for s in &scans {
+        if let Some(p) = s.pose {
+            chart.marker((p.x, p.y), colours::TRUTH, &format!("rev {}", s.rev));
+        }
+    }
+    chart.legend(&keys);
+    (chart.finish(), revs)
+}
+
+/// The world's points that frame the map.
+fn world_extent(s: &Scenario) -> (Vec<f64>, Vec<f64>) {
+    let mut xs = vec![s.robot.start.x];
+    let mut ys = vec![s.robot.start.y];
+    for w in &s.world.walls {
+        xs.extend([w.from[0], w.to[0]]);
+        ys.extend([w.from[1], w.to[1]]);
+    }
+    for c in &s.world.cylinders {
+        xs.extend([c.center[0] - c.radius, c.center[0] + c.radius]);
+        ys.extend([c.center[1] - c.radius, c.center[1] + c.radius]);
+    }
+    for b in &s.world.boards {
+        for (x, y) in board_corners(b) {
+            xs.push(x);
+            ys.push(y);
+        }
+    }
+    (xs, ys)
+}
+
+/// A board's four corners, world frame.
+fn board_corners(b: &hilsim_sim::scenario::Board) -> [(f64, f64); 4] {
+    let centre = Pose::new(b.center[0], b.center[1], b.yaw_deg.to_radians());
+    let (hl, ht) = (b.length / 2.0, b.thickness / 2.0);
+    // The board's length runs along `yaw_deg` (its local x axis).
+    [(-hl, -ht), (hl, -ht), (hl, ht), (-hl, ht)].map(|(dx, dy)| {
+        let p = centre.transform([dx, dy]);
+        (p[0], p[1])
+    })
+}
+
+/// Walls as lines, boards as filled rectangles, cylinders as circles.
+fn draw_world(chart: &mut Chart, s: &Scenario) {
+    let wall = Stroke::solid(colours::WORLD, 3.0);
+    for w in &s.world.walls {
+        chart.line(&[(w.from[0], w.from[1]), (w.to[0], w.to[1])], wall);
+    }
+    for b in &s.world.boards {
+        chart.polygon(
+            &board_corners(b),
+            "#b9b9b9",
+            Stroke::solid(colours::WORLD, 1.0),
+        );
+    }
+    for c in &s.world.cylinders {
+        chart.circle(
+            (c.center[0], c.center[1]),
+            c.radius,
+            "#d6d6d6",
+            Stroke::solid(colours::WORLD, 1.5),
+        );
+    }
+}
+
+/// One revolution's readings placed in the world.
+struct Scan {
+    rev: u64,
+    pose: Option<Pose>,
+    raw: Vec<(f64, f64)>,
+    calibrated: Vec<(f64, f64)>,
+}
+
+/// A few revolutions spread over the run, among those with the most valid readings.
+fn chosen_revolutions(view: &View<'_>) -> Vec<u64> {
+    let Some(lidar) = view.inputs.recording.lidar.as_deref() else {
+        return Vec::new();
+    };
+    if view.reference == "none" {
+        return Vec::new();
+    }
+    let mut revs: Vec<(u64, usize)> = Vec::new();
+    for s in lidar {
+        match revs.last_mut() {
+            Some((rev, n)) if *rev == s.rev => *n += usize::from(!s.invalid),
+            _ => revs.push((s.rev, usize::from(!s.invalid))),
+        }
+    }
+    let most = revs.iter().map(|r| r.1).max().unwrap_or(0);
+    // Complete revolutions only: at least half as many valid readings as the best one.
+    let full: Vec<u64> = revs
+        .iter()
+        .filter(|r| r.1 * 2 >= most && r.1 > 0)
+        .map(|r| r.0)
+        .collect();
+    if full.is_empty() {
+        return Vec::new();
+    }
+    let mut chosen: Vec<u64> = (0..SCANS)
+        .map(|k| full[((k as f64 + 0.5) / SCANS as f64 * full.len() as f64) as usize % full.len()])
+        .collect();
+    chosen.dedup();
+    chosen
+}
+
+/// Revolution `rev`'s valid readings in the world frame, each from the pose at its own time.
+fn scan(view: &View<'_>, rev: u64) -> Scan {
+    let rec = view.inputs.recording;
+    let mount = rec.meta.lidar.unwrap_or_default();
+    let alpha = view.calibrated(Sensor::Lidar).map(|(_, a)| a.to_vec());
+    let readings: Vec<&LidarSample> = rec
+        .lidar
+        .iter()
+        .flatten()
+        .filter(|s| s.rev == rev && !s.invalid)
+        .collect();
+    let mut out = Scan {
+        rev,
+        pose: readings.first().and_then(|s| view.pose_at(s.t_s)),
+        raw: Vec::new(),
+        calibrated: Vec::new(),
+    };
+    for s in readings {
+        let Some(robot) = view.pose_at(s.t_s) else {
+            continue;
+        };
+        let lidar = mount.in_world(&robot);
+        let at = |range: f64| {
+            let p = lidar.transform([range * beam_rad(s).cos(), range * beam_rad(s).sin()]);
+            (p[0], p[1])
+        };
+        out.raw.push(at(s.range_m));
+        if let Some(d) = alpha.as_deref().and_then(|a| invert(a, s.range_m)) {
+            out.calibrated.push(at(d));
+        }
+    }
+    out
+}

@@ -1,0 +1,240 @@
+//! What the report computes from its inputs before drawing: the paths, the pose at any time,
+//! each reading's true distance (from the recording, else by ray casting the scenario's world
+//! from the true path) and the calibrated ranges.
+
+use hilsim_calibrator::{Calibration, Sensor};
+use hilsim_recording::{LidarSample, Pose, Recording};
+use hilsim_sim::{Scenario, World};
+
+/// A path: poses in time order.
+pub type Path = Vec<(f64, Pose)>;
+
+/// The inputs of a report.
+#[derive(Debug, Clone, Copy)]
+pub struct Inputs<'a> {
+    /// The page's title.
+    pub title: &'a str,
+    /// The recording (its source named in the page's header).
+    pub recording: &'a Recording,
+    /// Where the recording came from, for the header.
+    pub recording_name: &'a str,
+    /// The scenario the recording is a run of: the world, the declared sensor models.
+    pub scenario: Option<&'a Scenario>,
+    /// Calibrations of the recording, in the order they are shown.
+    pub calibrations: &'a [Calibration],
+}
+
+/// A reading with its true distance, for the error plots.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scored {
+    /// When, seconds.
+    pub t_s: f64,
+    /// The lidar revolution (0 for the sonar).
+    pub rev: u64,
+    /// The beam's angle in the sensor's frame, degrees (0 for the sonar).
+    pub angle_deg: f64,
+    /// The reading, metres.
+    pub reading_m: f64,
+    /// The true distance, metres (NaN when unknown).
+    pub true_m: f64,
+}
+
+/// The derived data of a report.
+#[derive(Debug)]
+pub struct View<'a> {
+    /// The inputs.
+    pub inputs: Inputs<'a>,
+    /// The true path (truth.csv), empty without one.
+    pub truth: Path,
+    /// The path dead-reckoned from the odometry, from the true start (else the scenario's
+    /// start, else the origin); empty without odometry.
+    pub odometry: Path,
+    /// What a reading's world position is computed from: "truth", "odometry" or "none".
+    pub reference: &'static str,
+    /// Each valid lidar reading with its true distance.
+    pub lidar: Vec<Scored>,
+    /// Each valid sonar reading with its true distance.
+    pub sonar: Vec<Scored>,
+    /// Where the true distances came from, for the page.
+    pub true_distance_source: &'static str,
+}
+
+impl<'a> View<'a> {
+    /// Derives what the page draws.
+    #[must_use]
+    pub fn new(inputs: Inputs<'a>) -> Self {
+        let rec = inputs.recording;
+        let truth: Path = rec
+            .truth
+            .iter()
+            .flatten()
+            .map(|s| (s.t_s, Pose::new(s.x_m, s.y_m, s.yaw_rad)))
+            .collect();
+        let start = truth.first().map(|p| p.1).or_else(|| {
+            inputs.scenario.map(|s| {
+                let p = &s.robot.start;
+                Pose::new(p.x, p.y, p.yaw_deg.to_radians())
+            })
+        });
+        let odometry = dead_reckoning(rec, start.unwrap_or(Pose::new(0.0, 0.0, 0.0)));
+        let reference = if !truth.is_empty() {
+            "truth"
+        } else if !odometry.is_empty() {
+            "odometry"
+        } else {
+            "none"
+        };
+        let world = inputs.scenario.map(World::new);
+        let has_column = rec.lidar.iter().flatten().any(|s| s.true_range_m.is_some())
+            || rec.sonar.iter().flatten().any(|s| s.true_range_m.is_some());
+        let true_distance_source = if has_column {
+            "the recording's true_range_m columns"
+        } else if world.is_some() && !truth.is_empty() {
+            "rays cast in the scenario's world from the true path"
+        } else {
+            "none (the recording has no true_range_m and no truth with a scenario)"
+        };
+        let max_range = inputs
+            .scenario
+            .and_then(|s| s.sensors.lidar.as_ref())
+            .map_or(6.0, |l| l.max_range_m);
+        let lidar = rec
+            .lidar
+            .iter()
+            .flatten()
+            .filter(|s| !s.invalid)
+            .map(|s| Scored {
+                t_s: s.t_s,
+                rev: s.rev,
+                angle_deg: f64::from(s.angle_deg),
+                reading_m: s.range_m,
+                true_m: s.true_range_m.unwrap_or_else(|| {
+                    cast(
+                        world.as_ref(),
+                        &truth,
+                        rec.meta
+                            .lidar
+                            .as_ref()
+                            .map_or(Pose::new(0.0, 0.0, 0.0), |m| {
+                                Pose::new(m.x_m, m.y_m, m.yaw_rad())
+                            }),
+                        s.t_s,
+                        beam_rad(s),
+                        max_range,
+                    )
+                }),
+            })
+            .collect();
+        let sonar_max = inputs
+            .scenario
+            .and_then(|s| s.sensors.sonar.as_ref())
+            .map_or(6.0, |s| s.max_range_m);
+        let sonar_mount = rec
+            .meta
+            .sonar
+            .as_ref()
+            .map_or(Pose::new(0.0, 0.0, 0.0), |m| {
+                Pose::new(m.x_m, m.y_m, m.yaw_deg.to_radians())
+            });
+        let sonar = rec
+            .sonar
+            .iter()
+            .flatten()
+            .filter(|s| s.range_m.is_finite() && s.range_m > 0.0)
+            .map(|s| Scored {
+                t_s: s.t_s,
+                rev: 0,
+                angle_deg: 0.0,
+                reading_m: s.range_m,
+                true_m: s.true_range_m.unwrap_or_else(|| {
+                    cast(world.as_ref(), &truth, sonar_mount, s.t_s, 0.0, sonar_max)
+                }),
+            })
+            .collect();
+        Self {
+            inputs,
+            truth,
+            odometry,
+            reference,
+            lidar,
+            sonar,
+            true_distance_source,
+        }
+    }
+
+    /// The robot's pose at `t` on the reference path (truth, else odometry), interpolated.
+    #[must_use]
+    pub fn pose_at(&self, t: f64) -> Option<Pose> {
+        let path = if self.truth.is_empty() {
+            &self.odometry
+        } else {
+            &self.truth
+        };
+        pose_at(path, t)
+    }
+
+    /// The first calibration with a model of `sensor`.
+    #[must_use]
+    pub fn calibrated(&self, sensor: Sensor) -> Option<(&Calibration, &[f64])> {
+        self.inputs
+            .calibrations
+            .iter()
+            .find_map(|c| c.sensors.get(&sensor).map(|m| (c, m.alpha.as_slice())))
+    }
+}
+
+/// The beam's direction in the lidar's frame, radians.
+#[must_use]
+pub fn beam_rad(s: &LidarSample) -> f64 {
+    f64::from(s.angle_deg).to_radians()
+}
+
+/// The pose at `t` on `path`, interpolated (held at the ends); `None` for an empty path.
+#[must_use]
+pub fn pose_at(path: &[(f64, Pose)], t: f64) -> Option<Pose> {
+    let i = path.partition_point(|(ti, _)| *ti <= t);
+    match (i.checked_sub(1).and_then(|j| path.get(j)), path.get(i)) {
+        (Some((t0, p0)), Some((t1, p1))) if t1 > t0 => Some(p0.lerp(p1, (t - t0) / (t1 - t0))),
+        (Some((_, p)), _) | (None, Some((_, p))) => Some(*p),
+        (None, None) => None,
+    }
+}
+
+/// The distance along a beam at `beam_rad` in the frame of a sensor mounted at `mount`, from
+/// the true pose at `t`, to the first obstacle of `world` (NaN when either is unknown or
+/// nothing is hit within `max_m`).
+fn cast(
+    world: Option<&World>,
+    truth: &[(f64, Pose)],
+    mount: Pose,
+    t: f64,
+    beam_rad: f64,
+    max_m: f64,
+) -> f64 {
+    let (Some(world), Some(pose)) = (world, pose_at(truth, t)) else {
+        return f64::NAN;
+    };
+    let sensor = pose.compose(mount.x, mount.y, mount.yaw);
+    world
+        .cast_ray([sensor.x, sensor.y], sensor.yaw + beam_rad, max_m)
+        .map_or(f64::NAN, |hit| hit.distance)
+}
+
+/// The odometry dead-reckoned from `start` ([`Pose::drive`] between readings).
+fn dead_reckoning(rec: &Recording, start: Pose) -> Path {
+    let Some(odometry) = rec.odometry.as_deref() else {
+        return Vec::new();
+    };
+    let base = rec.meta.robot.wheel_base_m;
+    let mut path = Vec::with_capacity(odometry.len());
+    let mut pose = start;
+    let mut last: Option<(f64, f64)> = None;
+    for o in odometry {
+        if let Some((l, r)) = last {
+            pose = pose.drive(o.left_m - l, o.right_m - r, base);
+        }
+        last = Some((o.left_m, o.right_m));
+        path.push((o.t_s, pose));
+    }
+    path
+}

@@ -1,0 +1,92 @@
+//! `hilsim report RECORDING [--scenario FILE] [--calibration FILE] --out DIR`: the run report,
+//! one self-contained `DIR/index.html`. `hilsim run --report DIR` writes the same page.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use hilsim_calibrator::Calibration;
+use hilsim_recording::{write_file_atomically, Recording};
+use hilsim_report::Inputs;
+use hilsim_sim::Scenario;
+
+/// Draw a recording: the world, the paths, the scans, each sensor's error against distance
+/// and the calibration, as one self-contained HTML page.
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// The recording directory.
+    pub recording: PathBuf,
+    /// The scenario the recording is a run of: its world is drawn and its declared sensor
+    /// models shown.
+    #[arg(long)]
+    pub scenario: Option<PathBuf>,
+    /// A calibration to show: the JSON of `hilsim calibrate --json`, or a run's `results.json`
+    /// (default: RECORDING/results.json when there is one).
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// The directory to write `index.html` into (created if needed; a previous report's page is
+    /// replaced, anything else refused).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
+    check_report_dir(&args.out)?;
+    let scenario = args.scenario.as_deref().map(Scenario::load).transpose()?;
+    let recording = Recording::read_dir(&args.recording)?;
+    let beside = args.recording.join("results.json");
+    let calibration_file = args
+        .calibration
+        .clone()
+        .or_else(|| beside.is_file().then_some(beside));
+    let calibrations = match &calibration_file {
+        Some(path) => {
+            let text = super::calibrate::read_calibration_text(path)?;
+            Calibration::all_from_json(&text, &path.display().to_string())?
+        }
+        None => Vec::new(),
+    };
+    let name = args.recording.display().to_string();
+    let title = format!("hilsim report: {name}");
+    let html = hilsim_report::render(Inputs {
+        title: &title,
+        recording: &recording,
+        recording_name: &name,
+        scenario: scenario.as_ref(),
+        calibrations: &calibrations,
+    });
+    write_report_page(&args.out, &html)?;
+    writeln!(out, "report: {}", args.out.join("index.html").display())?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses, before any work, a report directory that is not one: a file, or a directory whose
+/// `index.html` is not a previous report (the user's page is never replaced).
+pub fn check_report_dir(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("{}: exists and is not a directory", dir.display());
+    }
+    let page = dir.join("index.html");
+    if page.exists() {
+        let mut head = Vec::new();
+        std::fs::File::open(&page)
+            .and_then(|f| f.take(4096).read_to_end(&mut head))
+            .with_context(|| format!("{}: cannot read", page.display()))?;
+        if !hilsim_report::is_report(&String::from_utf8_lossy(&head)) {
+            bail!(
+                "{}: exists and is not a hilsim report; not replacing it",
+                page.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Writes `html` as `dir/index.html` (the directory created if needed), atomically.
+pub fn write_report_page(dir: &Path, html: &str) -> Result<()> {
+    check_report_dir(dir)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    write_file_atomically(&dir.join("index.html"), html.as_bytes())?;
+    Ok(())
+}

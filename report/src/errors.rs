@@ -108,6 +108,8 @@ fn chart(
     let means = binned_means(&known, x);
     let stroke = Stroke::solid(colours::TRUTH, 2.0);
     chart.line(&means, stroke);
+    // Dots too: a bin between two empty ones is no line.
+    chart.dots(&means, colours::TRUTH, 2.5, 1.0);
     keys.push(Key::Line(stroke, "mean of the readings".into()));
     chart.legend(&keys);
     Some(chart.finish())

@@ -46,25 +46,30 @@ pub fn render_with(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
 <h1>{title}</h1>"#,
         title = escape(inputs.title)
     );
-    let count = |n: Option<usize>| n.map_or_else(|| "none".to_string(), |n| n.to_string());
     let revolutions = rec.lidar.as_deref().map(|l| {
         let mut revs: Vec<u64> = l.iter().map(|s| s.rev).collect();
         revs.dedup();
         revs.len()
     });
+    let mut facts = vec![format!("{} s", fmt_sig(rec.duration_s()))];
+    if let (Some(l), Some(revs)) = (&rec.lidar, revolutions) {
+        facts.push(format!("{} lidar readings in {revs} revolutions", l.len()));
+    }
+    if let Some(s) = &rec.sonar {
+        facts.push(format!("{} sonar readings", s.len()));
+    }
+    if let Some(o) = &rec.odometry {
+        facts.push(format!("{} odometry readings", o.len()));
+    }
+    facts.push(format!("{} wheel commands", rec.commands.len()));
+    if let Some(t) = &rec.truth {
+        facts.push(format!("{} true poses", t.len()));
+    }
     let _ = writeln!(
         s,
-        r#"<p class="facts">Recording <code>{}</code>: {} s; {} lidar readings in {} revolutions, {} sonar readings, {} odometry readings, {} commands, truth: {}.{}</p>"#,
+        r#"<p class="facts">Recording <code>{}</code>: {}.{}</p>"#,
         escape(inputs.recording_name),
-        fmt_sig(rec.duration_s()),
-        count(rec.lidar.as_ref().map(Vec::len)),
-        count(revolutions),
-        count(rec.sonar.as_ref().map(Vec::len)),
-        count(rec.odometry.as_ref().map(Vec::len)),
-        rec.commands.len(),
-        rec.truth
-            .as_ref()
-            .map_or("none".to_string(), |t| format!("{} poses", t.len())),
+        facts.join(", "),
         inputs.scenario.map_or(String::new(), |sc| format!(
             " Scenario <code>{}</code>, seed {}.",
             escape(&sc.name),
@@ -79,7 +84,7 @@ pub fn render_with(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
         missing.push("the recording has no truth: the scans are placed on the path dead-reckoned from the odometry, and errors against the true distance need <code>true_range_m</code> columns");
     }
     if inputs.calibrations.is_empty() {
-        missing.push("no calibration was given (<code>--calibration FILE</code>, the JSON of <code>hilsim calibrate --json</code> or a run's <code>results.json</code>): no fitted curves or calibrated scans");
+        missing.push("no calibration, so no fitted curves or calibrated scans (a run calibrates with the methods its scenario's <code>[calibration]</code> names; <code>hilsim report --calibration FILE</code> takes the JSON of <code>hilsim calibrate --json</code> or a run's <code>results.json</code>)");
     }
     if !missing.is_empty() {
         let _ = writeln!(

@@ -80,7 +80,7 @@ fn report_without_scenario_or_truth_says_what_it_cannot_show() {
     let html = std::fs::read_to_string(tmp.path().join("rep/index.html")).unwrap();
     assert!(html.contains("Not shown: no scenario was given"));
     assert!(html.contains("Not shown: the recording has no truth"));
-    assert!(html.contains("Not shown: no calibration was given"));
+    assert!(html.contains("Not shown: no calibration"));
     // The path still comes from the odometry, and the scans are placed on it.
     assert!(html.contains("path from the odometry"));
     assert!(html.contains("from the dead-reckoned pose"));

@@ -33,5 +33,5 @@ mod summary;
 
 pub use config::{FloodLimits, HilConfig, DEFAULT_FIRMWARE_GRACE, DEFAULT_WATCHDOG};
 pub use report::{Ending, Fault, HilReport};
-pub use session::run;
+pub use session::{run, run_with_progress, HilProgress};
 pub use setup::{stop_on_signals, HilPorts, HilWorld};

@@ -5,6 +5,7 @@
 //! `[[expect]]` assertion held; 1 a firmware fault (crash, hang, flood, lidar never read), a
 //! failed assertion or an interrupted run; 2 bad input, or the harness itself failed.
 
+use std::io::IsTerminal as _;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,6 +19,7 @@ use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
 use hilsim_scenarios::metrics;
 use hilsim_sim::scenario::MAX_RUN_S;
 use hilsim_sim::Scenario;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 #[derive(Debug, clap::Args)]
 pub struct HilArgs {
@@ -55,6 +57,9 @@ fn seconds(flag: &str, value: f64) -> Result<Duration> {
     }
     Ok(Duration::from_secs_f64(value))
 }
+
+/// Simulated seconds between two status lines on a terminal shared with the firmware's output.
+const STATUS_LINE_EVERY_S: f64 = 5.0;
 
 pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     // Everything is checked before a port is opened or the firmware started.
@@ -113,8 +118,38 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
         duration.as_secs_f64()
     )?;
     out.flush()?;
-    let report = hil_run::run(world, ports, Some(firmware), &config, &stop)
-        .context("firmware in the loop")?;
+    // How far the run has come, on stderr when it is a terminal (stdout keeps its lines for
+    // scripts): a status line redrawn in place, or, when stdout is that terminal too, a whole
+    // line every 5 s, because the firmware's own output goes there and a line redrawn in place
+    // would overwrite it.
+    let total_s = duration.as_secs_f64();
+    let on_terminal = std::io::stderr().is_terminal();
+    let status = (on_terminal && !std::io::stdout().is_terminal()).then(|| {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{spinner} hil: {msg}") {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let mut next_line_s = STATUS_LINE_EVERY_S;
+    let report =
+        hil_run::run_with_progress(world, ports, Some(firmware), &config, &stop, &mut |p| {
+            let message = format!(
+                "{:.1} of {total_s:.1} s, {} requests, {} lidar revolutions sent, {} dropped",
+                p.t_s, p.requests, p.revolutions_sent, p.revolutions_dropped
+            );
+            if let Some(bar) = &status {
+                bar.set_message(message);
+                bar.tick();
+            } else if on_terminal && p.t_s >= next_line_s {
+                next_line_s += STATUS_LINE_EVERY_S;
+                eprintln!("hil: {message}");
+            }
+        });
+    if let Some(bar) = &status {
+        bar.finish_and_clear();
+    }
+    let report = report.context("firmware in the loop")?;
     // The scenario's assertions, on the metrics a firmware's run has.
     let hil_metrics = metrics::of_hil(&report);
     let outcomes = metrics::check(

@@ -53,12 +53,43 @@ pub fn run(
     config: &HilConfig,
     stop: &AtomicBool,
 ) -> io::Result<HilReport> {
+    run_with_progress(world, ports, firmware, config, stop, &mut |_| {})
+}
+
+/// How far a run has come, for a status line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HilProgress {
+    /// Simulated time, seconds.
+    pub t_s: f64,
+    /// Lidar revolutions written whole.
+    pub revolutions_sent: u64,
+    /// Lidar revolutions thrown away (the firmware did not read them in time).
+    pub revolutions_dropped: u64,
+    /// Requests the command port answered.
+    pub requests: u64,
+}
+
+/// Simulated time between two calls of a run's progress callback, seconds.
+const PROGRESS_EVERY_S: f64 = 0.1;
+
+/// As [`run`], telling `progress` how far the run has come every 0.1 s of simulated time.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with_progress(
+    world: HilWorld,
+    ports: HilPorts,
+    firmware: Option<Firmware>,
+    config: &HilConfig,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&HilProgress),
+) -> io::Result<HilReport> {
     let HilPorts { lidar, robot } = ports;
     let mut firmware = firmware;
     let mut world = world;
     let streamer = Streamer::new(lidar, Pacing::Realtime).with_faults(world.wire_faults.take());
     let mut session = Session::new(world, streamer, robot, config);
-    let ending = session.run(firmware.as_mut(), stop)?;
+    let ending = session.run(firmware.as_mut(), stop, progress)?;
     session.finish(ending, firmware)
 }
 
@@ -150,12 +181,25 @@ impl<'c> Session<'c> {
         &mut self,
         mut firmware: Option<&mut Firmware>,
         stop: &AtomicBool,
+        progress: &mut dyn FnMut(&HilProgress),
     ) -> io::Result<Ending> {
         self.origin = Instant::now();
         self.last_request = self.origin;
+        let steps_per_progress = ((PROGRESS_EVERY_S / self.step_s).round() as u64).max(1);
+        let mut progress_steps = 0;
         loop {
             let now = Instant::now();
             self.simulate_until(now);
+            if self.steps_done >= progress_steps + steps_per_progress {
+                progress_steps = self.steps_done;
+                let stream = self.streamer.stats();
+                progress(&HilProgress {
+                    t_s: self.steps_done as f64 * self.step_s,
+                    revolutions_sent: stream.revolutions_sent,
+                    revolutions_dropped: stream.revolutions_dropped,
+                    requests: self.port.stats().requests,
+                });
+            }
             self.send_due_packets(now)?;
             if let Some(fault) = self.serve_requests(now)? {
                 return Ok(Ending::Fault(fault));

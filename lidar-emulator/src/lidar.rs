@@ -96,6 +96,8 @@ pub struct Lidar {
     rev_start_s: f64,
     rev_rpm: f64,
     effects: LidarEffects,
+    /// `[effects.sensor_latency]`: how late each reading is stamped, seconds (0 when off).
+    latency_s: f64,
     /// `timing = "per_revolution"` without `[effects.lidar_motion_skew]`: every reading of a
     /// revolution from the lidar's pose at the revolution's start.
     snapshot: bool,
@@ -134,7 +136,10 @@ impl Lidar {
         let mut motor = rng::stream(seed, "lidar.motor");
         let mut lidar = Self {
             model,
-            mount: config.mount.into(),
+            // `[effects.lidar_mount_offset]`: the rays leave from where the unit really is;
+            // `meta.toml` keeps the declared mount.
+            mount: crate::effects::real_mount(config.mount.into(), effects.lidar_mount_offset),
+            latency_s: effects.sensor_latency.map_or(0.0, |l| l.lidar_s),
             angle_noise_rad: config.angle_noise_deg.to_radians(),
             rpm: config.rpm,
             rpm_wobble: config.rpm_wobble,
@@ -262,7 +267,7 @@ impl Lidar {
         let beam = yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
         let cast_limit = self.cast_limit_m();
         let mut reading = LidarReading {
-            t_s: t,
+            t_s: t + self.latency_s,
             rev: self.rev,
             angle_deg: self.index,
             distance_mm: 0,

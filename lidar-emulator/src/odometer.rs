@@ -17,6 +17,11 @@ pub struct Odometer {
     next: u64,
     /// `[effects.odometer_wheel_slip]`: slip velocity per unit of acceleration, seconds.
     slip_gain_s: Option<f64>,
+    /// `[effects.odometer_wheel_radius]`: each wheel's radius over nominal (1 when off). The
+    /// encoders count turns and multiply by the nominal radius: they report travel / scale.
+    radius_scale: [f64; 2],
+    /// `[effects.sensor_latency]`: how late each reading is stamped, seconds (0 when off).
+    latency_s: f64,
 }
 
 impl Odometer {
@@ -43,6 +48,10 @@ impl Odometer {
             rng: rng::stream(seed, "odometer"),
             next: 0,
             slip_gain_s: effects.odometer_wheel_slip.map(|e| e.gain_s),
+            radius_scale: effects
+                .odometer_wheel_radius
+                .map_or([1.0, 1.0], |r| [r.left_scale, r.right_scale]),
+            latency_s: effects.sensor_latency.map_or(0.0, |l| l.odometer_s),
         }
     }
 
@@ -79,10 +88,11 @@ impl Odometer {
                 left += slip_travel_m(gain, (step.wheels1[0] - step.wheels0[0]) / dt);
                 right += slip_travel_m(gain, (step.wheels1[1] - step.wheels0[1]) / dt);
             }
+            let [left_scale, right_scale] = self.radius_scale;
             out.push(OdometrySample {
-                t_s: hilsim_sim::exact_time_s(t),
-                left_m: self.report(left),
-                right_m: self.report(right),
+                t_s: crate::effects::stamped_s(t, self.latency_s),
+                left_m: self.report(left / left_scale),
+                right_m: self.report(right / right_scale),
             });
         }
     }

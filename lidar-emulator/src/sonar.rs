@@ -24,6 +24,8 @@ pub struct Sonar {
     next_ping: u64,
     /// `[effects.sonar_speed_of_sound]`: c(calibrated) / c(air); 1 when off.
     range_scale: f64,
+    /// `[effects.sensor_latency]`: how late each ping is stamped, seconds (0 when off).
+    latency_s: f64,
 }
 
 impl Sonar {
@@ -74,6 +76,7 @@ impl Sonar {
             range_scale: effects.sonar_speed_of_sound.map_or(1.0, |e| {
                 sonar_range_scale(e.air_temperature_c, e.calibrated_at_c)
             }),
+            latency_s: effects.sensor_latency.map_or(0.0, |l| l.sonar_s),
         })
     }
 
@@ -131,7 +134,7 @@ impl Sonar {
                 let ranged = d * self.range_scale;
                 let range = (self.model.sample(ranged, &mut self.rng) * 1000.0).round() / 1000.0;
                 out.push(SonarSample {
-                    t_s: hilsim_sim::exact_time_s(t),
+                    t_s: crate::effects::stamped_s(t, self.latency_s),
                     range_m: range.max(0.0),
                     true_range_m: Some(d),
                 });

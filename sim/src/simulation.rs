@@ -90,7 +90,10 @@ pub struct Simulation {
     world: World,
     driver: Driver,
     step_s: f64,
+    /// The effective wheel base (the nominal one unless `[effects.drive_wheel_base]`).
     wheel_base_m: f64,
+    /// `[effects.odometer_wheel_radius]`: each wheel's radius over nominal (1 when off).
+    wheel_radius_scale: [f64; 2],
     steps_done: u64,
     end_step: Option<u64>,
     pose: Pose,
@@ -131,7 +134,14 @@ impl Simulation {
             world,
             driver,
             step_s: scenario.step_s(),
-            wheel_base_m: scenario.robot.wheel_base_m,
+            // `[effects.drive_wheel_base]`: the wheels push the body `scale` times the nominal
+            // base apart, so the true body turn and the wheels' true travel both follow it.
+            wheel_base_m: scenario.robot.wheel_base_m
+                * scenario.effects.drive_wheel_base.map_or(1.0, |b| b.scale),
+            wheel_radius_scale: scenario
+                .effects
+                .odometer_wheel_radius
+                .map_or([1.0, 1.0], |r| [r.left_scale, r.right_scale]),
             steps_done: 0,
             end_step: None,
             pose,
@@ -235,6 +245,13 @@ impl Simulation {
     /// Differential drive: wheel speeds → body twist, held by setting the body's velocity each
     /// step; the physics then resolves contacts (a wall stops the robot).
     fn apply(&mut self, command: WheelCommand) {
+        // A wheel turned at the commanded speed over its nominal radius moves the ground by its
+        // real radius: `[effects.odometer_wheel_radius]` (scales of 1 when off).
+        let [left_scale, right_scale] = self.wheel_radius_scale;
+        let command = WheelCommand {
+            left_mps: command.left_mps * left_scale,
+            right_mps: command.right_mps * right_scale,
+        };
         // The wheels achieve the command scaled by the actuation error (1 when it is off) …
         let factor = self.actuation.next_factor(self.step_s);
         let (v, omega) = match &mut self.lag {

@@ -35,10 +35,18 @@ fn every_effect_table_loads_with_its_defaults() {
          [effects.sonar_beam_width]\nhalf_angle_deg = 12.0\n\
          [effects.sonar_speed_of_sound]\nair_temperature_c = 2.0\n\
          [effects.odometer_wheel_slip]\ngain_s = 0.05\n\
-         [effects.drive_motor_lag]\ntime_constant_s = 0.3\n"
+         [effects.drive_motor_lag]\ntime_constant_s = 0.3\n\
+         [effects.lidar_mount_offset]\nyaw_deg = 2.0\n\
+         [effects.sensor_latency]\nlidar_s = 0.02\n\
+         [effects.odometer_wheel_radius]\nright_scale = 1.01\n\
+         [effects.drive_wheel_base]\nscale = 1.05\n"
     );
     let s = load(&text).unwrap();
-    assert_eq!(s.effects.active().len(), 9);
+    assert_eq!(s.effects.active().len(), 13);
+    // Issue 15's tables: each key defaults to no change.
+    assert_eq!(s.effects.lidar_mount_offset.unwrap().x_m, 0.0);
+    assert_eq!(s.effects.sensor_latency.unwrap().sonar_s, 0.0);
+    assert_eq!(s.effects.odometer_wheel_radius.unwrap().left_scale, 1.0);
     assert_eq!(s.effects.lidar_reflectivity.unwrap().reference, 0.8);
     assert_eq!(
         s.effects.sonar_speed_of_sound.unwrap().calibrated_at_c,
@@ -85,6 +93,26 @@ fn bad_effect_tables_are_refused_at_their_line() {
         (
             "[sensors.lidar]\n[effects.lidar_reflectivity]\ncoefficient_m = 0.01\nreference = 0.0\n",
             "s.toml:9: effects.lidar_reflectivity.reference: expected a reflectivity in (0, 1]",
+        ),
+        (
+            "[sensors.lidar]\n[effects.lidar_mount_offset]\nyaw_deg = 90.0\n",
+            "s.toml:8: effects.lidar_mount_offset.yaw_deg: expected degrees in -45..=45, found 90",
+        ),
+        (
+            "[effects.sensor_latency]\nsonar_s = 0.1\n",
+            "s.toml:7: effects.sensor_latency.sonar_s: this effect needs a [sensors.sonar]",
+        ),
+        (
+            "[sensors.lidar]\n[effects.sensor_latency]\nlidar_s = -0.1\n",
+            "s.toml:8: effects.sensor_latency.lidar_s: expected seconds in 0..=1, found -0.1",
+        ),
+        (
+            "[effects.odometer_wheel_radius]\nleft_scale = 0.0\n",
+            "s.toml:7: effects.odometer_wheel_radius.left_scale: expected a scale in 0.5..=1.5, found 0",
+        ),
+        (
+            "[effects.drive_wheel_base]\nscale = inf\n",
+            "s.toml:7: effects.drive_wheel_base.scale: expected a scale in 0.5..=1.5, found inf",
         ),
         (
             "[sensors.lidar]\n[effects.lidar_mixed_pixels]\nhalf_width_deg = nan\n",

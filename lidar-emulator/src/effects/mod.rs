@@ -10,6 +10,7 @@
 mod incidence;
 mod lidar;
 mod mixed_pixels;
+mod mounting;
 mod reflectivity;
 mod speed_of_sound;
 mod warmup;
@@ -18,6 +19,7 @@ mod wheel_slip;
 pub use incidence::{incidence_error_m, tan_incidence, MAX_INCIDENCE_DEG};
 pub use lidar::{BeamReturn, LidarEffects};
 pub use mixed_pixels::footprint_range_m;
+pub use mounting::{real_mount, stamped_s};
 pub use reflectivity::range_walk_m;
 pub use speed_of_sound::{sonar_range_scale, speed_of_sound_mps};
 pub use warmup::warmup_error_m;

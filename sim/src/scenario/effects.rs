@@ -40,6 +40,18 @@ pub struct Effects {
     /// The wheels reach a commanded speed with a first-order lag.
     #[serde(default)]
     pub drive_motor_lag: Option<DriveMotorLag>,
+    /// The lidar sits on the robot at another yaw or position than its declared mount.
+    #[serde(default)]
+    pub lidar_mount_offset: Option<LidarMountOffset>,
+    /// Sensors' timestamps lag the moment of measurement by a constant delay each.
+    #[serde(default)]
+    pub sensor_latency: Option<SensorLatency>,
+    /// The wheels' radii differ from nominal, each by its own scale.
+    #[serde(default)]
+    pub odometer_wheel_radius: Option<OdometerWheelRadius>,
+    /// The effective wheel base differs from nominal.
+    #[serde(default)]
+    pub drive_wheel_base: Option<DriveWheelBase>,
 }
 
 impl Effects {
@@ -59,6 +71,13 @@ impl Effects {
             ("sonar_speed_of_sound", self.sonar_speed_of_sound.is_some()),
             ("odometer_wheel_slip", self.odometer_wheel_slip.is_some()),
             ("drive_motor_lag", self.drive_motor_lag.is_some()),
+            ("lidar_mount_offset", self.lidar_mount_offset.is_some()),
+            ("sensor_latency", self.sensor_latency.is_some()),
+            (
+                "odometer_wheel_radius",
+                self.odometer_wheel_radius.is_some(),
+            ),
+            ("drive_wheel_base", self.drive_wheel_base.is_some()),
         ];
         on.iter().filter(|(_, o)| *o).map(|(n, _)| *n).collect()
     }
@@ -163,4 +182,66 @@ pub struct OdometerWheelSlip {
 pub struct DriveMotorLag {
     /// The lag's time constant τ, seconds.
     pub time_constant_s: f64,
+}
+
+/// `[effects.lidar_mount_offset]`: the lidar's real mount is its declared one (`[sensors.lidar]
+/// mount`, what `meta.toml` records) moved by this much in the robot's frame: a unit bolted on a
+/// little rotated or off-centre.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarMountOffset {
+    /// Extra yaw, degrees (counter-clockwise seen from above).
+    #[serde(default)]
+    pub yaw_deg: f64,
+    /// Extra forward offset, metres.
+    #[serde(default)]
+    pub x_m: f64,
+    /// Extra leftward offset, metres.
+    #[serde(default)]
+    pub y_m: f64,
+}
+
+/// `[effects.sensor_latency]`: each sensor's timestamps are this much later than the moment it
+/// measured (a driver that stamps a reading when it arrives, not when it was taken).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorLatency {
+    /// The lidar's delay, seconds.
+    #[serde(default)]
+    pub lidar_s: f64,
+    /// The sonar's delay, seconds.
+    #[serde(default)]
+    pub sonar_s: f64,
+    /// The odometer's delay, seconds.
+    #[serde(default)]
+    pub odometer_s: f64,
+}
+
+/// `[effects.odometer_wheel_radius]`: each wheel's real radius is its nominal one times a scale.
+/// The motors turn the wheels at the commanded speed over the nominal radius, so the robot moves
+/// `scale` times the command; the encoders count turns times the nominal radius, so they report
+/// the true travel divided by `scale` (the command, near enough): only the outside world sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OdometerWheelRadius {
+    /// The left wheel's radius over nominal.
+    #[serde(default = "one")]
+    pub left_scale: f64,
+    /// The right wheel's radius over nominal.
+    #[serde(default = "one")]
+    pub right_scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[effects.drive_wheel_base]`: the wheels' effective contact points are `scale` times the
+/// nominal wheel base apart (wide tyres, a soft floor), so a turn commanded for the nominal base
+/// comes out `1 / scale` times as large, and the encoders' turn likewise.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveWheelBase {
+    /// The effective wheel base over nominal.
+    pub scale: f64,
 }

@@ -117,5 +117,41 @@ pub(super) fn validate(s: &Scenario) -> Check {
         let p = |k: &'static str| key_path!["effects", "drive_motor_lag", k];
         positive_up_to(p("time_constant_s"), x.time_constant_s, 10.0, "seconds")?;
     }
+    // The bounds below are far beyond any real unit (a lidar 45° off its mount, a wheel half
+    // again as large, a second of latency): values outside them are typos.
+    if let Some(x) = e.lidar_mount_offset {
+        let p = |k: &'static str| key_path!["effects", "lidar_mount_offset", k];
+        needs(p("yaw_deg"), lidar.is_some(), "lidar")?;
+        within(p("yaw_deg"), x.yaw_deg, -45.0, 45.0, "degrees")?;
+        within(p("x_m"), x.x_m, -0.5, 0.5, "metres")?;
+        within(p("y_m"), x.y_m, -0.5, 0.5, "metres")?;
+    }
+    if let Some(x) = e.sensor_latency {
+        let p = |k: &'static str| key_path!["effects", "sensor_latency", k];
+        for (key, v, present, sensor) in [
+            ("lidar_s", x.lidar_s, lidar.is_some(), "lidar"),
+            ("sonar_s", x.sonar_s, has_sonar, "sonar"),
+            (
+                "odometer_s",
+                x.odometer_s,
+                s.sensors.odometer.is_some(),
+                "odometer",
+            ),
+        ] {
+            within(p(key), v, 0.0, 1.0, "seconds")?;
+            if v != 0.0 {
+                needs(p(key), present, sensor)?;
+            }
+        }
+    }
+    if let Some(x) = e.odometer_wheel_radius {
+        let p = |k: &'static str| key_path!["effects", "odometer_wheel_radius", k];
+        within(p("left_scale"), x.left_scale, 0.5, 1.5, "a scale")?;
+        within(p("right_scale"), x.right_scale, 0.5, 1.5, "a scale")?;
+    }
+    if let Some(x) = e.drive_wheel_base {
+        let p = |k: &'static str| key_path!["effects", "drive_wheel_base", k];
+        within(p("scale"), x.scale, 0.5, 1.5, "a scale")?;
+    }
     Ok(())
 }

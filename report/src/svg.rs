@@ -255,6 +255,14 @@ impl Chart {
         )
     }
 
+    /// The chart with `pixels` below the frame instead of the usual margin (room for long
+    /// category names). Call before drawing.
+    #[must_use]
+    pub fn with_bottom_margin(mut self, pixels: f64) -> Self {
+        self.bottom = pixels;
+        self
+    }
+
     /// The page's x coordinate of data `x`.
     #[must_use]
     pub fn sx(&self, x: f64) -> f64 {
@@ -274,6 +282,16 @@ impl Chart {
 
     /// The grid, the ticks, the frame, the title and the axes' labels.
     pub fn axes(&mut self, title: &str, x_label: &str, y_label: &str) {
+        self.frame(title, x_label, y_label, None);
+    }
+
+    /// As [`Chart::axes`] for a categorical x axis: category `i` at x = i, its name written
+    /// slanted below the frame.
+    pub fn axes_categorical(&mut self, title: &str, categories: &[String], y_label: &str) {
+        self.frame(title, "", y_label, Some(categories));
+    }
+
+    fn frame(&mut self, title: &str, x_label: &str, y_label: &str, categories: Option<&[String]>) {
         let (w, h) = (self.width, self.height);
         let (l, r, t, b) = (self.left, self.right, self.top, self.bottom);
         // Grid lines behind the data (clipped to the frame), their labels outside it.
@@ -294,21 +312,33 @@ impl Chart {
                 y + 4.0,
             );
         }
-        let x_ticks = ticks(self.x.lo, self.x.hi, 8);
-        let x_digits = decimals(&x_ticks);
-        for v in x_ticks {
-            let x = self.sx(v);
-            let _ = writeln!(
-                self.back,
-                r##"<line x1="{x:.1}" x2="{x:.1}" y1="{t}" y2="{:.1}" stroke="{}"/>"##,
-                h - b,
-                if v == 0.0 { "#9a9a9a" } else { "#e6e6e6" },
-            );
-            let _ = writeln!(
-                self.front,
-                r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{v:.x_digits$}</text>"##,
-                h - b + 16.0,
-            );
+        if let Some(names) = categories {
+            for (i, name) in names.iter().enumerate() {
+                let x = self.sx(i as f64);
+                let y = h - b + 14.0;
+                let _ = writeln!(
+                    self.front,
+                    r##"<text x="{x:.1}" y="{y:.1}" text-anchor="end" transform="rotate(-35 {x:.1} {y:.1})">{}</text>"##,
+                    escape(name)
+                );
+            }
+        } else {
+            let x_ticks = ticks(self.x.lo, self.x.hi, 8);
+            let x_digits = decimals(&x_ticks);
+            for v in x_ticks {
+                let x = self.sx(v);
+                let _ = writeln!(
+                    self.back,
+                    r##"<line x1="{x:.1}" x2="{x:.1}" y1="{t}" y2="{:.1}" stroke="{}"/>"##,
+                    h - b,
+                    if v == 0.0 { "#9a9a9a" } else { "#e6e6e6" },
+                );
+                let _ = writeln!(
+                    self.front,
+                    r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{v:.x_digits$}</text>"##,
+                    h - b + 16.0,
+                );
+            }
         }
         let _ = writeln!(
             self.front,

@@ -1,4 +1,6 @@
-//! Number and text formatting shared by the renderers.
+//! Number and text formatting shared by the renderers (the chart module's, plus millimetres).
+
+pub(super) use hilsim_report::svg::{escape, fmt_sig};
 
 /// Metres as millimetres with one decimal, "—" when not finite.
 pub(super) fn mm(v: f64) -> String {
@@ -7,24 +9,4 @@ pub(super) fn mm(v: f64) -> String {
     } else {
         "—".to_string()
     }
-}
-
-/// A number with about three significant figures.
-pub(super) fn fmt_sig(v: f64) -> String {
-    if !v.is_finite() {
-        return "—".into();
-    }
-    if v == 0.0 {
-        return "0".into();
-    }
-    let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 8) as usize;
-    format!("{v:.digits$}")
-}
-
-/// `s` escaped for HTML and SVG text and attributes.
-pub(super) fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }

@@ -1,6 +1,6 @@
 //! Show: the diagnosis as the JSON object of `interfaces.md`, as text for people, and as
 //! evidence for the eye: residuals against the located variable before and after the fix
-//! (hand-written SVG, no plotting dependency) and an HTML page that holds them with the verdict.
+//! (SVG, drawn with `hilsim_report::svg`) and an HTML page that holds them with the verdict.
 //! Everything here returns strings; writing files is the caller's business.
 
 mod format;

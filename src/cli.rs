@@ -44,7 +44,7 @@ pub enum Command {
     Diagnose(crate::commands::diagnose::DiagnoseArgs),
     /// Draw a recording as one self-contained HTML page: the world, the paths, the scans, each
     /// sensor's error against distance and the calibration.
-    Report(crate::commands::report::ReportArgs),
+    Report(ReportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -211,4 +211,24 @@ pub struct ScenarioTestArgs {
     /// assertion) for CI systems.
     #[arg(long, value_name = "FILE")]
     pub junit: Option<PathBuf>,
+}
+
+/// Draw a recording: the world, the paths, the scans, each sensor's error against distance
+/// and the calibration, as one self-contained HTML page.
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// The recording directory.
+    pub recording: PathBuf,
+    /// The scenario the recording is a run of: its world is drawn and its declared sensor
+    /// models shown.
+    #[arg(long)]
+    pub scenario: Option<PathBuf>,
+    /// A calibration to show: the JSON of `hilsim calibrate --json`, or a run's `results.json`
+    /// (default: RECORDING/results.json when there is one).
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// The directory to write `index.html` into (created if needed; a previous report's page is
+    /// replaced, anything else refused).
+    #[arg(long)]
+    pub out: PathBuf,
 }

@@ -2,7 +2,7 @@
 //! one self-contained `DIR/index.html`. `hilsim run --report DIR` writes the same page.
 
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
@@ -11,25 +11,7 @@ use hilsim_recording::{write_file_atomically, Recording};
 use hilsim_report::Inputs;
 use hilsim_sim::Scenario;
 
-/// Draw a recording: the world, the paths, the scans, each sensor's error against distance
-/// and the calibration, as one self-contained HTML page.
-#[derive(Debug, clap::Args)]
-pub struct ReportArgs {
-    /// The recording directory.
-    pub recording: PathBuf,
-    /// The scenario the recording is a run of: its world is drawn and its declared sensor
-    /// models shown.
-    #[arg(long)]
-    pub scenario: Option<PathBuf>,
-    /// A calibration to show: the JSON of `hilsim calibrate --json`, or a run's `results.json`
-    /// (default: RECORDING/results.json when there is one).
-    #[arg(long)]
-    pub calibration: Option<PathBuf>,
-    /// The directory to write `index.html` into (created if needed; a previous report's page is
-    /// replaced, anything else refused).
-    #[arg(long)]
-    pub out: PathBuf,
-}
+use crate::cli::ReportArgs;
 
 pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     check_report_dir(&args.out)?;

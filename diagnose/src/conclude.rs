@@ -1,10 +1,11 @@
-//! The verdict of a diagnosis: from the best candidate and the nominal evidence, where the
-//! mismatch is, which effect (if any) explains it, and the notes on the other sensors.
+//! The verdict of a diagnosis: from the named effects, the nominal evidence and what each
+//! sensor's residuals show under its named effects: where the mismatch is, which effects
+//! explain it, and what no named effect explains.
 
 use crate::catalogue::Sensor;
 use crate::explain::CandidateFit;
-use crate::locate::{Evidence, TestKind};
-use crate::outcome::{Options, SensorSummary, Verdict};
+use crate::locate::{Evidence, Floors, TestKind};
+use crate::outcome::{NamedEffect, Options, SensorSummary, Verdict};
 use crate::residuals::Context;
 
 /// What the residuals under the nominal model show.
@@ -25,17 +26,28 @@ pub(crate) fn declared_cone(ctx: &Context<'_>) -> f64 {
 }
 
 /// The evidence to report as the location among `evidence` (strongest first), of `sensor` when
-/// given: the strongest test against a variable when one is significant (it says where; a bias
-/// there rather than the spread it causes, when the bias test is at least half as strong), with
-/// the strongest significant test against a motion variable appended when it is at least half
-/// as strong ("… while turn rate …"), else the strongest test.
-fn place_of(evidence: &[Evidence], sensor: Option<Sensor>, threshold: f64) -> Option<Evidence> {
+/// given: the strongest test against a variable when one counts (significant and large enough:
+/// [`Evidence::counts`]; it says where; a bias there rather than the spread it causes, when the
+/// bias test is at least half as strong), with the strongest counting test against a motion
+/// variable appended when it is at least half as strong ("… while turn rate …"), else the
+/// strongest counting test, else (`or_strongest`) the strongest test.
+fn place_of(
+    evidence: &[Evidence],
+    sensor: Option<Sensor>,
+    threshold: f64,
+    floors: &Floors,
+    or_strongest: bool,
+) -> Option<Evidence> {
     let of = |e: &&Evidence| sensor.is_none_or(|s| e.sensor == s);
-    let top = evidence.iter().find(of)?;
+    let top = evidence
+        .iter()
+        .filter(of)
+        .find(|e| e.counts(threshold, floors))
+        .or_else(|| or_strongest.then(|| evidence.iter().find(of)).flatten())?;
     let sensor = top.sensor;
     let against: Vec<&Evidence> = evidence
         .iter()
-        .filter(|e| e.sensor == sensor && e.score > threshold)
+        .filter(|e| e.sensor == sensor && e.counts(threshold, floors))
         .filter(|e| matches!(e.test, TestKind::BiasAgainst | TestKind::SpreadAgainst))
         .collect();
     let Some(&first) = against.first() else {
@@ -69,127 +81,126 @@ fn place_of(evidence: &[Evidence], sensor: Option<Sensor>, threshold: f64) -> Op
     Some(located)
 }
 
-/// The answer, where it is located, the named effect's fit and the sentence that says it.
+/// The answer, where it is located, the named effects and what is left unexplained, and the
+/// sentence that says it.
 pub(crate) struct Conclusion {
     pub verdict: Verdict,
     pub located: Option<Evidence>,
-    pub fitted: Option<CandidateFit>,
+    pub effects: Vec<NamedEffect>,
+    pub unexplained: Vec<Evidence>,
     pub explanation: String,
 }
 
-/// The verdict from the best candidate (if any) and the nominal evidence.
+/// One sensor's structure left under its named effects: `evidence`, strongest first (the
+/// nominal evidence when none is named).
+pub(crate) struct Left {
+    pub sensor: Sensor,
+    pub evidence: Vec<Evidence>,
+}
+
+/// The verdict from the effects `named` (strongest first), the nominal evidence and the
+/// evidence left in each sensor under its named effects.
 pub(crate) fn conclude(
     ctx: &Context<'_>,
     nominal: &Nominal,
-    best: Option<CandidateFit>,
+    named: Vec<CandidateFit>,
+    left: &[Left],
     options: &Options,
 ) -> Conclusion {
     let threshold = nominal.threshold;
-    match (best, nominal.misaligned.clone()) {
-        (Some(best), _) => conclude_effect(ctx, nominal, best, options),
-        // Most readings far from every prediction and no effect explains them: the recording
-        // is not a run of this scenario (or its trajectory is wrong).
-        (None, Some(m)) => Conclusion {
-            verdict: Verdict::Unexplained,
-            explanation: format!(
-                "Nothing aligns: {}. No catalogued effect explains it.",
-                m.detail
+    let floors = &options.floors;
+    let effects: Vec<NamedEffect> = named
+        .into_iter()
+        .map(|fit| NamedEffect {
+            located: place_of(
+                &nominal.evidence,
+                Some(fit.effect.sensor()),
+                threshold,
+                floors,
+                true,
             ),
-            located: Some(m),
-            fitted: None,
-        },
-        (None, None) => {
-            match place_of(&nominal.evidence, None, threshold).filter(|s| s.score > threshold) {
-                Some(s) => Conclusion {
-                    verdict: Verdict::Unexplained,
-                    explanation: format!(
-                    "A mismatch is located in the {} ({}) but no catalogued effect explains it: \
-                     none improves the held-out fit by {} nats.",
-                    s.sensor, s.place, options.min_gain
-                ),
-                    located: Some(s),
-                    fitted: None,
-                },
-                None => Conclusion {
-                    verdict: Verdict::None,
-                    located: None,
-                    fitted: None,
-                    explanation: "The recording agrees with the simulation within its noise: no \
-                              test finds structure in the residuals and no catalogued effect \
-                              improves the held-out fit."
-                        .to_string(),
-                },
-            }
+            fit,
+        })
+        .collect();
+    let mut unexplained: Vec<Evidence> = Vec::new();
+    for l in left {
+        let explained = effects.iter().any(|e| e.fit.effect.sensor() == l.sensor);
+        // Most readings far from every prediction and no effect of the sensor named: the
+        // recording is not a run of this scenario (or its trajectory is wrong).
+        if let Some(m) = nominal
+            .misaligned
+            .as_ref()
+            .filter(|m| m.sensor == l.sensor && !explained)
+        {
+            unexplained.push(m.clone());
+        } else if let Some(e) = place_of(&l.evidence, Some(l.sensor), threshold, floors, false) {
+            unexplained.push(e);
         }
     }
-}
-
-/// The verdict when `best` is good enough to name: the effect, if it leaves little of the
-/// located structure, else "unexplained".
-fn conclude_effect(
-    ctx: &Context<'_>,
-    nominal: &Nominal,
-    best: CandidateFit,
-    options: &Options,
-) -> Conclusion {
-    let threshold = nominal.threshold;
-    let sensor = best.effect.sensor();
-    let left = best.remaining.as_ref().map_or(0.0, |r| r.score);
-    // Against an estimated trajectory part of the effect was absorbed into the estimate
-    // (which the fit cannot undo), so twice the share may remain.
-    let share = if ctx.estimated {
-        2.0 * options.max_remaining
-    } else {
-        options.max_remaining
-    };
-    let strongest = nominal
-        .sensors
+    unexplained.sort_by(|a, b| b.score.total_cmp(&a.score));
+    let cone = declared_cone(ctx);
+    let mut explanation = effects
         .iter()
-        .find(|x| x.sensor == sensor)
-        .map_or(0.0, |x| x.strongest);
-    let allowed = (threshold + 2.0).max(share * strongest);
-    let located = place_of(&nominal.evidence, Some(sensor), threshold);
-    if left <= allowed {
-        Conclusion {
-            verdict: Verdict::Effect(best.effect),
-            located,
-            explanation: best.effect.explanation(&best.params, declared_cone(ctx)),
-            fitted: Some(best),
+        .map(|e| e.fit.effect.explanation(&e.fit.params, cone))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let left_words: Vec<String> = unexplained
+        .iter()
+        .map(|u| {
+            let size = if u.size_m.is_finite() {
+                format!(", {:.1} mm", u.size_m * 1000.0)
+            } else {
+                String::new()
+            };
+            format!("the {} ({}{size})", u.sensor, u.place)
+        })
+        .collect();
+    let verdict = match (effects.first(), unexplained.first()) {
+        (Some(e), _) => Verdict::Effect(e.fit.effect),
+        (None, Some(_)) => Verdict::Unexplained,
+        (None, None) => Verdict::None,
+    };
+    match verdict {
+        Verdict::Effect(_) if !left_words.is_empty() => {
+            explanation += &format!(
+                " Left unexplained (no catalogued effect explains it): {}.",
+                left_words.join("; ")
+            );
         }
-    } else {
-        let explanation = format!(
-            "A mismatch is located in the {sensor} but no catalogued effect explains it: \
-             the best, {}, leaves structure of {left:.1}σ ({}).",
-            best.effect,
-            best.remaining
-                .as_ref()
-                .map_or(String::new(), |r| r.place.clone())
-        );
-        Conclusion {
-            verdict: Verdict::Unexplained,
-            located,
-            fitted: None,
-            explanation,
+        Verdict::Effect(_) => {}
+        Verdict::Unexplained => {
+            let first = &unexplained[0];
+            explanation = if first.score.is_infinite() {
+                format!(
+                    "Nothing aligns: {}. No catalogued effect explains it.",
+                    first.detail
+                )
+            } else {
+                format!(
+                    "A mismatch is located in {} but no catalogued effect explains it: none \
+                     improves the held-out fit by {} nats by changing the readings more than \
+                     the sensor's floor.",
+                    left_words.join("; "),
+                    options.min_gain
+                )
+            };
+        }
+        Verdict::None => {
+            explanation = "The recording agrees with the simulation within its noise: no \
+                           test finds structure in the residuals larger than the sensors' \
+                           floors and no catalogued effect improves the held-out fit."
+                .to_string();
         }
     }
-}
-
-/// A note for each other sensor whose residuals depart from its noise (`significant`), unless
-/// the verdict explains it, it is the located one or a note already names it.
-pub(crate) fn note_other_sensors(
-    notes: &mut Vec<String>,
-    significant: &[Evidence],
-    verdict: Verdict,
-    located: Option<&Evidence>,
-) {
-    for s in significant {
-        let explained = matches!(verdict, Verdict::Effect(e) if e.sensor() == s.sensor);
-        let already = located.is_some_and(|l| l.sensor == s.sensor);
-        if !explained && !already && !notes.iter().any(|n| n.contains(s.sensor.name())) {
-            notes.push(format!(
-                "the {} also departs from its noise ({:.1}σ at {})",
-                s.sensor, s.score, s.place
-            ));
-        }
+    let located = match effects.first() {
+        Some(e) => e.located.clone(),
+        None => unexplained.first().cloned(),
+    };
+    Conclusion {
+        verdict,
+        located,
+        effects,
+        unexplained,
+        explanation,
     }
 }

@@ -1,13 +1,11 @@
 //! The orchestration of one diagnosis, stage by stage: align, gather the sensors' residuals,
 //! the nominal evidence, fit the candidates, re-align under a lidar effect, conclude, plot.
 
-use rayon::prelude::*;
-
 use hilsim_recording::Recording;
 
 use crate::align::{self, Aligned, Alignment};
-use crate::catalogue::{Effect, Sensor};
-use crate::conclude::{conclude, declared_cone, note_other_sensors, Conclusion, Nominal};
+use crate::catalogue::Sensor;
+use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
 use crate::explain::{self, CandidateFit};
 use crate::locate::{self, Evidence, TestKind};
@@ -15,6 +13,7 @@ use crate::outcome::{Diagnosis, Options, SensorSummary};
 use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, SensorData};
+use crate::select::{self, hypothesis_of, Selection};
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
 /// it (against an estimated trajectory only); they stop once the parameter moves by less than
@@ -92,37 +91,43 @@ pub fn diagnose_with_progress(
     progress(Stage::Locating);
     let nominal = nominal_evidence(&ctx, &data, options);
     progress(Stage::Fitting);
-    let mut candidates = fit_candidates(&ctx, &data, options);
-    let best = best_candidate(&ctx, &candidates, options);
+    let Selection {
+        named,
+        mut candidates,
+    } = select::select(&ctx, &data, options);
     progress(Stage::Concluding);
-    let (best, realigned) =
-        realign_lidar(&ctx, &aligned, best, &mut candidates, &mut data, options)?;
+    let (named, realigned) =
+        realign_lidar(&ctx, &aligned, named, &mut candidates, &mut data, options)?;
     let realigned_ctx = realigned.as_ref().map(|a| Context {
         trajectory: &a.trajectory,
         position_sd_m: a.position_sd_m,
         yaw_sd_rad: a.yaw_sd_rad,
         ..ctx
     });
-    let plot_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
+    let final_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
+    let left = structure_left(final_ctx, &data, &nominal, &named);
     let Conclusion {
         verdict,
         located,
-        fitted,
+        effects,
+        unexplained,
         explanation,
-    } = conclude(&ctx, &nominal, best, options);
+    } = conclude(&ctx, &nominal, named, &left, options);
     let significant: Vec<Evidence> = nominal
         .evidence
         .iter()
         .filter(|e| e.score > nominal.threshold)
         .cloned()
         .collect();
-    note_other_sensors(&mut notes, &significant, verdict, located.as_ref());
-    let plots = plot::plots(plot_ctx, &data, located.as_ref(), fitted.as_ref());
+    let fitted = effects.first().map(|e| e.fit.clone());
+    let plots = plot::plots(final_ctx, &data, located.as_ref(), fitted.as_ref());
     Ok(Diagnosis {
         verdict,
         located,
         explanation,
         fitted,
+        effects,
+        unexplained,
         candidates,
         sensors: nominal.sensors,
         evidence: significant,
@@ -131,6 +136,43 @@ pub fn diagnose_with_progress(
         notes,
         plots,
     })
+}
+
+/// Each sensor's tests under its named effects (the nominal evidence where none is named).
+fn structure_left(
+    ctx: &Context<'_>,
+    data: &[SensorData],
+    nominal: &Nominal,
+    named: &[CandidateFit],
+) -> Vec<Left> {
+    let names = |id: u32| ctx.physics.object_name(id);
+    data.iter()
+        .map(|d| {
+            let mine: Vec<CandidateFit> = named
+                .iter()
+                .filter(|c| c.effect.sensor() == d.sensor)
+                .cloned()
+                .collect();
+            let evidence = if mine.is_empty() {
+                nominal
+                    .evidence
+                    .iter()
+                    .filter(|e| e.sensor == d.sensor)
+                    .cloned()
+                    .collect()
+            } else {
+                let all = d.rows(None);
+                let f = residuals::fits(d, &all, &ctx.predict(d, &hypothesis_of(&mine), &all));
+                let mut ev = locate::locate(d, &all, &f, &names, !ctx.estimated);
+                ev.sort_by(|a, b| b.score.total_cmp(&a.score));
+                ev
+            };
+            Left {
+                sensor: d.sensor,
+                evidence,
+            }
+        })
+        .collect()
 }
 
 /// The sensors' residual data with enough readings to test (a note for each with too few).
@@ -236,69 +278,42 @@ fn misaligned_evidence(sensor: Sensor, wild: f64) -> Evidence {
             sensor
         ),
         range: None,
+        size_m: f64::NAN,
+        noise_m: f64::NAN,
     }
 }
 
-/// Every applicable effect fitted (in parallel: each is independent), best held-out gain first.
-fn fit_candidates(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Vec<CandidateFit> {
-    let names = |id: u32| ctx.physics.object_name(id);
-    let present: Vec<Sensor> = data.iter().map(|d| d.sensor).collect();
-    let tries: Vec<(Effect, &SensorData)> = options
-        .effects
-        .iter()
-        .filter(|e| explain::applicable(**e, ctx, &present))
-        .filter_map(|&e| data.iter().find(|d| d.sensor == e.sensor()).map(|d| (e, d)))
-        .collect();
-    let mut candidates: Vec<CandidateFit> = tries
-        .par_iter()
-        .map(|(e, d)| explain::fit_candidate(ctx, d, *e, options.max_fit_rows, &names))
-        .collect();
-    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
-    candidates
-}
-
-/// The best candidate good enough to name, if any.
-fn best_candidate(
-    ctx: &Context<'_>,
-    candidates: &[CandidateFit],
-    options: &Options,
-) -> Option<CandidateFit> {
-    // An effect fitted to (next to) its own absence is the nominal model: what it gains is
-    // noise the fit chased, not physics.
-    let declared_cone = declared_cone(ctx);
-    candidates
-        .iter()
-        .find(|c| {
-            c.heldout_gain > options.min_gain
-                && c.bic_gain > 0.0
-                && c.effect.departs(&c.params, declared_cone)
-        })
-        .cloned()
-}
-
 /// Against an estimated trajectory a lidar effect was partly absorbed into the scan matching
-/// (fitted with the nominal model): the trajectory is estimated again under the effect's fitted
-/// model and the effect refitted against it. Returns the best candidate and, when it was
-/// refitted, the trajectory it rests on (`candidates` and the lidar's `data` then follow it).
+/// (fitted with the nominal model): the trajectory is estimated again under the named lidar
+/// effects' fitted model and the strongest refitted against it (the others held). Returns the
+/// named effects and, when one was refitted, the trajectory it rests on (`candidates` and the
+/// lidar's `data` then follow it).
 fn realign_lidar(
     ctx: &Context<'_>,
     aligned: &Aligned,
-    best: Option<CandidateFit>,
+    mut named: Vec<CandidateFit>,
     candidates: &mut [CandidateFit],
     data: &mut [SensorData],
     options: &Options,
-) -> Result<(Option<CandidateFit>, Option<Aligned>), MismatchError> {
-    let Some(mut current) = best
-        .clone()
-        .filter(|b| ctx.estimated && b.effect.sensor() == Sensor::Lidar)
+) -> Result<(Vec<CandidateFit>, Option<Aligned>), MismatchError> {
+    let Some(at) = named
+        .iter()
+        .position(|b| b.effect.sensor() == Sensor::Lidar)
+        .filter(|_| ctx.estimated)
     else {
-        return Ok((best, None));
+        return Ok((named, None));
     };
-    let names = |id: u32| ctx.physics.object_name(id);
-    let declared_cone = declared_cone(ctx);
+    let mut current = named[at].clone();
+    let others: Vec<CandidateFit> = named
+        .iter()
+        .filter(|c| c.effect.sensor() == Sensor::Lidar && c.effect != current.effect)
+        .cloned()
+        .collect();
+    let base = hypothesis_of(&others);
+    let cone = declared_cone(ctx);
     let mut realigned: Option<Aligned> = None;
     for _ in 0..REALIGN_ROUNDS {
-        let hypothesis = Hypothesis::with(current.effect, current.params.clone());
+        let hypothesis = base.and(current.effect, current.params.clone());
         let again = align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?;
         let ctx2 = Context {
             trajectory: &again.trajectory,
@@ -311,10 +326,8 @@ fn realign_lidar(
         };
         lidar.clusters = Some(residuals::shared_error_clusters(ctx2.trajectory, &lidar.t));
         let refit =
-            explain::fit_candidate(&ctx2, &lidar, current.effect, options.max_fit_rows, &names);
-        if !(refit.heldout_gain > options.min_gain
-            && refit.effect.departs(&refit.params, declared_cone))
-        {
+            explain::fit_candidate(&ctx2, &lidar, &base, current.effect, options.max_fit_rows);
+        if !select::earns_place(&refit, cone, options) {
             break;
         }
         let (before, after) = (current.params[0], refit.params[0]);
@@ -329,10 +342,11 @@ fn realign_lidar(
         }
     }
     if realigned.is_none() {
-        return Ok((best, None));
+        return Ok((named, None));
     }
     if let Some(c) = candidates.iter_mut().find(|c| c.effect == current.effect) {
         *c = current.clone();
     }
-    Ok((Some(current), realigned))
+    named[at] = current;
+    Ok((named, realigned))
 }

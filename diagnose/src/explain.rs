@@ -1,16 +1,16 @@
 //! Explain: fit each catalogued effect's parameters by maximum likelihood on the training half,
 //! then compare it with "none" (and with the others) on the held-out half: the held-out
 //! log-likelihood gain is the score, the Bayesian information criterion on the training half a
-//! second opinion. The fitted model's residuals are located again: an effect that leaves the
-//! located structure standing explains only part of the mismatch.
+//! second opinion. Effects are fitted on top of a base (those already named in the sensor),
+//! and the effects named in one sensor are refitted jointly.
 
-use crate::catalogue::{Effect, Sensor};
-use crate::locate::{locate, Evidence};
-use crate::optimize::{maximize, standard_errors};
+use crate::catalogue::{Effect, ParamSpec, Sensor};
+use crate::optimize::{maximize, refine, standard_errors};
 use crate::physics::Hypothesis;
-use crate::residuals::{fits, log_likelihood, rmse, Context, SensorData};
+use crate::residuals::{fits, log_likelihood, rmse, Context, Predictive, SensorData};
 
-/// One candidate effect, fitted and scored.
+/// One candidate effect, fitted and scored against a base model (the nominal one, or the
+/// effects already named in its sensor).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CandidateFit {
     /// The effect.
@@ -19,13 +19,13 @@ pub struct CandidateFit {
     pub params: Vec<f64>,
     /// Their standard errors (inverse observed information); NaN where the likelihood is flat.
     pub param_sd: Vec<f64>,
-    /// Log-likelihood gain over "none" on the training half.
+    /// Log-likelihood gain over the base on the training half.
     pub train_gain: f64,
-    /// Log-likelihood gain over "none" on the held-out half: the score.
+    /// Log-likelihood gain over the base on the held-out half: the score.
     pub heldout_gain: f64,
-    /// BIC gain over "none": `2 · train_gain − k ln n` (positive favours the effect).
+    /// BIC gain over the base: `2 · train_gain − k ln n` (positive favours the effect).
     pub bic_gain: f64,
-    /// Held-out RMSE of the sensor's residuals before (nominal) and after the fit, metres.
+    /// Held-out RMSE of the sensor's residuals before (the base) and after the fit, metres.
     pub rmse_before: f64,
     /// See `rmse_before`.
     pub rmse_after: f64,
@@ -33,9 +33,19 @@ pub struct CandidateFit {
     pub noise_floor: f64,
     /// Held-out readings the RMSEs are over.
     pub heldout_n: usize,
-    /// The strongest structure left in the sensor's residuals after the fit.
-    pub remaining: Option<Evidence>,
+    /// How much the effect changes the predicted readings, metres: the RMS change of the
+    /// predictive mean over the tenth of the held-out readings it changes most (at least 30),
+    /// so an effect that acts on a few readings (edges, the first seconds) is measured where
+    /// it acts.
+    pub size_m: f64,
+    /// The declared noise over those readings (RMS predicted standard deviation), metres.
+    pub size_noise_m: f64,
 }
+
+/// Readings the size of an effect is measured over: this share of the held-out ones, at
+/// least [`SIZE_MIN_READINGS`].
+const SIZE_SHARE: f64 = 0.1;
+const SIZE_MIN_READINGS: usize = 30;
 
 /// Training rows for fitting: every `stride`-th, at most `max_rows`.
 fn fit_rows(data: &SensorData, max_rows: usize) -> Vec<usize> {
@@ -52,26 +62,64 @@ fn total_ll(ctx: &Context<'_>, data: &SensorData, h: &Hypothesis, rows: &[usize]
         .sum()
 }
 
-/// Fits `effect` to its sensor's data and scores it.
-pub(crate) fn fit_candidate(
+/// The mean of a predictive mixture (NaN: no reading expected).
+fn predictive_mean(p: &Predictive) -> f64 {
+    let w: f64 = p.iter().map(|g| g.weight).sum();
+    if p.is_empty() || w <= 0.0 {
+        return f64::NAN;
+    }
+    p.iter().map(|g| g.weight * g.mean_m).sum::<f64>() / w
+}
+
+/// The effect size: the RMS change of the predictive mean from `before` to `after` over the
+/// readings it changes most, with the RMS predicted standard deviation there.
+fn effect_size(before: &[Predictive], after: &[Predictive]) -> (f64, f64) {
+    let mut change: Vec<(f64, f64)> = before
+        .iter()
+        .zip(after)
+        .filter_map(|(b, a)| {
+            let d = predictive_mean(a) - predictive_mean(b);
+            let sd = a.iter().map(|g| g.weight * g.sd_m).sum::<f64>()
+                / a.iter().map(|g| g.weight).sum::<f64>();
+            (d.is_finite() && sd.is_finite()).then_some((d.abs(), sd))
+        })
+        .collect();
+    if change.is_empty() {
+        return (0.0, f64::NAN);
+    }
+    let k = ((change.len() as f64 * SIZE_SHARE) as usize)
+        .max(SIZE_MIN_READINGS)
+        .min(change.len());
+    change.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let top = &change[..k];
+    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        (top.iter().map(|x| f(x).powi(2)).sum::<f64>() / k as f64).sqrt()
+    };
+    (rms(&|x| x.0), rms(&|x| x.1))
+}
+
+/// Scores `effect` with `params` on top of `base`: its gains over the base on both halves,
+/// the held-out RMSE before and after, its size; `param_sd` from the curvature of the training
+/// likelihood in its own parameters (the base held fixed).
+fn score(
     ctx: &Context<'_>,
     data: &SensorData,
+    base: &Hypothesis,
     effect: Effect,
-    max_fit_rows: usize,
-    names: &dyn Fn(u32) -> String,
+    params: Vec<f64>,
+    train: &[usize],
 ) -> CandidateFit {
     let specs = effect.params();
-    let train = fit_rows(data, max_fit_rows);
-    let nominal = Hypothesis::nominal();
-    let train_none = total_ll(ctx, data, &nominal, &train);
-    let mut objective =
-        |x: &[f64]| total_ll(ctx, data, &Hypothesis::with(effect, x.to_vec()), &train);
-    let (params, best) = maximize(specs, &mut objective);
+    let train_base = total_ll(ctx, data, base, train);
+    let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), train);
+    let best = objective(&params);
     let param_sd = standard_errors(specs, &params, best, &mut objective, 2e-3);
-    let fitted = Hypothesis::with(effect, params.clone());
+    let fitted = base.and(effect, params.clone());
     let heldout = data.rows(Some(true));
-    let before = fits(data, &heldout, &ctx.predict(data, &nominal, &heldout));
-    let after = fits(data, &heldout, &ctx.predict(data, &fitted, &heldout));
+    let before_p = ctx.predict(data, base, &heldout);
+    let after_p = ctx.predict(data, &fitted, &heldout);
+    let before = fits(data, &heldout, &before_p);
+    let after = fits(data, &heldout, &after_p);
     let heldout_gain: f64 =
         after.iter().map(|f| f.ll).sum::<f64>() - before.iter().map(|f| f.ll).sum::<f64>();
     // RMSE over the held-out readings the fitted model explains (not outliers to it), before
@@ -80,13 +128,8 @@ pub(crate) fn fit_candidate(
     let both = |i: usize| before[i].residual.is_finite() && !after[i].outlier;
     let (rmse_before, _, _) = rmse(&before, both);
     let (rmse_after, noise_floor, heldout_n) = rmse(&after, both);
-    // What is left after the fix, over all readings.
-    let all = data.rows(None);
-    let all_after = fits(data, &all, &ctx.predict(data, &fitted, &all));
-    let remaining = locate(data, &all, &all_after, names, !ctx.estimated)
-        .into_iter()
-        .max_by(|a, b| a.score.total_cmp(&b.score));
-    let train_gain = best - train_none;
+    let (size_m, size_noise_m) = effect_size(&before_p, &after_p);
+    let train_gain = best - train_base;
     CandidateFit {
         effect,
         bic_gain: 2.0 * train_gain - specs.len() as f64 * (train.len() as f64).ln(),
@@ -98,8 +141,72 @@ pub(crate) fn fit_candidate(
         rmse_after,
         noise_floor,
         heldout_n,
-        remaining,
+        size_m,
+        size_noise_m,
     }
+}
+
+/// Fits `effect` on top of `base` to its sensor's data and scores it.
+pub(crate) fn fit_candidate(
+    ctx: &Context<'_>,
+    data: &SensorData,
+    base: &Hypothesis,
+    effect: Effect,
+    max_fit_rows: usize,
+) -> CandidateFit {
+    let specs = effect.params();
+    let train = fit_rows(data, max_fit_rows);
+    let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
+    let (params, _) = maximize(specs, &mut objective);
+    score(ctx, data, base, effect, params, &train)
+}
+
+/// Refits the effects of one sensor `chosen` (each fitted in turn on top of those before it)
+/// jointly: every parameter at once, from where the turns left them. Each is then scored
+/// against the others: its gain is what it adds to them.
+pub(crate) fn refit_jointly(
+    ctx: &Context<'_>,
+    data: &SensorData,
+    chosen: &[CandidateFit],
+    max_fit_rows: usize,
+) -> Vec<CandidateFit> {
+    if chosen.len() < 2 {
+        return chosen.to_vec();
+    }
+    let train = fit_rows(data, max_fit_rows);
+    let specs: Vec<ParamSpec> = chosen
+        .iter()
+        .flat_map(|c| c.effect.params().iter().copied())
+        .collect();
+    let start: Vec<f64> = chosen.iter().flat_map(|c| c.params.clone()).collect();
+    let split = |x: &[f64]| -> Hypothesis {
+        let mut h = Hypothesis::nominal();
+        let mut at = 0;
+        for c in chosen {
+            let k = c.effect.params().len();
+            h = h.and(c.effect, x[at..at + k].to_vec());
+            at += k;
+        }
+        h
+    };
+    let mut objective = |x: &[f64]| total_ll(ctx, data, &split(x), &train);
+    let (x, _) = refine(&specs, &start, 30 * specs.len(), &mut objective);
+    let joint = split(&x);
+    joint
+        .effects
+        .iter()
+        .map(|(effect, params)| {
+            let others = Hypothesis {
+                effects: joint
+                    .effects
+                    .iter()
+                    .filter(|(e, _)| e != effect)
+                    .cloned()
+                    .collect(),
+            };
+            score(ctx, data, &others, *effect, params.clone(), &train)
+        })
+        .collect()
 }
 
 /// Whether `effect` can be tried on these data at all.

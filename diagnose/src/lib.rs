@@ -9,8 +9,9 @@
 //! 2. `residuals`: every reading against its prediction under the declared noise model.
 //! 3. [`locate`]: tests of bias, spread and whiteness against range, bearing, incidence
 //!    angle, object, time, speed, acceleration, turn rate…; the strongest is the location.
-//! 4. [`explain`]: each catalogued effect fitted by maximum likelihood on the training
-//!    half and scored on the held-out half against "none" and each other.
+//! 4. [`explain`], `select`: each catalogued effect fitted by maximum likelihood on the
+//!    training half and scored on the held-out half; effects named by forward selection on
+//!    held-out data, several at once, then refitted jointly.
 //! 5. [`show`]: the verdict as JSON and text, the held-out fit before and after, plots.
 //!
 //! The physics is behind the [`Physics`] trait, which `hilsim` implements from the simulator:
@@ -29,6 +30,7 @@ mod outcome;
 mod physics;
 mod plot;
 mod residuals;
+mod select;
 pub mod self_test;
 pub mod show;
 mod sim_physics;
@@ -41,8 +43,8 @@ pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
 pub use explain::CandidateFit;
 pub use hilsim_recording::Pose;
-pub use locate::{Evidence, TestKind};
-pub use outcome::{Diagnosis, Options, SensorSummary, Verdict};
+pub use locate::{Evidence, Floors, TestKind};
+pub use outcome::{Diagnosis, NamedEffect, Options, SensorSummary, Verdict};
 pub use physics::{
     Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
     OdometryPrediction, Physics, SonarPrediction,

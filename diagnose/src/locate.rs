@@ -51,6 +51,86 @@ pub struct Evidence {
     pub detail: String,
     /// The strongest bin's limits (continuous variables), for plots.
     pub range: Option<(f64, f64)>,
+    /// How large the departure is, metres: a bias's mean residual (against a variable: the
+    /// bin's mean residual less the overall one), a spread's excess standard deviation (robust:
+    /// heavier tails than Gaussian do not count), or the standard deviation of a correlated
+    /// component in time. NaN when it cannot be measured (no reading has a prediction).
+    pub size_m: f64,
+    /// The declared noise there: the RMS of the predicted standard deviations, metres.
+    pub noise_m: f64,
+}
+
+impl Evidence {
+    /// Whether this departure is a mismatch: statistically significant (its score above
+    /// `threshold`) and large enough to matter (its size above `floors`' floor for its sensor
+    /// and noise). A size that cannot be measured counts as large (a recording that does not
+    /// align, readings where nothing was expected).
+    #[must_use]
+    pub fn counts(&self, threshold: f64, floors: &Floors) -> bool {
+        self.score > threshold
+            && (self.size_m.is_nan() || self.size_m > floors.floor_m(self.sensor, self.noise_m))
+    }
+}
+
+/// The practical-significance floors: a departure smaller than
+/// `max(absolute floor of its sensor, noise_share × the declared noise there)` is not reported
+/// as a mismatch however significant it is over many readings. Derived in `docs/diagnose.md`
+/// ("Practical significance").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Floors {
+    /// Lidar, metres.
+    pub lidar_m: f64,
+    /// Sonar, metres.
+    pub sonar_m: f64,
+    /// Encoders, metres.
+    pub odometer_m: f64,
+    /// Drive (a wheel's travel over a 0.1 s window), metres.
+    pub drive_m: f64,
+    /// Share of the declared noise's standard deviation below which a departure does not
+    /// matter.
+    pub noise_share: f64,
+}
+
+impl Default for Floors {
+    /// A scenario's world is measured to a few millimetres (a tape measure, a drawing), so a
+    /// range mismatch below 5 mm is as likely the world's as the sensor's; an encoder or the
+    /// drive resolves far less than a millimetre of travel, but their noise is a few: 2 mm
+    /// and 1 mm (a 0.1 s window). A departure below a quarter of the noise's standard
+    /// deviation changes no single reading's likelihood by more than 0.25²/2 ≈ 3 %: it matters
+    /// only summed over thousands of readings, where any two simulators differ.
+    fn default() -> Self {
+        Self {
+            lidar_m: 0.005,
+            sonar_m: 0.005,
+            odometer_m: 0.002,
+            drive_m: 0.001,
+            noise_share: 0.25,
+        }
+    }
+}
+
+impl Floors {
+    /// The absolute floor of `sensor`, metres.
+    #[must_use]
+    pub fn absolute_m(&self, sensor: Sensor) -> f64 {
+        match sensor {
+            Sensor::Lidar => self.lidar_m,
+            Sensor::Sonar => self.sonar_m,
+            Sensor::Odometer => self.odometer_m,
+            Sensor::Drive => self.drive_m,
+        }
+    }
+
+    /// The floor of a departure of `sensor` where the declared noise is `noise_m`.
+    #[must_use]
+    pub fn floor_m(&self, sensor: Sensor, noise_m: f64) -> f64 {
+        let relative = if noise_m.is_finite() {
+            self.noise_share * noise_m
+        } else {
+            0.0
+        };
+        self.absolute_m(sensor).max(relative)
+    }
 }
 
 /// A two-sided normal statistic as a one-sided score (the same tail probability).
@@ -268,6 +348,37 @@ impl<'a> Scores<'a> {
         }
     }
 
+    /// The RMS of the predicted standard deviations at the positions `ks`, metres.
+    fn noise(&self, ks: &[usize]) -> f64 {
+        let v: Vec<f64> = ks
+            .iter()
+            .map(|&k| self.fits[k].sd)
+            .filter(|s| s.is_finite())
+            .collect();
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            (v.iter().map(|s| s * s).sum::<f64>() / v.len() as f64).sqrt()
+        }
+    }
+
+    /// The excess spread at `ks`, metres: the noise there times `√(s² − 1)`, `s` the scores'
+    /// robust scale (1.4826 × their median absolute deviation, 1 for the declared noise).
+    /// Robust, so a small share of wild readings or heavier tails than Gaussian do not make a
+    /// spread large: only a wider core does.
+    fn excess_spread(&self, ks: &[usize]) -> f64 {
+        let mut z: Vec<f64> = ks.iter().map(|&k| self.z[k]).collect();
+        if z.is_empty() {
+            return f64::NAN;
+        }
+        let mid = z.len() / 2;
+        let median = *z.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let mut dev: Vec<f64> = z.iter().map(|v| (v - median).abs()).collect();
+        let mad = *dev.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let s = 1.4826 * mad;
+        self.noise(ks) * (s * s - 1.0).max(0.0).sqrt()
+    }
+
     /// The overall bias (a t statistic of the scores) and spread (Σ z² against its χ²_n null,
     /// as a normal score).
     fn overall(&self) -> [Evidence; 2] {
@@ -291,6 +402,8 @@ impl<'a> Scores<'a> {
                     self.mean_residual(&all) * 1000.0
                 ),
                 range: None,
+                size_m: self.mean_residual(&all).abs(),
+                noise_m: self.noise(&all),
             },
             Evidence {
                 sensor,
@@ -304,6 +417,8 @@ impl<'a> Scores<'a> {
                     ss / n as f64
                 ),
                 range: None,
+                size_m: self.excess_spread(&all),
+                noise_m: self.noise(&all),
             },
         ]
     }
@@ -360,6 +475,8 @@ impl<'a> Scores<'a> {
         let (zb, g) = best_bias;
         let (lim, _) = &groups[g];
         let (mb, _, ks) = &stats[g];
+        let everywhere: Vec<usize> = (0..self.rows.len()).collect();
+        let overall_residual = self.mean_residual(&everywhere);
         let bias = Evidence {
             sensor,
             test: TestKind::BiasAgainst,
@@ -375,6 +492,8 @@ impl<'a> Scores<'a> {
                 c.name()
             ),
             range: (!c.categorical()).then_some(*lim),
+            size_m: (self.mean_residual(ks) - overall_residual).abs(),
+            noise_m: self.noise(ks),
         };
         let (sb, g) = best_spread;
         let (lim, _) = &groups[g];
@@ -393,18 +512,42 @@ impl<'a> Scores<'a> {
                 c.name()
             ),
             range: (!c.categorical()).then_some(*lim),
+            size_m: self.excess_spread(ks),
+            noise_m: self.noise(ks),
         };
         Some([bias, spread])
     }
 
-    /// Whiteness: the scores in time order (Ljung–Box), when there are lags to test.
+    /// Whiteness: the scores in time order (Ljung–Box), when there are lags to test; each
+    /// wheel on its own for the encoders and the drive (their rows alternate left, right), so
+    /// noise the two wheels share at one instant is not mistaken for correlation in time. The
+    /// wheel with the larger statistic is reported.
     fn whiteness(&self) -> Option<Evidence> {
         let (data, rows, sensor) = (self.data, self.rows, self.data.sensor);
-        let mut order: Vec<usize> = (0..rows.len()).collect();
-        order.sort_by(|&a, &b| data.t[rows[a]].total_cmp(&data.t[rows[b]]));
-        let series: Vec<f64> = order.iter().map(|&k| self.z[k]).collect();
-        let (q, k) = ljung_box(&series, LAGS, 1.0);
-        (k > 0).then(|| Evidence {
+        let channels = match sensor {
+            Sensor::Odometer | Sensor::Drive => 2,
+            Sensor::Lidar | Sensor::Sonar => 1,
+        };
+        let mut best: Option<(f64, usize, usize, Vec<usize>)> = None;
+        for channel in 0..channels {
+            let mut order: Vec<usize> = (0..rows.len())
+                .filter(|&k| rows[k] % channels == channel)
+                .collect();
+            order.sort_by(|&a, &b| data.t[rows[a]].total_cmp(&data.t[rows[b]]));
+            let series: Vec<f64> = order.iter().map(|&k| self.z[k]).collect();
+            let (q, k) = ljung_box(&series, LAGS, 1.0);
+            if k > 0 && best.as_ref().is_none_or(|b| q > b.0) {
+                best = Some((q, k, series.len(), order));
+            }
+        }
+        let (q, k, n, ks) = best?;
+        // The correlated component's share of the variance, from the lags' mean squared
+        // autocorrelation beyond its null (Q ≈ n Σ r²): a component of standard deviation s in
+        // noise σ has r ≈ s² / (s² + σ²), so s = σ √(r / (1 − r)).
+        let r = ((q - k as f64).max(0.0) / (n as f64 * k as f64))
+            .sqrt()
+            .min(0.99);
+        Some(Evidence {
             sensor,
             test: TestKind::Whiteness,
             covariate: Some(Covariate::Time),
@@ -412,6 +555,8 @@ impl<'a> Scores<'a> {
             place: format!("{sensor} readings in time order"),
             detail: format!("Ljung–Box Q {q:.0} on {k} lags (white noise: {k})"),
             range: None,
+            size_m: self.noise(&ks) * (r / (1.0 - r)).sqrt(),
+            noise_m: self.noise(&ks),
         })
     }
 }

@@ -99,6 +99,51 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
     (x, best_v)
 }
 
+fn to_unit(spec: &ParamSpec, x: f64) -> f64 {
+    let u = if spec.log {
+        (x.max(spec.lo).ln() - spec.lo.ln()) / (spec.hi.ln() - spec.lo.ln())
+    } else {
+        (x - spec.lo) / (spec.hi - spec.lo)
+    };
+    u.clamp(0.0, 1.0)
+}
+
+/// A local maximum of `f` near `start` (within the box of `specs`), with the value there:
+/// Nelder–Mead from `start` with steps of half a grid cell, at most `max_evals` evaluations.
+/// For a joint refit of parameters each already fitted on its own.
+pub(crate) fn refine(
+    specs: &[ParamSpec],
+    start: &[f64],
+    max_evals: usize,
+    f: &mut dyn FnMut(&[f64]) -> f64,
+) -> (Vec<f64>, f64) {
+    let mut eval = |u: &[f64]| -> f64 {
+        let x: Vec<f64> = specs.iter().zip(u).map(|(s, &u)| from_unit(s, u)).collect();
+        let v = f(&x);
+        if v.is_finite() {
+            v
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    let u0: Vec<f64> = specs
+        .iter()
+        .zip(start)
+        .map(|(s, &x)| to_unit(s, x))
+        .collect();
+    let step: Vec<f64> = specs
+        .iter()
+        .map(|s| 0.5 / (s.grid.max(2) - 1) as f64)
+        .collect();
+    let (u, v) = nelder_mead(&mut eval, &u0, &step, max_evals);
+    let x = specs
+        .iter()
+        .zip(&u)
+        .map(|(s, &u)| from_unit(s, u))
+        .collect();
+    (x, v)
+}
+
 /// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`.
 fn nelder_mead(
     f: &mut dyn FnMut(&[f64]) -> f64,

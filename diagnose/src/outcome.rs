@@ -3,7 +3,7 @@
 use crate::align::Alignment;
 use crate::catalogue::{Effect, Sensor};
 use crate::explain::CandidateFit;
-use crate::locate::Evidence;
+use crate::locate::{Evidence, Floors};
 use crate::plot::PlotData;
 
 /// Settings of the diagnosis. The defaults are the ones `docs/diagnose.md` derives and the
@@ -14,8 +14,8 @@ pub struct Options {
     pub alpha: f64,
     /// Held-out log-likelihood gain over "none" (nats) an effect needs to be named.
     pub min_gain: f64,
-    /// Share of the located structure (in normal-score terms) the fitted effect may leave.
-    pub max_remaining: f64,
+    /// The practical-significance floors: a departure below them is no mismatch.
+    pub floors: Floors,
     /// The effects tried (default: the whole catalogue).
     pub effects: Vec<Effect>,
     /// Training readings per sensor used to fit an effect (evenly thinned beyond this).
@@ -30,7 +30,7 @@ impl Default for Options {
         Self {
             alpha: 0.01,
             min_gain: 10.0,
-            max_remaining: 0.25,
+            floors: Floors::default(),
             effects: Effect::ALL.to_vec(),
             max_fit_rows: 15_000,
             misaligned_share: 0.5,
@@ -61,6 +61,16 @@ impl Verdict {
     }
 }
 
+/// A named effect: its fit and where its sensor departs from the simulation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedEffect {
+    /// The fit.
+    pub fit: CandidateFit,
+    /// Where the mismatch it explains is located (its sensor's strongest structure under the
+    /// nominal model).
+    pub located: Option<Evidence>,
+}
+
 /// One sensor's held-out residuals under the nominal model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SensorSummary {
@@ -85,8 +95,14 @@ pub struct Diagnosis {
     pub located: Option<Evidence>,
     /// One sentence: what physics was left out (or why none or no effect is named).
     pub explanation: String,
-    /// The named effect's fit.
+    /// The primary named effect's fit (the first of `effects`).
     pub fitted: Option<CandidateFit>,
+    /// Every effect named, strongest held-out gain first (each scored against the others of
+    /// its sensor), with where its sensor's mismatch is located.
+    pub effects: Vec<NamedEffect>,
+    /// Every located mismatch no named effect explains (at most one a sensor: the strongest
+    /// structure left in its residuals under its named effects), with its size.
+    pub unexplained: Vec<Evidence>,
     /// Every candidate tried, best held-out score first.
     pub candidates: Vec<CandidateFit>,
     /// Each sensor compared.

@@ -13,41 +13,56 @@ use hilsim_recording::Pose;
 
 use crate::trajectory::Trajectory;
 
-/// A model to predict with: the nominal one, or the nominal one with one effect switched on
-/// with `params` (in the order of [`Effect::params`]).
-#[derive(Debug, Clone, PartialEq)]
+/// A model to predict with: the nominal one, or the nominal one with one or more effects
+/// switched on, each with its parameters (in the order of [`Effect::params`]).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Hypothesis {
-    /// The effect switched on; `None`: the nominal model.
-    pub effect: Option<Effect>,
-    /// Its parameters.
-    pub params: Vec<f64>,
+    /// The effects switched on, each at most once; empty: the nominal model.
+    pub effects: Vec<(Effect, Vec<f64>)>,
 }
 
 impl Hypothesis {
     /// The scenario as declared.
     #[must_use]
     pub fn nominal() -> Self {
-        Self {
-            effect: None,
-            params: Vec::new(),
-        }
+        Self::default()
     }
 
     /// The scenario with `effect` switched on with `params`.
     #[must_use]
     pub fn with(effect: Effect, params: Vec<f64>) -> Self {
         Self {
-            effect: Some(effect),
-            params,
+            effects: vec![(effect, params)],
         }
     }
 
-    /// The `i`-th parameter when `effect` is the one switched on.
+    /// This hypothesis with `effect` switched on with `params` as well (replacing its
+    /// parameters when it already is).
+    #[must_use]
+    pub fn and(&self, effect: Effect, params: Vec<f64>) -> Self {
+        let mut effects: Vec<(Effect, Vec<f64>)> = self
+            .effects
+            .iter()
+            .filter(|(e, _)| *e != effect)
+            .cloned()
+            .collect();
+        effects.push((effect, params));
+        Self { effects }
+    }
+
+    /// Whether no effect is switched on.
+    #[must_use]
+    pub fn is_nominal(&self) -> bool {
+        self.effects.is_empty()
+    }
+
+    /// The `i`-th parameter of `effect` when it is switched on.
     #[must_use]
     pub fn param_of(&self, effect: Effect, i: usize) -> Option<f64> {
-        (self.effect == Some(effect))
-            .then(|| self.params.get(i).copied())
-            .flatten()
+        self.effects
+            .iter()
+            .find(|(e, _)| *e == effect)
+            .and_then(|(_, p)| p.get(i).copied())
     }
 }
 
@@ -91,6 +106,8 @@ pub struct DeclaredLidar {
     pub rpm: f64,
     /// The farthest valid range, metres.
     pub max_range_m: f64,
+    /// The nearest valid range, metres.
+    pub min_range_m: f64,
 }
 
 /// One lidar reading to predict.
@@ -181,7 +198,7 @@ pub struct OdometryPrediction {
 /// }
 /// let physics = Corridor(Declared {
 ///     scenario: "corridor".into(), start: Pose::default(), wheel_base_m: 0.23,
-///     lidar: Some(DeclaredLidar { snapshot: false, rpm: 300.0, max_range_m: 6.0 }),
+///     lidar: Some(DeclaredLidar { snapshot: false, rpm: 300.0, max_range_m: 6.0, min_range_m: 0.06 }),
 ///     sonar_half_angle_deg: None, odometer: false,
 ///     actuation: Default::default(),
 /// });

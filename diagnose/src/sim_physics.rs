@@ -100,6 +100,7 @@ impl SimPhysics {
                         && s.effects.lidar_motion_skew.is_none(),
                     rpm: l.rpm,
                     max_range_m: l.max_range_m,
+                    min_range_m: l.min_range_m,
                 }),
                 sonar_half_angle_deg: s.sensors.sonar.as_ref().map(|u| {
                     s.effects
@@ -171,8 +172,8 @@ impl SimPhysics {
     /// The scenario's effects with the hypothesis's switched on over them.
     fn effects(&self, h: &Hypothesis) -> Effects {
         let mut e = self.scenario.effects.clone();
-        if let Some(effect) = h.effect {
-            effect.apply(&h.params, &mut e);
+        for (effect, params) in &h.effects {
+            effect.apply(params, &mut e);
         }
         e
     }
@@ -292,7 +293,7 @@ impl Physics for SimPhysics {
             return times.iter().map(|_| none).collect();
         };
         // Where a wider cone would look (asked only with the nominal model: a covariate).
-        let wide = hypothesis.effect.is_none().then(|| {
+        let wide = hypothesis.is_nominal().then(|| {
             let mut e = effects.clone();
             Effect::SonarBeamWidth.apply(&[30.0], &mut e);
             SonarPredictor::new(config, &e)

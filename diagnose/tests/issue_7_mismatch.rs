@@ -64,6 +64,7 @@ impl Corridor {
                     snapshot: false,
                     rpm: REV_HZ * 60.0,
                     max_range_m: 8.0,
+                    min_range_m: 0.06,
                 }),
                 sonar_half_angle_deg: None,
                 odometer: false,

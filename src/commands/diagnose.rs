@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan};
-use hilsim_diagnose::{show, Effect, Options, SimPhysics, Stage};
+use hilsim_diagnose::{show, Effect, Floors, Options, SimPhysics, Stage};
 use hilsim_recording::{write_file_atomically, Recording};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -56,6 +56,50 @@ pub struct DiagnoseArgs {
     /// still printed.
     #[arg(long, conflicts_with = "self_test")]
     pub fail_on_mismatch: bool,
+    /// A sensor's practical floor: a mismatch smaller than this many millimetres (and than
+    /// `--floor-noise-share` of the declared noise) is not reported, however significant
+    /// (`SENSOR=MM`, SENSOR one of lidar, sonar, odometer, drive; repeatable; defaults in
+    /// docs/diagnose.md).
+    #[arg(long = "floor", value_name = "SENSOR=MM", conflicts_with = "self_test")]
+    pub floors: Vec<String>,
+    /// The share of the declared noise's standard deviation below which a mismatch is not
+    /// reported (default 0.25).
+    #[arg(long, value_name = "X", conflicts_with = "self_test")]
+    pub floor_noise_share: Option<f64>,
+}
+
+/// The diagnosis's options from `--floor` and `--floor-noise-share`.
+fn options(args: &DiagnoseArgs) -> Result<Options> {
+    let mut floors = Floors::default();
+    for f in &args.floors {
+        let Some((sensor, mm)) = f.split_once('=') else {
+            bail!("--floor: expected SENSOR=MM, found `{f}`");
+        };
+        let mm: f64 = match mm.trim().parse() {
+            Ok(v) if v >= 0.0 && f64::is_finite(v) => v,
+            _ => bail!("--floor: expected a size in millimetres ≥ 0, found `{mm}`"),
+        };
+        let slot = match sensor.trim() {
+            "lidar" => &mut floors.lidar_m,
+            "sonar" => &mut floors.sonar_m,
+            "odometer" => &mut floors.odometer_m,
+            "drive" => &mut floors.drive_m,
+            other => {
+                bail!("--floor: expected a sensor (lidar, sonar, odometer, drive), found `{other}`")
+            }
+        };
+        *slot = mm / 1000.0;
+    }
+    if let Some(x) = args.floor_noise_share {
+        if !(x.is_finite() && x >= 0.0) {
+            bail!("--floor-noise-share: expected a share ≥ 0, found {x}");
+        }
+        floors.noise_share = x;
+    }
+    Ok(Options {
+        floors,
+        ..Options::default()
+    })
 }
 
 pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
@@ -139,19 +183,18 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let (Some(sim), Some(real)) = (&args.sim, &args.real) else {
         bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
     };
+    let options = options(args)?;
     let scenario = super::load_scenario(Some(sim), None)?;
     let recording = Recording::read_dir(real)?;
     let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
     // The stages on a terminal only: stdout starts with the verdict and stderr holds one line
     // for an error, as scripts expect.
     let status = StageStatus::new();
-    let diagnosis = hilsim_diagnose::diagnose_with_progress(
-        &physics,
-        &recording,
-        &Options::default(),
-        &mut |stage| status.stage(stage),
-    )
-    .with_context(|| real.display().to_string())?;
+    let diagnosis =
+        hilsim_diagnose::diagnose_with_progress(&physics, &recording, &options, &mut |stage| {
+            status.stage(stage)
+        })
+        .with_context(|| real.display().to_string())?;
     drop(status);
     if let Some(dir) = &args.report {
         write_report(dir, &diagnosis, sim, real)?;

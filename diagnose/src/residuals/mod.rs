@@ -17,6 +17,6 @@ mod sensors;
 
 pub(crate) use self::clusters::shared_error_clusters;
 pub use self::data::Covariate;
-pub(crate) use self::data::{Context, SensorData};
+pub(crate) use self::data::{Context, Predictive, SensorData};
 pub(crate) use self::likelihood::{fits, log_likelihood, rmse, Fit};
 pub(crate) use self::sensors::{drive, lidar, odometer, sonar};

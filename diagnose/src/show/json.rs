@@ -2,6 +2,8 @@
 
 use serde_json::{json, Map, Value};
 
+use crate::explain::CandidateFit;
+use crate::locate::Evidence;
 use crate::outcome::Diagnosis;
 
 /// A finite number as JSON, anything else as `null`: no NaN ever reaches a user.
@@ -13,35 +15,54 @@ fn num(v: f64) -> Value {
     }
 }
 
-/// The diagnosis as the `hilsim diagnose --json` object of `interfaces.md` (plus `param_sd`,
-/// `fit.sensor`, `fit.noise_floor_m`, `fit.readings`, `located.score`, `alignment` and `notes`).
-#[must_use]
-pub fn to_json(d: &Diagnosis) -> Value {
-    let located = d.located.as_ref().map_or(Value::Null, |l| {
-        json!({
-            "sensor": l.sensor.name(),
-            "where": l.place,
-            "evidence": l.detail,
-            "score": num(l.score),
-        })
-    });
+/// A located departure: where, the numbers behind it, its score and its size.
+fn evidence(l: &Evidence) -> Value {
+    json!({
+        "sensor": l.sensor.name(),
+        "where": l.place,
+        "evidence": l.detail,
+        "score": num(l.score),
+        "size_m": num(l.size_m),
+    })
+}
+
+/// An effect's parameters and their standard errors, by name.
+fn params_of(f: &CandidateFit) -> (Map<String, Value>, Map<String, Value>) {
     let mut params = Map::new();
     let mut param_sd = Map::new();
-    if let Some(f) = &d.fitted {
-        for (i, spec) in f.effect.params().iter().enumerate() {
-            params.insert(spec.name.to_string(), num(f.params[i]));
-            param_sd.insert(spec.name.to_string(), num(f.param_sd[i]));
-        }
+    for (i, spec) in f.effect.params().iter().enumerate() {
+        params.insert(spec.name.to_string(), num(f.params[i]));
+        param_sd.insert(spec.name.to_string(), num(f.param_sd[i]));
     }
+    (params, param_sd)
+}
+
+/// An effect's held-out fit: its sensor's RMSE without it (the others named in the sensor in
+/// place) and with it.
+fn fit_of(f: &CandidateFit) -> Value {
+    json!({
+        "metric": "heldout_rmse_m",
+        "sensor": f.effect.sensor().name(),
+        "before": num(f.rmse_before),
+        "after": num(f.rmse_after),
+        "noise_floor_m": num(f.noise_floor),
+        "readings": f.heldout_n,
+    })
+}
+
+/// The diagnosis as the `hilsim diagnose --json` object of `interfaces.md` (plus `param_sd`,
+/// `fit.sensor`, `fit.noise_floor_m`, `fit.readings`, `located.score`, `located.size_m`,
+/// `effects[].heldout_gain`, `effects[].size_m`, `unexplained[].score`, `alignment` and
+/// `notes`).
+#[must_use]
+pub fn to_json(d: &Diagnosis) -> Value {
+    let located = d.located.as_ref().map_or(Value::Null, evidence);
+    let (params, param_sd) = d
+        .fitted
+        .as_ref()
+        .map_or_else(|| (Map::new(), Map::new()), params_of);
     let fit = match &d.fitted {
-        Some(f) => json!({
-            "metric": "heldout_rmse_m",
-            "sensor": f.effect.sensor().name(),
-            "before": num(f.rmse_before),
-            "after": num(f.rmse_after),
-            "noise_floor_m": num(f.noise_floor),
-            "readings": f.heldout_n,
-        }),
+        Some(f) => fit_of(f),
         None => {
             // No fix: the located sensor's (or the first sensor's) nominal fit, unchanged.
             let s = d
@@ -85,6 +106,35 @@ pub fn to_json(d: &Diagnosis) -> Value {
         .position(|c| c["score"].as_f64().is_some_and(|s| s < 0.0))
         .unwrap_or(candidates.len());
     candidates.insert(none_at, json!({"effect": "none", "score": 0.0}));
+    let effects: Vec<Value> = d
+        .effects
+        .iter()
+        .map(|e| {
+            let (params, param_sd) = params_of(&e.fit);
+            json!({
+                "effect": e.fit.effect.name(),
+                "params": params,
+                "param_sd": param_sd,
+                "located": e.located.as_ref().map_or(Value::Null, evidence),
+                "fit": fit_of(&e.fit),
+                "heldout_gain": num(e.fit.heldout_gain),
+                "size_m": num(e.fit.size_m),
+            })
+        })
+        .collect();
+    let unexplained: Vec<Value> = d
+        .unexplained
+        .iter()
+        .map(|u| {
+            json!({
+                "sensor": u.sensor.name(),
+                "where": u.place,
+                "size_m": num(u.size_m),
+                "evidence": u.detail,
+                "score": num(u.score),
+            })
+        })
+        .collect();
     json!({
         "mismatch": d.mismatch(),
         "located": located,
@@ -93,6 +143,8 @@ pub fn to_json(d: &Diagnosis) -> Value {
         "params": params,
         "param_sd": param_sd,
         "fit": fit,
+        "effects": effects,
+        "unexplained": unexplained,
         "candidates": candidates,
         "alignment": d.alignment.name(),
         "notes": d.notes,

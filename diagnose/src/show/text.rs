@@ -11,11 +11,8 @@ pub fn summary(d: &Diagnosis) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "verdict: {}", d.verdict.name());
     let _ = writeln!(s, "  {}", d.explanation);
-    if let Some(l) = &d.located {
-        let _ = writeln!(s, "located: {} — {}", l.sensor, l.place);
-        let _ = writeln!(s, "  {} ({:.1}σ)", l.detail, l.score);
-    }
-    if let Some(f) = &d.fitted {
+    for (k, e) in d.effects.iter().enumerate() {
+        let f = &e.fit;
         let params: Vec<String> = f
             .effect
             .params()
@@ -33,16 +30,35 @@ pub fn summary(d: &Diagnosis) -> String {
                     .to_string()
             })
             .collect();
-        let _ = writeln!(s, "fitted: {}", params.join(", "));
+        let role = if k == 0 { "effect" } else { "also" };
+        let _ = writeln!(s, "{role}: {} ({})", f.effect, params.join(", "));
+        if let Some(l) = &e.located {
+            let _ = writeln!(s, "  located: {} — {} ({:.1}σ)", l.sensor, l.place, l.score);
+            let _ = writeln!(s, "    {}", l.detail);
+        }
         let _ = writeln!(
             s,
-            "held-out {} RMSE: {} before, {} after (noise floor {}, {} readings)",
+            "  held-out {} RMSE: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
+             changes the readings by {})",
             f.effect.sensor(),
             mm(f.rmse_before),
             mm(f.rmse_after),
             mm(f.noise_floor),
-            f.heldout_n
+            f.heldout_n,
+            f.heldout_gain,
+            mm(f.size_m)
         );
+    }
+    for u in &d.unexplained {
+        let _ = writeln!(
+            s,
+            "unexplained: {} — {} ({}, {:.1}σ)",
+            u.sensor,
+            u.place,
+            mm(u.size_m),
+            u.score
+        );
+        let _ = writeln!(s, "  {}", u.detail);
     }
     if !d.candidates.is_empty() {
         let top: Vec<String> = d

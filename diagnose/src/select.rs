@@ -1,0 +1,145 @@
+//! Which effects to name: forward selection on held-out data. Every applicable effect is fitted
+//! on its own; in each sensor the best that earns its place is named, the others are fitted
+//! again on top of it, and so on while one earns its place; the effects named in one sensor
+//! are then refitted jointly and each must still earn its place against the others.
+//!
+//! An effect earns its place when it improves the held-out log-likelihood by more than
+//! [`Options::min_gain`], its BIC gain on the training half is positive, its fitted parameter
+//! departs from the effect's absence by more than the sensors resolve (`Effect::departs`),
+//! and it changes the predicted readings by more than the sensor's practical floor
+//! ([`crate::locate::Floors`]): a small difference between the recording and the simulation
+//! that some effect can mimic is not that effect.
+
+use rayon::prelude::*;
+
+use crate::catalogue::{Effect, Sensor};
+use crate::conclude::declared_cone;
+use crate::explain::{self, CandidateFit};
+use crate::outcome::Options;
+use crate::physics::Hypothesis;
+use crate::residuals::{Context, SensorData};
+
+/// Effects named in one sensor at most (the catalogue's lidar has five; more than three at
+/// once in one sensor is past what a recording of a minute separates).
+const MAX_PER_SENSOR: usize = 3;
+
+/// The outcome of the selection.
+pub(crate) struct Selection {
+    /// The effects named, strongest held-out gain first, each scored against the others of
+    /// its sensor.
+    pub named: Vec<CandidateFit>,
+    /// Every applicable effect fitted on its own against the nominal model, best held-out gain
+    /// first.
+    pub candidates: Vec<CandidateFit>,
+}
+
+/// Whether `c` earns its place (see the module's documentation).
+pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Options) -> bool {
+    c.heldout_gain > options.min_gain
+        && c.bic_gain > 0.0
+        && c.effect.departs(&c.params, declared_cone)
+        && c.size_m > options.floors.floor_m(c.effect.sensor(), c.size_noise_m)
+}
+
+/// The hypothesis of the effects `fits` with their parameters.
+pub(crate) fn hypothesis_of(fits: &[CandidateFit]) -> Hypothesis {
+    fits.iter().fold(Hypothesis::nominal(), |h, c| {
+        h.and(c.effect, c.params.clone())
+    })
+}
+
+/// Every applicable effect fitted on its own (in parallel: each is independent), best held-out
+/// gain first.
+fn first_round(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Vec<CandidateFit> {
+    let present: Vec<Sensor> = data.iter().map(|d| d.sensor).collect();
+    let tries: Vec<(Effect, &SensorData)> = options
+        .effects
+        .iter()
+        .filter(|e| explain::applicable(**e, ctx, &present))
+        .filter_map(|&e| data.iter().find(|d| d.sensor == e.sensor()).map(|d| (e, d)))
+        .collect();
+    let nominal = Hypothesis::nominal();
+    let mut candidates: Vec<CandidateFit> = tries
+        .par_iter()
+        .map(|(e, d)| explain::fit_candidate(ctx, d, &nominal, *e, options.max_fit_rows))
+        .collect();
+    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    candidates
+}
+
+/// Forward selection in one sensor's `data`, starting from `pool` (its effects fitted on
+/// their own), then the joint refit.
+fn select_in(
+    ctx: &Context<'_>,
+    data: &SensorData,
+    mut pool: Vec<CandidateFit>,
+    options: &Options,
+) -> Vec<CandidateFit> {
+    let cone = declared_cone(ctx);
+    let mut chosen: Vec<CandidateFit> = Vec::new();
+    while chosen.len() < MAX_PER_SENSOR {
+        let Some(k) = pool
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| earns_place(c, cone, options))
+            .max_by(|a, b| a.1.heldout_gain.total_cmp(&b.1.heldout_gain))
+            .map(|(k, _)| k)
+        else {
+            break;
+        };
+        chosen.push(pool.swap_remove(k));
+        if pool.is_empty() || chosen.len() == MAX_PER_SENSOR {
+            break;
+        }
+        let base = hypothesis_of(&chosen);
+        pool = pool
+            .par_iter()
+            .map(|c| explain::fit_candidate(ctx, data, &base, c.effect, options.max_fit_rows))
+            .collect();
+    }
+    // Jointly; an effect the others make redundant is dropped and the rest refitted.
+    while chosen.len() >= 2 {
+        let joint = explain::refit_jointly(ctx, data, &chosen, options.max_fit_rows);
+        let kept: Vec<CandidateFit> = joint
+            .iter()
+            .filter(|c| earns_place(c, cone, options))
+            .cloned()
+            .collect();
+        if kept.len() == joint.len() {
+            return joint;
+        }
+        if kept.len() == 1 {
+            // Alone again: scored against the nominal model, as in the first round.
+            let alone = explain::fit_candidate(
+                ctx,
+                data,
+                &Hypothesis::nominal(),
+                kept[0].effect,
+                options.max_fit_rows,
+            );
+            return if earns_place(&alone, cone, options) {
+                vec![alone]
+            } else {
+                Vec::new()
+            };
+        }
+        chosen = kept;
+    }
+    chosen
+}
+
+/// The effects to name in `data`, with every candidate fitted on its own.
+pub(crate) fn select(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Selection {
+    let candidates = first_round(ctx, data, options);
+    let mut named: Vec<CandidateFit> = Vec::new();
+    for d in data {
+        let pool: Vec<CandidateFit> = candidates
+            .iter()
+            .filter(|c| c.effect.sensor() == d.sensor)
+            .cloned()
+            .collect();
+        named.extend(select_in(ctx, d, pool, options));
+    }
+    named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    Selection { named, candidates }
+}

@@ -1,6 +1,8 @@
 //! The plot data of a diagnosis: one sensor's held-out residuals against the located variable
 //! and against time, before and after the fix. `show` draws them.
 
+use hilsim_recording::Pose;
+
 use crate::catalogue::Sensor;
 use crate::explain::CandidateFit;
 use crate::locate::Evidence;
@@ -25,8 +27,12 @@ pub struct PlotData {
     pub before: Vec<f64>,
     /// Residuals under the fitted effect, metres (when one is named).
     pub after: Option<Vec<f64>>,
-    /// The located range of the variable, when there is one.
+    /// The located range of the variable, when there is one (a category's value twice, for a
+    /// categorical variable).
     pub highlight: Option<(f64, f64)>,
+    /// Where in the world each reading was, metres (NaN when unknown): the lidar's or the
+    /// sonar's hit point, the robot's position for the odometer and the drive.
+    pub positions: Vec<[f64; 2]>,
     /// A title.
     pub title: String,
 }
@@ -62,6 +68,7 @@ pub(crate) fn plots(
             .map(|f| f.residual)
             .collect::<Vec<f64>>()
     });
+    let positions = world_positions(ctx, d, &rows);
     let mut variables = Vec::new();
     if let Some(c) = located.and_then(|l| l.covariate) {
         variables.push(c);
@@ -92,18 +99,62 @@ pub(crate) fn plots(
             } else {
                 Vec::new()
             };
+            let located_here = located.filter(|l| l.covariate == Some(c));
+            // A located category is named in the evidence's place ("board 1 (dark)").
+            let located_category = located_here.and_then(|l| {
+                categories
+                    .iter()
+                    .find(|(_, name)| l.place.contains(name.as_str()))
+                    .map(|(v, _)| (*v, *v))
+            });
             Some(PlotData {
                 sensor,
                 variable: c,
-                categories,
                 x: rows.iter().map(|&i| values[i]).collect(),
                 before: before.clone(),
                 after: after.clone(),
-                highlight: located
-                    .filter(|l| l.covariate == Some(c))
-                    .and_then(|l| l.range),
+                highlight: located_here
+                    .and_then(|l| l.range)
+                    .or(if categories.is_empty() {
+                        None
+                    } else {
+                        located_category
+                    }),
+                categories,
+                positions: positions.clone(),
                 title: format!("{sensor} residuals against {} (held-out half)", c.name()),
             })
+        })
+        .collect()
+}
+
+/// Where in the world each of `rows` was: a range sensor's hit point (its true range along its
+/// beam from the trajectory's pose at the reading's time), else the robot's position.
+fn world_positions(ctx: &Context<'_>, d: &SensorData, rows: &[usize]) -> Vec<[f64; 2]> {
+    let meta = &ctx.recording.meta;
+    let range = d.covariate(Covariate::Range);
+    let bearing = d.covariate(Covariate::Bearing);
+    rows.iter()
+        .map(|&i| {
+            let robot = ctx.trajectory.pose_at(d.t[i]);
+            let hit = |mount: Pose, beam_deg: f64| -> Option<[f64; 2]> {
+                let r = range?.get(i).copied().filter(|r| r.is_finite())?;
+                let sensor = robot.compose(mount.x, mount.y, mount.yaw);
+                let b = beam_deg.to_radians();
+                Some(sensor.transform([r * b.cos(), r * b.sin()]))
+            };
+            let point = match d.sensor {
+                Sensor::Lidar => meta.lidar.and_then(|m| {
+                    let beam = bearing?.get(i).copied()?;
+                    hit(Pose::new(m.x_m, m.y_m, m.yaw_rad()), beam)
+                }),
+                Sensor::Sonar => meta
+                    .sonar
+                    .as_ref()
+                    .and_then(|m| hit(Pose::new(m.x_m, m.y_m, m.yaw_deg.to_radians()), 0.0)),
+                Sensor::Odometer | Sensor::Drive => Some([robot.x, robot.y]),
+            };
+            point.unwrap_or([f64::NAN; 2])
         })
         .collect()
 }

@@ -18,5 +18,5 @@ mod timelines;
 pub mod view;
 
 pub use map::Overlay;
-pub use page::{is_report, render, render_with, GENERATOR};
+pub use page::{is_report, map_svg, render, render_with, GENERATOR};
 pub use view::Inputs;

@@ -25,6 +25,12 @@ table{border-collapse:collapse;margin:8px 0 12px;font-size:.93em}td,th{border:1p
 .pass{color:#237a3b}.fail{color:#b3261e;font-weight:600}.missing{background:#fff8e1;border:1px solid #f0d98c;padding:8px 12px}
 svg{max-width:100%;height:auto}";
 
+/// The map alone (the world, the paths, a few scans, `overlay`) as an SVG document.
+#[must_use]
+pub fn map_svg(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
+    map(&View::new(inputs), overlay).0
+}
+
 /// The report's HTML page.
 #[must_use]
 pub fn render(inputs: Inputs<'_>) -> String {

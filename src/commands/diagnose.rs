@@ -15,6 +15,7 @@ use anyhow::{bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan};
 use hilsim_diagnose::{show, Effect, Floors, Options, SimPhysics, Stage};
 use hilsim_recording::{write_file_atomically, Recording};
+use hilsim_sim::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// Compare a simulation with a real recording: locate the mismatch, name the physics left out,
@@ -144,7 +145,12 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
                 let rec_dir = dir.join("recording");
                 run.recording.write_dir(&rec_dir)?;
                 let origin = format!("<built-in {}>", scenario.name);
-                write_report(dir, &run.diagnosis, Path::new(&origin), &rec_dir)?;
+                write_report(
+                    dir,
+                    &run.diagnosis,
+                    (Path::new(&origin), &scenario),
+                    (&rec_dir, &run.recording),
+                )?;
             }
             if args.json {
                 writeln!(out, "{}", run.to_json())?;
@@ -197,7 +203,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .with_context(|| real.display().to_string())?;
     drop(status);
     if let Some(dir) = &args.report {
-        write_report(dir, &diagnosis, sim, real)?;
+        write_report(dir, &diagnosis, (sim, &scenario), (real, &recording))?;
     }
     if args.json {
         writeln!(out, "{}", show::to_json(&diagnosis))?;
@@ -213,8 +219,14 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Writes `index.html` and its plots into `dir` (created if needed), each file atomically.
-fn write_report(dir: &Path, d: &hilsim_diagnose::Diagnosis, sim: &Path, real: &Path) -> Result<()> {
+/// Writes `index.html`, its plots and the map into `dir` (created if needed), each file
+/// atomically.
+fn write_report(
+    dir: &Path,
+    d: &hilsim_diagnose::Diagnosis,
+    (sim, scenario): (&Path, &Scenario),
+    (real, recording): (&Path, &Recording),
+) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     let mut files = Vec::new();
     for (i, p) in d.plots.iter().enumerate() {
@@ -231,11 +243,45 @@ fn write_report(dir: &Path, d: &hilsim_diagnose::Diagnosis, sim: &Path, real: &P
         real.display(),
         sim.display()
     );
+    let name = real.display().to_string();
+    let map = hilsim_report::map_svg(
+        hilsim_report::Inputs {
+            title: &title,
+            recording,
+            recording_name: &name,
+            scenario: Some(scenario),
+            calibrations: &[],
+        },
+        located_overlay(d).as_ref(),
+    );
+    write_file_atomically(&dir.join("map.svg"), map.as_bytes())?;
     write_file_atomically(
         &dir.join("index.html"),
-        show::html(d, &title, &files).as_bytes(),
+        show::html(d, &title, &files, Some("map.svg")).as_bytes(),
     )?;
     Ok(())
+}
+
+/// The held-out readings where the mismatch was located, in the world, for the map: those of
+/// the first plot (the located variable's) inside its highlighted range.
+fn located_overlay(d: &hilsim_diagnose::Diagnosis) -> Option<hilsim_report::Overlay> {
+    let located = d.located.as_ref()?;
+    let plot = d.plots.first()?;
+    let (lo, hi) = plot.highlight?;
+    let points: Vec<(f64, f64)> = plot
+        .x
+        .iter()
+        .zip(&plot.positions)
+        .filter(|(x, p)| (lo..=hi).contains(*x) && p[0].is_finite() && p[1].is_finite())
+        .map(|(_, p)| (p[0], p[1]))
+        .collect();
+    (!points.is_empty()).then(|| hilsim_report::Overlay {
+        points,
+        label: format!(
+            "{} readings where the mismatch was located ({})",
+            located.sensor, located.place
+        ),
+    })
 }
 
 /// The diagnosis's stages: a spinner on stderr when it is a terminal (cleared when done, or on

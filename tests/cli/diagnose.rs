@@ -259,12 +259,18 @@ fn the_report_holds_plots_of_the_fix() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| n.ends_with(".svg"))
         .collect();
-    assert!(!svgs.is_empty());
+    assert!(svgs.len() >= 2, "the map and the residual plots: {svgs:?}");
     for svg in &svgs {
         assert!(page.contains(svg.as_str()), "{svg} not on the page");
         let body = std::fs::read_to_string(tmp.path().join("rep").join(svg)).unwrap();
         assert!(body.starts_with("<svg") && body.trim_end().ends_with("</svg>"));
-        assert!(body.contains("after (effect fitted)"));
+        if svg == "map.svg" {
+            // The world with the real path, and the readings where the mismatch was located.
+            assert!(body.contains("true path"), "{body}");
+            assert!(body.contains("where the mismatch was located"), "{body}");
+        } else {
+            assert!(body.contains("after (effect fitted)"));
+        }
         assert!(!body.contains("NaN"));
     }
 }

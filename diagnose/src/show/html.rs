@@ -5,10 +5,11 @@ use std::fmt::Write as _;
 use super::format::{escape, fmt_sig, mm};
 use crate::outcome::{Diagnosis, Verdict};
 
-/// The report page: the verdict, the evidence, the fit and the plots (`plot_files[i]` is where
-/// the caller wrote `svg(&d.plots[i])`, relative to the page).
+/// The report page: the verdict, the evidence, the map, the fit and the plots (`plot_files[i]`
+/// is where the caller wrote `svg(&d.plots[i])`, `map_file` where it wrote the world's map with
+/// the located readings marked, relative to the page).
 #[must_use]
-pub fn html(d: &Diagnosis, title: &str, plot_files: &[String]) -> String {
+pub fn html(d: &Diagnosis, title: &str, plot_files: &[String], map_file: Option<&str>) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
@@ -45,6 +46,13 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
             l.score,
             d.threshold,
             escape(&l.detail)
+        );
+    }
+    if let Some(file) = map_file {
+        let _ = writeln!(
+            s,
+            r##"<img src="{}" alt="the world, the real path and where the mismatch was located">"##,
+            escape(file)
         );
     }
     fix(&mut s, d);

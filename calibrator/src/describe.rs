@@ -227,7 +227,11 @@ impl Calibration {
             order: value["order"]
                 .as_u64()
                 .and_then(|n| usize::try_from(n).ok()),
-            landmarks: None,
+            landmarks: value["landmarks"].as_array().and_then(|list| {
+                list.iter()
+                    .map(|p| Some([p.get(0)?.as_f64()?, p.get(1)?.as_f64()?]))
+                    .collect()
+            }),
             notes,
         })
     }

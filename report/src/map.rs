@@ -90,8 +90,31 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
         chart.line(&line(&view.truth), stroke);
         keys.push(Key::Line(stroke, "true path".into()));
     }
-    if let Some(start) = view.truth.first().or(view.odometry.first()) {
-        chart.marker((start.1.x, start.1.y), "#2a9d4b", "start");
+    // Landmarks a calibration found, given in the frame of the robot's start pose.
+    let start = view.truth.first().or(view.odometry.first()).map(|p| p.1);
+    if let Some(origin) = start {
+        let found: Vec<(f64, f64)> = view
+            .inputs
+            .calibrations
+            .iter()
+            .filter_map(|c| c.landmarks.as_ref())
+            .flatten()
+            .map(|p| {
+                let w = origin.transform(*p);
+                (w[0], w[1])
+            })
+            .collect();
+        if !found.is_empty() {
+            chart.crosses(
+                &found,
+                colours::method(hilsim_calibrator::Method::Landmarks),
+            );
+            keys.push(Key::Dots(
+                colours::method(hilsim_calibrator::Method::Landmarks),
+                "landmarks the calibration found (×)".into(),
+            ));
+        }
+        chart.marker((origin.x, origin.y), "#2a9d4b", "start");
     }
     for s in &scans {
         if let Some(p) = s.pose {

@@ -131,8 +131,7 @@ pub fn render_with(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
     if charts.is_empty() {
         let _ = writeln!(
             s,
-            "<p>No reading has a known true distance (true distances come from {}).</p>",
-            view.true_distance_source
+            "<p>No reading has a known true distance: they come from a recording's <code>true_range_m</code> columns, or from rays cast in the scenario's world along <code>truth.csv</code>'s path.</p>"
         );
     } else {
         for c in charts {

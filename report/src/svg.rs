@@ -393,6 +393,27 @@ impl Chart {
         let _ = writeln!(self.body, "</g>");
     }
 
+    /// A cross (×) of 6 pixels at each of `points`, drawn above the data.
+    pub fn crosses(&mut self, points: &[(f64, f64)], colour: &str) {
+        for &(x, y) in points {
+            if x.is_finite() && y.is_finite() {
+                let (px, py) = (self.sx(x), self.sy(y));
+                let _ = writeln!(
+                    self.front,
+                    r#"<path d="M{:.1},{:.1}L{:.1},{:.1}M{:.1},{:.1}L{:.1},{:.1}" stroke="{colour}" stroke-width="2.5"/>"#,
+                    px - 6.0,
+                    py - 6.0,
+                    px + 6.0,
+                    py + 6.0,
+                    px - 6.0,
+                    py + 6.0,
+                    px + 6.0,
+                    py - 6.0
+                );
+            }
+        }
+    }
+
     /// A shaded band between `lower` and `upper` over the same x values (`(x, lower, upper)`).
     pub fn band(&mut self, rows: &[(f64, f64, f64)], colour: &str, opacity: f64) {
         let rows: Vec<&(f64, f64, f64)> = rows

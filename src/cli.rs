@@ -42,6 +42,10 @@ pub enum Command {
     /// simulation left out, fit it and show the held-out improvement (or prove it blind with
     /// `--self-test N`).
     Diagnose(crate::commands::diagnose::DiagnoseArgs),
+    /// Turn a ROS 2 bag (MCAP, CDR) into a recording.
+    Import(crate::commands::import::ImportArgs),
+    /// Write a recording as ROS 2 messages in an MCAP file (Foxglove, RViz, `ros2 bag play`).
+    Export(crate::commands::export::ExportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -60,6 +64,9 @@ pub struct RunArgs {
     /// Print the results as one JSON object (`results.json`'s) instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Also write the run as ROS 2 messages in this MCAP file (as `hilsim export`).
+    #[arg(long, value_name = "OUT")]
+    pub mcap: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -80,6 +87,9 @@ pub struct RecordArgs {
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Also write the recording as ROS 2 messages in this MCAP file (as `hilsim export`).
+    #[arg(long, value_name = "OUT")]
+    pub mcap: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]

@@ -33,6 +33,12 @@ fn main() -> ExitCode {
         Command::Dataset(args) => commands::dataset::dataset(args, &mut out),
         Command::Hil(args) => commands::hil::hil(args, &mut out),
         Command::Diagnose(args) => commands::diagnose::diagnose(args, &mut out),
+        Command::Import(args) => {
+            commands::import::import(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
+        Command::Export(args) => {
+            commands::export::export(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
     };
     let _ = out.flush();
     match result {

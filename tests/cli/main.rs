@@ -11,6 +11,7 @@ mod hil;
 mod limits;
 mod outputs;
 mod record;
+mod ros2;
 mod run;
 mod scenario_test;
 mod serve;

@@ -250,6 +250,47 @@ fn average(
 mod tests {
     use super::*;
 
+    fn revolution(angles: impl Iterator<Item = f64>) -> Vec<LidarSample> {
+        angles
+            .map(|angle_deg| LidarSample {
+                t_s: 0.0,
+                rev: 0,
+                angle_deg,
+                range_m: 1.0,
+                strength: 1,
+                invalid: false,
+                warning: false,
+                true_range_m: None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_beam_grid_is_the_lidars_own() {
+        assert_eq!(
+            BeamGrid::of(&revolution((0..360).map(f64::from))),
+            BeamGrid::XV11
+        );
+        let half = BeamGrid::of(&revolution((0..720).map(|i| f64::from(i) * 0.5)));
+        assert_eq!(
+            (half.count, half.step_deg, half.offset_deg),
+            (720, 0.5, 0.0)
+        );
+        assert_eq!(half.index(359.5), 719);
+        assert_eq!(half.index(359.9), 0);
+        // 1,080 readings a third of a degree apart, starting a sixth of a degree off 0; a lost
+        // reading (a step of two) does not change the grid.
+        let third = 360.0 / 1080.0;
+        let angles = (0..1080)
+            .filter(|i| *i != 7)
+            .map(|i| (f64::from(i) + 0.5) * third);
+        let grid = BeamGrid::of(&revolution(angles));
+        assert_eq!(grid.count, 1080);
+        assert!((grid.offset_deg - third / 2.0).abs() < 1e-9);
+        assert_eq!(grid.index((8.5) * third), 8);
+        assert!((grid.angle_rad(8) - (8.5 * third).to_radians()).abs() < 1e-12);
+    }
+
     #[test]
     fn an_edge_beam_keeps_its_majority_surface() {
         let mk = |r: f64| Reading {

@@ -225,6 +225,22 @@ fn summary_channels(path: &Path) -> Result<Option<Vec<Channel>>, Error> {
     Ok(Some(found))
 }
 
+/// The number of messages in an MCAP file, by reading it whole (every chunk decompressed and
+/// its CRC checked, no message decoded).
+///
+/// # Errors
+/// As [`channels`], and a truncated or corrupt file.
+pub fn count_messages(path: &Path) -> Result<u64, Error> {
+    let mut count = 0;
+    stream(path, |item| {
+        if let Item::Message { .. } = item {
+            count += 1;
+        }
+        Ok(())
+    })?;
+    Ok(count)
+}
+
 /// Reads an MCAP file from start to end, handing each channel, message and metadata record to
 /// `visit` in file order; `visit`'s error ends the read.
 ///

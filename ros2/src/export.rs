@@ -140,7 +140,8 @@ enum Event {
 }
 
 /// Writes `recording` as an MCAP file at `out` (atomically: a temporary sibling renamed into
-/// place when complete), with `world` drawn as markers when given.
+/// place when complete), with `world` drawn as markers when given; chunks zstd-compressed (as
+/// `ros2 bag record --storage-preset-profile zstd_fast` writes them).
 ///
 /// # Errors
 /// The file cannot be written.
@@ -149,12 +150,25 @@ pub fn export(
     world: Option<&World>,
     out: &Path,
 ) -> Result<ExportReport, Error> {
+    export_with(recording, world, out, true)
+}
+
+/// As [`export`], chunks compressed or not (rosbag2's default preset writes them plain).
+///
+/// # Errors
+/// The file cannot be written.
+pub fn export_with(
+    recording: &Recording,
+    world: Option<&World>,
+    out: &Path,
+    compress: bool,
+) -> Result<ExportReport, Error> {
     let file = AtomicFile::create(out)?;
     let fail = |err: mcap::McapError| Error::bag(out, err.to_string());
     let writer = WriteOptions::new()
         .profile("ros2")
         .library(concat!("hilsim ", env!("CARGO_PKG_VERSION")))
-        .compression(Some(Compression::Zstd))
+        .compression(compress.then_some(Compression::Zstd))
         .disable_seeking(true)
         .create(NoSeek::new(file))
         .map_err(fail)?;

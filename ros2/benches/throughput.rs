@@ -15,7 +15,7 @@ use hilsim_recording::{
     CommandSample, LidarSample, Meta, Mount, OdometrySample, Recording, SonarMount, SonarSample,
     TruthSample,
 };
-use hilsim_ros2::{bag, export_with, import, ImportOptions};
+use hilsim_ros2::{bag, export_with, import, ExportOptions, ImportOptions};
 
 /// A run of `seconds`: the robot reversing at 0.06 m/s from 0.5 m before a board.
 fn run(seconds: usize) -> Recording {
@@ -105,7 +105,11 @@ fn measure(seconds: usize, dir: &Path) {
         let what = if compress { "zstd" } else { "plain" };
         let mcap = dir.join(format!("run-{seconds}-{what}.mcap"));
         let export_time = best_of(5, || {
-            export_with(&rec, None, &mcap, compress).expect("writes");
+            let options = ExportOptions {
+                compress,
+                ..ExportOptions::default()
+            };
+            export_with(&rec, &options, &mcap).expect("writes");
         });
         let csv_time = best_of(5, || rec.write_dir(&dir.join("csv")).expect("writes"));
         let bytes = std::fs::metadata(&mcap).expect("written").len() as f64;

@@ -11,6 +11,7 @@
 //! | `/tf` | `tf2_msgs/msg/TFMessage`: `map` → `base_link` (truth; else `odom` → `base_link`) | |
 //! | `/tf_static` | `tf2_msgs/msg/TFMessage`: `base_link` → `laser`, `base_link` → `sonar` | |
 //! | `/world` | `visualization_msgs/msg/MarkerArray` (with a world) | `map` |
+//! | `/scan_calibrated` | `sensor_msgs/msg/LaserScan` (with calibrated ranges) | `laser` |
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -150,19 +151,48 @@ pub fn export(
     world: Option<&World>,
     out: &Path,
 ) -> Result<ExportReport, Error> {
-    export_with(recording, world, out, true)
+    let options = ExportOptions {
+        world,
+        ..ExportOptions::default()
+    };
+    export_with(recording, &options, out)
 }
 
-/// As [`export`], chunks compressed or not (rosbag2's default preset writes them plain).
+/// What an export writes besides the recording.
+#[derive(Debug, Clone, Copy)]
+pub struct ExportOptions<'a> {
+    /// The world, drawn as markers (`/world`).
+    pub world: Option<&'a World>,
+    /// zstd chunks (else plain, as rosbag2's default preset writes them).
+    pub compress: bool,
+    /// A calibrated range for each lidar row (NaN for none), sent as `/scan_calibrated`.
+    pub calibrated_m: Option<&'a [f64]>,
+}
+
+impl Default for ExportOptions<'_> {
+    fn default() -> Self {
+        Self {
+            world: None,
+            compress: true,
+            calibrated_m: None,
+        }
+    }
+}
+
+/// As [`export`], with the options given.
 ///
 /// # Errors
-/// The file cannot be written.
+/// The file cannot be written, or `calibrated_m` is not one range per lidar row.
 pub fn export_with(
     recording: &Recording,
-    world: Option<&World>,
+    options: &ExportOptions<'_>,
     out: &Path,
-    compress: bool,
 ) -> Result<ExportReport, Error> {
+    let rows = recording.lidar.as_ref().map_or(0, Vec::len);
+    if options.calibrated_m.is_some_and(|c| c.len() != rows) {
+        return Err(Error::bag(out, "calibrated ranges: not one per lidar row"));
+    }
+    let (world, compress) = (options.world, options.compress);
     let file = AtomicFile::create(out)?;
     let fail = |err: mcap::McapError| Error::bag(out, err.to_string());
     let writer = WriteOptions::new()
@@ -179,7 +209,7 @@ pub fn export_with(
         buffer: Vec::with_capacity(1 << 14),
         report: ExportReport::default(),
     };
-    write_all(&mut bag, recording, world).map_err(fail)?;
+    write_all(&mut bag, recording, world, options.calibrated_m).map_err(fail)?;
     bag.writer.finish().map_err(fail)?;
     let report = std::mem::take(&mut bag.report);
     let file = bag.writer.into_inner().into_inner();
@@ -191,6 +221,7 @@ fn write_all<W: Write>(
     bag: &mut Bag<W>,
     rec: &Recording,
     world: Option<&World>,
+    calibrated_m: Option<&[f64]>,
 ) -> Result<(), mcap::McapError> {
     let mut metadata = BTreeMap::from([(START_KEY.to_string(), START_NS.to_string())]);
     if let Some(first) = rec.odometry.as_ref().and_then(|o| o.first()) {
@@ -269,8 +300,22 @@ fn write_all<W: Write>(
         let t_ns = stamp_ns(t_s);
         match event {
             Event::Scan(from, to) => {
-                let scan = laser_scan(&lidar[from..to], range_max);
+                let mut scan = laser_scan(&lidar[from..to], range_max);
                 bag.write("/scan", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
+                if let Some(calibrated) = calibrated_m {
+                    // The same revolution, each reading replaced by its calibrated range.
+                    let reported = laser_scan_ranges(&lidar[from..to], |i| {
+                        let d = calibrated[from + i];
+                        if d.is_finite() {
+                            d as f32
+                        } else {
+                            f32::NAN
+                        }
+                    });
+                    scan.ranges = reported;
+                    scan.range_max = f32::MAX;
+                    bag.write("/scan_calibrated", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
+                }
             }
             Event::Sonar(i) => {
                 let range = Range {
@@ -378,11 +423,9 @@ fn events(rec: &Recording) -> Vec<(f64, Event)> {
     events
 }
 
-/// One revolution as a LaserScan: readings placed at `angle_min + i·angle_increment`, the
-/// increment the smallest step between the revolution's angles (a reading lost leaves a NaN);
-/// invalid readings are NaN, strengths the intensities.
-fn laser_scan(rev: &[LidarSample], range_max: f32) -> LaserScan {
-    // Angles unwrapped into one increasing turn from the first.
+/// A revolution's angles unwrapped into one increasing turn from the first, degrees from it,
+/// and the step between neighbouring slots (the smallest between the angles).
+fn slots(rev: &[LidarSample]) -> (Vec<f64>, f64) {
     let first = rev[0].angle_deg;
     let mut turns = 0.0;
     let mut previous = first;
@@ -401,9 +444,32 @@ fn laser_scan(rev: &[LidarSample], range_max: f32) -> LaserScan {
         .map(|w| w[1] - w[0])
         .filter(|d| *d > 1e-9)
         .fold(f64::INFINITY, f64::min);
-    let step = if step.is_finite() { step } else { 1.0 };
-    // A slot per step; a revolution of wildly uneven angles is capped at 100,000 slots.
-    let slot = |a: f64| ((a / step).round() as usize).min(99_999);
+    (unwrapped, if step.is_finite() { step } else { 1.0 })
+}
+
+/// A reading's slot: a revolution of wildly uneven angles is capped at 100,000 slots.
+fn slot(a: f64, step: f64) -> usize {
+    ((a / step).round() as usize).min(99_999)
+}
+
+/// A LaserScan's ranges for a revolution, `range(i)` for its row i, NaN where none.
+fn laser_scan_ranges(rev: &[LidarSample], range: impl Fn(usize) -> f32) -> Vec<f32> {
+    let (unwrapped, step) = slots(rev);
+    let slots = unwrapped.last().map_or(1, |&a| slot(a, step) + 1);
+    let mut ranges = vec![f32::NAN; slots];
+    for (i, &a) in unwrapped.iter().enumerate() {
+        ranges[slot(a, step)] = range(i);
+    }
+    ranges
+}
+
+/// One revolution as a LaserScan: readings placed at `angle_min + i·angle_increment`, the
+/// increment the smallest step between the revolution's angles (a reading lost leaves a NaN);
+/// invalid readings are NaN, strengths the intensities.
+fn laser_scan(rev: &[LidarSample], range_max: f32) -> LaserScan {
+    let first = rev[0].angle_deg;
+    let (unwrapped, step) = slots(rev);
+    let slot = |a: f64| slot(a, step);
     let slots = unwrapped.last().map_or(1, |&a| slot(a) + 1);
     let mut ranges = vec![f32::NAN; slots];
     let mut intensities = vec![0.0f32; slots];

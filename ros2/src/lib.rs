@@ -31,7 +31,7 @@ pub mod msgs;
 pub mod topics;
 
 pub use error::Error;
-pub use export::{export, export_with, ExportReport, World, START_NS};
+pub use export::{export, export_with, ExportOptions, ExportReport, World, START_NS};
 pub use import::{
     angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,
 };

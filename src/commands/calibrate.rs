@@ -160,7 +160,7 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
 }
 
 /// Reads the JSON that `hilsim calibrate --json` printed.
-fn read_calibration(path: &Path) -> Result<Calibration> {
+pub(crate) fn read_calibration(path: &Path) -> Result<Calibration> {
     // A calibration is a few hundred bytes; read at most this much of whatever the path is.
     const MAX_CALIBRATION_BYTES: u64 = 1 << 20;
     let file =

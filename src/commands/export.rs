@@ -1,10 +1,12 @@
-//! `hilsim export RECORDING --mcap OUT [--scenario FILE]`: a recording as ROS 2 messages in an
-//! MCAP file (and the `--mcap OUT` of `record` and `run`).
+//! `hilsim export RECORDING --mcap OUT [--scenario FILE] [--calibration FILE]`: a recording as
+//! ROS 2 messages in an MCAP file (and the `--mcap OUT` of `record` and `run`).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
+use hilsim_calibrator::landmarks::Inverse;
+use hilsim_calibrator::Sensor;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
@@ -18,6 +20,10 @@ pub struct ExportArgs {
     /// The scenario the recording ran: its world is drawn as markers (`/world`).
     #[arg(long, value_name = "FILE")]
     pub scenario: Option<PathBuf>,
+    /// A calibration (`hilsim calibrate --json`): the scans with each reading inverted through
+    /// its lidar model are sent too, as `/scan_calibrated`.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
 }
 
 pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
@@ -26,10 +32,52 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
         Some(path) => Some(world(&super::load_scenario(Some(path), None)?)),
         None => None,
     };
+    let calibration = args
+        .calibration
+        .as_deref()
+        .map(super::calibrate::read_calibration)
+        .transpose()?;
     let recording = Recording::read_dir(&args.recording)?;
-    write_mcap(&recording, world.as_ref(), &args.mcap)?;
+    let calibrated = match (&calibration, args.calibration.as_deref()) {
+        (Some(calibration), Some(path)) => Some(calibrated_ranges(&recording, calibration, path)?),
+        _ => None,
+    };
+    let options = hilsim_ros2::ExportOptions {
+        world: world.as_ref(),
+        calibrated_m: calibrated.as_deref(),
+        ..hilsim_ros2::ExportOptions::default()
+    };
+    hilsim_ros2::export_with(&recording, &options, &args.mcap)?;
     writeln!(out, "wrote {}", args.mcap.display())?;
     Ok(())
+}
+
+/// Each lidar reading's distance by the calibration's lidar model (the distance whose mean
+/// reading it is); NaN for an invalid reading.
+fn calibrated_ranges(
+    recording: &Recording,
+    calibration: &hilsim_calibrator::Calibration,
+    path: &Path,
+) -> Result<Vec<f64>> {
+    let model = calibration
+        .sensors
+        .get(&Sensor::Lidar)
+        .with_context(|| format!("{}: no lidar model", path.display()))?;
+    let lidar = recording.lidar.as_deref().unwrap_or_default();
+    // Search up to past the farthest reading: a lidar model is fitted below 100 m.
+    let farthest = lidar.iter().map(|s| s.range_m).fold(1.0, f64::max);
+    let inverse = Inverse::new(&model.alpha, [0.0, 2.0 * farthest + 100.0])
+        .with_context(|| format!("{}: the lidar model", path.display()))?;
+    Ok(lidar
+        .iter()
+        .map(|s| {
+            if s.invalid {
+                f64::NAN
+            } else {
+                inverse.distance(s.range_m)
+            }
+        })
+        .collect())
 }
 
 /// Writes `recording` as MCAP at `path`.

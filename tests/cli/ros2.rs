@@ -130,6 +130,68 @@ fn a_recording_exported_and_imported_is_the_recording() {
     assert_eq!(back2.meta.sonar.unwrap().half_angle_deg, 15.0);
 }
 
+/// With a calibration, the export carries the calibrated scans as a second LaserScan topic:
+/// the import then asks which lidar topic is meant, and the calibrated one is nearer the truth.
+#[test]
+fn a_calibrated_export_carries_the_calibrated_scans() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let out = hilsim(
+        tmp.path(),
+        &["record", scenario.to_str().unwrap(), "--out", "rec"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "em", "--json"],
+    );
+    fs::write(tmp.path().join("em.json"), &out.stdout).unwrap();
+    let args = [
+        "export",
+        "rec",
+        "--mcap",
+        "c.mcap",
+        "--calibration",
+        "em.json",
+    ];
+    let out = hilsim(tmp.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = hilsim(tmp.path(), &["import", "c.mcap", "--out", "r"]);
+    let err = assert_bad_input(&out);
+    assert!(err.ends_with("2 topics of type sensor_msgs/msg/LaserScan: /scan, /scan_calibrated; choose the lidar's with --lidar TOPIC\n"), "{err}");
+    let args = [
+        "import",
+        "c.mcap",
+        "--out",
+        "r",
+        "--lidar",
+        "/scan_calibrated",
+    ];
+    let out = hilsim(tmp.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let raw = Recording::read_dir(&tmp.path().join("rec")).unwrap();
+    let calibrated = Recording::read_dir(&tmp.path().join("r")).unwrap();
+    let mse = |rec: &Recording| {
+        let pairs: Vec<(f64, f64)> = rec
+            .lidar
+            .as_ref()
+            .unwrap()
+            .iter()
+            .zip(raw.lidar.as_ref().unwrap())
+            .filter(|(s, _)| !s.invalid && s.angle_deg == 0.0)
+            .map(|(s, truth)| (s.range_m, truth.true_range_m.unwrap()))
+            .collect();
+        pairs.iter().map(|(r, d)| (r - d).powi(2)).sum::<f64>() / pairs.len() as f64
+    };
+    // EM's own figure for this run is an MSE ratio above 3 (scenarios/straight-board.toml).
+    assert!(
+        mse(&raw) > 3.0 * mse(&calibrated),
+        "{} {}",
+        mse(&raw),
+        mse(&calibrated)
+    );
+}
+
 #[test]
 fn bad_bags_are_one_line_errors_naming_the_file() {
     let tmp = tempfile::tempdir().unwrap();

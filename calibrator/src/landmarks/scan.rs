@@ -46,7 +46,11 @@ impl BeamGrid {
         let mut steps: Vec<f64> = lidar
             .windows(2)
             .filter(|w| w[0].rev == w[1].rev)
-            .map(|w| w[1].angle_deg - w[0].angle_deg)
+            // The angle between neighbours, whichever way the lidar turns and across 0°.
+            .map(|w| {
+                let d = (w[1].angle_deg - w[0].angle_deg).rem_euclid(360.0);
+                d.min(360.0 - d)
+            })
             .filter(|d| *d > 1e-6)
             .collect();
         if steps.is_empty() {
@@ -288,6 +292,9 @@ mod tests {
         assert_eq!(grid.count, 1080);
         assert!((grid.offset_deg - third / 2.0).abs() < 1e-9);
         assert_eq!(grid.index((8.5) * third), 8);
+        // A lidar turning clockwise from 180° (a LaserScan from +π with a negative increment).
+        let clockwise = (0..720).map(|i| (180.0 - f64::from(i) * 0.5).rem_euclid(360.0));
+        assert_eq!(BeamGrid::of(&revolution(clockwise)).count, 720);
         assert!((grid.angle_rad(8) - (8.5 * third).to_radians()).abs() < 1e-12);
     }
 

@@ -251,6 +251,17 @@ pub(crate) fn stream(
     path: &Path,
     mut visit: impl FnMut(Item<'_>) -> Result<(), Error>,
 ) -> Result<(), Error> {
+    stream_while(path, |item| visit(item).map(|()| true))
+}
+
+/// As [`stream`], until `visit` returns `false`.
+///
+/// # Errors
+/// As [`stream`].
+pub(crate) fn stream_while(
+    path: &Path,
+    mut visit: impl FnMut(Item<'_>) -> Result<bool, Error>,
+) -> Result<(), Error> {
     let mut file = File::open(path).map_err(|err| Error::bag(path, err.to_string()))?;
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
@@ -269,23 +280,28 @@ pub(crate) fn stream(
                 reader.notify_read(read);
             }
             LinearReadEvent::Record { opcode, data } => {
-                match mcap::parse_record(opcode, data).map_err(|err| mcap_error(path, err))? {
-                    Record::Schema { header, .. } => {
-                        schemas.insert(header.id, header.name);
-                    }
-                    Record::Channel(c) => visit(Item::Channel(Channel {
-                        id: c.id,
-                        topic: c.topic,
-                        type_name: schemas.get(&c.schema_id).cloned().unwrap_or_default(),
-                        message_encoding: c.message_encoding,
-                    }))?,
-                    Record::Message { header, data } => visit(Item::Message {
-                        channel_id: header.channel_id,
-                        log_time: header.log_time,
-                        data: &data,
-                    })?,
-                    Record::Metadata(m) => visit(Item::Metadata(m))?,
-                    _ => {}
+                let go_on =
+                    match mcap::parse_record(opcode, data).map_err(|err| mcap_error(path, err))? {
+                        Record::Schema { header, .. } => {
+                            schemas.insert(header.id, header.name);
+                            true
+                        }
+                        Record::Channel(c) => visit(Item::Channel(Channel {
+                            id: c.id,
+                            topic: c.topic,
+                            type_name: schemas.get(&c.schema_id).cloned().unwrap_or_default(),
+                            message_encoding: c.message_encoding,
+                        }))?,
+                        Record::Message { header, data } => visit(Item::Message {
+                            channel_id: header.channel_id,
+                            log_time: header.log_time,
+                            data: &data,
+                        })?,
+                        Record::Metadata(m) => visit(Item::Metadata(m))?,
+                        _ => true,
+                    };
+                if !go_on {
+                    return Ok(());
                 }
             }
         }

@@ -129,6 +129,7 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     };
     let mut stream = RecordingStream::create(out, meta.clone(), tables)?;
     let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m);
+    converter.t0_ns = earliest_time(&files[0], &chosen)?;
     let mut bytes = 0;
     for file in &files {
         bytes += std::fs::metadata(file).map_or(0, |m| m.len());
@@ -182,9 +183,11 @@ where
             Ok(())
         }
         Item::Metadata(m) => {
-            if m.name == START_METADATA && converter.t0_ns.is_none() {
+            if m.name == START_METADATA {
                 let number = |key: &str| m.metadata.get(key).and_then(|v| v.parse::<f64>().ok());
-                converter.t0_ns = m.metadata.get(START_KEY).and_then(|v| v.parse().ok());
+                if converter.t0_ns.is_none() {
+                    converter.t0_ns = m.metadata.get(START_KEY).and_then(|v| v.parse().ok());
+                }
                 if let [Some(l), Some(r)] = ODOMETRY_START_KEYS.map(number) {
                     converter.odometry_start_m = (l, r);
                 }
@@ -209,6 +212,78 @@ where
                     Fault::Sink(err) => Error::Recording(err),
                 })
         }
+    })
+}
+
+/// How far into a bag (log time) the earliest message is looked for: a scan's stamp is its first
+/// reading's, logged a revolution or more later, after other topics' messages.
+const EARLIEST_WITHIN_NS: u64 = 10_000_000_000;
+
+/// The recording's t = 0: an export's own start, else the earliest time among the first messages
+/// of the chosen topics (each topic's first within the bag's first 10 s of log time): its header
+/// stamp, or the log time of an unstamped one on the same clock. `None` when none is found
+/// (the first message converted then sets it).
+///
+/// # Errors
+/// As [`bag::stream`].
+fn earliest_time(file: &Path, chosen: &Chosen) -> Result<Option<i64>, Error> {
+    let mut roles: HashMap<u16, Kind> = HashMap::new();
+    let mut stamped: Option<i64> = None;
+    let mut unstamped: Option<i64> = None;
+    let mut start = None;
+    let mut first_log = None;
+    bag::stream_while(file, |item| {
+        match item {
+            Item::Channel(c) => {
+                if let Some((_, kind)) = chosen.values().find(|(topic, _)| *topic == c.topic) {
+                    roles.insert(c.id, *kind);
+                }
+            }
+            Item::Metadata(m) if m.name == START_METADATA => {
+                start = m
+                    .metadata
+                    .get(START_KEY)
+                    .and_then(|v| v.parse::<i64>().ok());
+                return Ok(start.is_none());
+            }
+            Item::Metadata(_) => {}
+            Item::Message {
+                channel_id,
+                log_time,
+                data,
+            } => {
+                let first = *first_log.get_or_insert(log_time);
+                if log_time.saturating_sub(first) > EARLIEST_WITHIN_NS {
+                    return Ok(false);
+                }
+                let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
+                match roles.get(&channel_id) {
+                    // Every stamped message starts with its header.
+                    Some(Kind::Twist) => {
+                        unstamped = Some(unstamped.map_or(log_ns, |t| t.min(log_ns)));
+                    }
+                    Some(_) => {
+                        if let Ok(header) = decode::<crate::msgs::Header>(data) {
+                            if !header.stamp.is_zero() {
+                                let ns = header.stamp.ns();
+                                stamped = Some(stamped.map_or(ns, |t| t.min(ns)));
+                            }
+                        }
+                    }
+                    None => {}
+                }
+            }
+        }
+        Ok(true)
+    })?;
+    if start.is_some() {
+        return Ok(start);
+    }
+    Ok(match (stamped, unstamped) {
+        // Unstamped messages count when they are on the stamps' clock.
+        (Some(s), Some(u)) if (s - u).abs() <= OTHER_CLOCK_NS => Some(s.min(u)),
+        (Some(s), _) => Some(s),
+        (None, u) => u,
     })
 }
 
@@ -313,9 +388,12 @@ impl Converter {
 
     /// Seconds from t = 0, to the microsecond (what a recording keeps: `0.15`, not
     /// `0.15000000000000002`; far below any sensor's timing), in the table's order.
-    fn seconds(&mut self, role: Role, ns: f64) -> f64 {
-        let t0 = *self.t0_ns.get_or_insert(ns as i64);
-        let t = ((ns - t0 as f64) / 1e3).round() / 1e6;
+    /// `ns` on the stamps' clock plus `extra_ns` (a reading's offset within its scan): the
+    /// difference from t = 0 is taken in integers first, as a stamp (~1.7e18 ns) is finer than
+    /// an f64 resolves.
+    fn seconds(&mut self, role: Role, ns: i64, extra_ns: f64) -> f64 {
+        let t0 = *self.t0_ns.get_or_insert(ns);
+        let t = (((ns - t0) as f64 + extra_ns) / 1e3).round() / 1e6;
         let last = self.last_t.entry(role).or_insert(0.0);
         if t < *last {
             let (count, worst) = self.reordered.entry(role).or_insert((0, 0.0));
@@ -346,6 +424,28 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
+        self.convert(role, kind, log_ns, data, sink)?;
+        // Commands held for want of a clock go out as soon as a stamped message gives it,
+        // before any later command.
+        if let Some(offset) = self.clock_offset_ns {
+            for (log_ns, twist) in std::mem::take(&mut self.pending_commands) {
+                self.command(log_ns + offset, &twist, sink)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn convert<S>(
+        &mut self,
+        role: Role,
+        kind: Kind,
+        log_ns: i64,
+        data: &[u8],
+        sink: &mut S,
+    ) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
         let bad = |err: String| Fault::Message(format!("not a {} ({err})", kind.ros_name()));
         match (role, kind) {
             (Role::Lidar, _) => {
@@ -364,7 +464,7 @@ impl Converter {
                     self.sonar_out_of_range += 1;
                     return Ok(());
                 }
-                let t_s = self.seconds(role, ns as f64);
+                let t_s = self.seconds(role, ns, 0.0);
                 self.count(role, 1);
                 Ok(sink.sonar(&SonarSample {
                     t_s,
@@ -420,7 +520,7 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
-        let ns = self.stamped(scan.header.stamp, log_ns) as f64;
+        let ns = self.stamped(scan.header.stamp, log_ns);
         if scan.ranges.is_empty() {
             return Ok(());
         }
@@ -430,7 +530,7 @@ impl Converter {
         let (range_min, range_max) = (scan.range_min, scan.range_max);
         for (i, &range) in scan.ranges.iter().enumerate() {
             let i_f = i as f64;
-            let t_s = self.seconds(Role::Lidar, ns + i_f * time_increment_ns);
+            let t_s = self.seconds(Role::Lidar, ns, i_f * time_increment_ns);
             let valid = range.is_finite() && range >= range_min && range <= range_max;
             let strength = scan
                 .intensities
@@ -458,7 +558,7 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
-        let t_s = self.seconds(Role::Commands, ns as f64);
+        let t_s = self.seconds(Role::Commands, ns, 0.0);
         let (v, w) = (twist.linear.x, twist.angular.z);
         let half = 0.5 * self.wheel_base_m * w;
         self.count(Role::Commands, 1);
@@ -473,7 +573,7 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
-        let t_s = self.seconds(Role::Truth, ns as f64);
+        let t_s = self.seconds(Role::Truth, ns, 0.0);
         self.count(Role::Truth, 1);
         Ok(sink.truth(&TruthSample {
             t_s,
@@ -526,7 +626,7 @@ impl Converter {
                 (left_m, right_m)
             }
         };
-        let t_s = self.seconds(Role::Odometry, ns as f64);
+        let t_s = self.seconds(Role::Odometry, ns, 0.0);
         self.count(Role::Odometry, 1);
         Ok(sink.odometry(&OdometrySample {
             t_s,
@@ -582,7 +682,7 @@ impl Converter {
         let (Some(&l), Some(&r)) = (joints.position.get(left), joints.position.get(right)) else {
             return Err(Fault::Message("fewer positions than joint names".into()));
         };
-        let t_s = self.seconds(Role::Odometry, ns as f64);
+        let t_s = self.seconds(Role::Odometry, ns, 0.0);
         self.count(Role::Odometry, 1);
         Ok(sink.odometry(&OdometrySample {
             t_s,

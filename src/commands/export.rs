@@ -35,7 +35,7 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
     let calibration = args
         .calibration
         .as_deref()
-        .map(super::calibrate::read_calibration)
+        .map(super::read_calibration)
         .transpose()?;
     let recording = Recording::read_dir(&args.recording)?;
     let calibrated = match (&calibration, args.calibration.as_deref()) {

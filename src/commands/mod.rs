@@ -1,6 +1,7 @@
 //! One module per subcommand; each validates its arguments before opening anything.
 
 pub mod calibrate;
+mod calibration_file;
 pub mod dataset;
 pub mod decode;
 pub mod diagnose;
@@ -13,4 +14,5 @@ mod scenario_file;
 pub mod scenario_test;
 pub mod serve;
 
+pub use calibration_file::read_calibration;
 pub use scenario_file::load_scenario;

@@ -28,6 +28,7 @@ SCANS = 30
 READINGS = 720
 WHEEL_BASE = 0.3
 RANGE_MIN, RANGE_MAX = 0.1, 12.0
+ODOM_AFTER_NS = 20_000_000
 
 
 def scan_ranges(k):
@@ -89,7 +90,9 @@ def write(bagdir):
                 ranges=scan_ranges(k),
                 intensities=np.full(READINGS, 100.0 + k, dtype=np.float32),
             )
-            events.append((ns, scan_c, msg, "sensor_msgs/msg/LaserScan"))
+            # Logged when the revolution ends, after the odometry stamped later: t = 0 is
+            # still the first scan's stamp.
+            events.append((ns + 100_000_000, scan_c, msg, "sensor_msgs/msg/LaserScan"))
             sonar = t["sensor_msgs/msg/Range"](
                 header=header(ns + 5_000_000, "sonar"),
                 radiation_type=0,
@@ -100,7 +103,7 @@ def write(bagdir):
             )
             events.append((ns + 5_000_000, sonar_c, sonar, "sensor_msgs/msg/Range"))
         for j in range(2 * SCANS):
-            ns = T0_NS + j * 50_000_000
+            ns = T0_NS + ODOM_AFTER_NS + j * 50_000_000
             x, y, yaw = odom_pose(j)
             odom = t["nav_msgs/msg/Odometry"](
                 header=header(ns, "odom"),
@@ -175,7 +178,7 @@ def imported(bagdir, rec):
         right += ds + turn * WHEEL_BASE / 2
         close(float(odometry[j]["left_m"]), left, 1e-8, f"odometry row {j} left")
         close(float(odometry[j]["right_m"]), right, 1e-8, f"odometry row {j} right")
-        close(float(odometry[j]["t_s"]), 0.05 * j, 1e-9, f"odometry row {j} t_s")
+        close(float(odometry[j]["t_s"]), 0.02 + 0.05 * j, 1e-9, f"odometry row {j} t_s")
     commands = table(rec / "commands.csv")
     if len(commands) != SCANS // 2:
         fail(f"commands.csv has {len(commands)} rows")

@@ -45,6 +45,10 @@ pub enum Command {
     /// Draw a recording as one self-contained HTML page: the world, the paths, the scans, each
     /// sensor's error against distance and the calibration.
     Report(ReportArgs),
+    /// Turn a ROS 2 bag (MCAP, CDR) into a recording.
+    Import(crate::commands::import::ImportArgs),
+    /// Write a recording as ROS 2 messages in an MCAP file (Foxglove, RViz, `ros2 bag play`).
+    Export(crate::commands::export::ExportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -67,6 +71,9 @@ pub struct RunArgs {
     /// against distance, the calibration) into this directory.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Also write the run as ROS 2 messages in this MCAP file (as `hilsim export`).
+    #[arg(long, value_name = "OUT")]
+    pub mcap: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -87,6 +94,9 @@ pub struct RecordArgs {
     /// Seed of every random stream (default: the scenario's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Also write the recording as ROS 2 messages in this MCAP file (as `hilsim export`).
+    #[arg(long, value_name = "OUT")]
+    pub mcap: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]

@@ -34,6 +34,12 @@ fn main() -> ExitCode {
         Command::Hil(args) => commands::hil::hil(args, &mut out),
         Command::Diagnose(args) => commands::diagnose::diagnose(args, &mut out),
         Command::Report(args) => commands::report::report(args, &mut out),
+        Command::Import(args) => {
+            commands::import::import(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
+        Command::Export(args) => {
+            commands::export::export(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
     };
     let _ = out.flush();
     match result {

@@ -152,6 +152,7 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
         ));
     }
     check_finite_commands(rec)?;
+    let beam_index = nearest_beam(lidar, beam_index);
     let (mount, phi) = beam_direction(rec, beam_index)?;
     let beam_cos = phi.cos();
     let (t_s, lidar_m) = beam_readings(lidar, beam_index)?;
@@ -195,22 +196,44 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
     })
 }
 
-/// The beam's index in the lidar table: `beam_deg` rounded to a whole degree in 0..360.
-fn beam_index(opts: &SampleOptions) -> Result<u16, CalibrationError> {
+/// The requested beam angle, degrees in [0, 360).
+fn beam_index(opts: &SampleOptions) -> Result<f64, CalibrationError> {
     if !opts.beam_deg.is_finite() {
         return Err(CalibrationError::Invalid(format!(
             "beam angle must be finite, got {}",
             opts.beam_deg
         )));
     }
-    Ok(opts.beam_deg.round().rem_euclid(360.0) as u16)
+    Ok(opts.beam_deg.rem_euclid(360.0) % 360.0)
+}
+
+/// How far a revolution's reading may be from the beam's angle and still be its reading: a
+/// lidar's angles may shift a little from one revolution to the next (each scan has its own
+/// start angle), and none that is followed is spaced wider than a degree or two.
+const BEAM_TOLERANCE_DEG: f64 = 1.0;
+
+/// The angle between two directions, degrees in [0, 180].
+fn angular_distance_deg(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(360.0);
+    d.min(360.0 - d)
+}
+
+/// The lidar's angle nearest the requested one (the XV-11's whole degree, another lidar's
+/// nearest step); the requested angle when no reading is within [`BEAM_TOLERANCE_DEG`].
+fn nearest_beam(lidar: &[LidarSample], requested: f64) -> f64 {
+    lidar
+        .iter()
+        .map(|s| (angular_distance_deg(s.angle_deg, requested), s.angle_deg))
+        .filter(|(d, _)| *d <= BEAM_TOLERANCE_DEG)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(requested, |(_, a)| a)
 }
 
 /// The start distance: the caller's, else meta.toml's for the beam straight ahead.
 fn start_distance(
     rec: &Recording,
     opts: &SampleOptions,
-    beam_index: u16,
+    beam_index: f64,
 ) -> Result<Option<f64>, CalibrationError> {
     // meta.toml's start distance is the frontal target's (interfaces.md): it says nothing about
     // what another beam sees, so another beam needs its own start distance.
@@ -218,7 +241,7 @@ fn start_distance(
         .meta
         .world
         .target_start_distance_m
-        .filter(|_| beam_index == 0);
+        .filter(|_| angular_distance_deg(beam_index, 0.0) < 0.5);
     match opts.start_distance_m.or(meta_start) {
         Some(d) if d.is_finite() && d > 0.0 => Ok(Some(d)),
         Some(d) => Err(CalibrationError::Invalid(format!(
@@ -230,7 +253,7 @@ fn start_distance(
 
 /// The lidar mount and the beam's direction φ from the robot's forward axis, radians; a beam
 /// (nearly) perpendicular to the motion is an error.
-fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(Mount, f64), CalibrationError> {
+fn beam_direction(rec: &Recording, beam_index: f64) -> Result<(Mount, f64), CalibrationError> {
     let mount = rec.meta.lidar.unwrap_or_default();
     if ![mount.x_m, mount.y_m, mount.yaw_deg]
         .iter()
@@ -240,7 +263,7 @@ fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(Mount, f64), Cali
             "meta.toml [lidar] mount pose is not finite".into(),
         ));
     }
-    let phi = (mount.yaw_deg + f64::from(beam_index)).to_radians();
+    let phi = (mount.yaw_deg + beam_index).to_radians();
     let beam_cos = phi.cos();
     // A beam within ~5.7° of perpendicular to the motion sees the distance change by less than
     // a tenth of the travel: the commands no longer pin the distance down.
@@ -258,13 +281,13 @@ fn beam_direction(rec: &Recording, beam_index: u16) -> Result<(Mount, f64), Cali
 /// a beam that never, or only in a minority of revolutions, returns a valid reading is an error.
 fn beam_readings(
     lidar: &[LidarSample],
-    beam_index: u16,
+    beam_index: f64,
 ) -> Result<(Vec<f64>, Vec<Option<f64>>), CalibrationError> {
     let mut t_s = Vec::new();
     let mut lidar_m = Vec::new();
     let mut last_t = f64::NEG_INFINITY;
     let mut last_rev = None;
-    for s in lidar.iter().filter(|s| s.angle_deg == beam_index) {
+    for s in beam_of_each_revolution(lidar, beam_index) {
         if !(s.t_s.is_finite() && s.range_m.is_finite()) {
             return Err(CalibrationError::Invalid(format!(
                 "lidar.csv: non-finite value in revolution {} at {}°",
@@ -310,6 +333,35 @@ fn beam_readings(
         )));
     }
     Ok((t_s, lidar_m))
+}
+
+/// Each revolution's reading nearest the beam (within [`BEAM_TOLERANCE_DEG`]; the first of
+/// equally near ones), in table order.
+fn beam_of_each_revolution(
+    lidar: &[LidarSample],
+    beam_deg: f64,
+) -> impl Iterator<Item = &LidarSample> {
+    let mut chosen: Vec<&LidarSample> = Vec::new();
+    let mut best = f64::INFINITY;
+    for s in lidar {
+        let d = angular_distance_deg(s.angle_deg, beam_deg);
+        if d > BEAM_TOLERANCE_DEG {
+            continue;
+        }
+        match chosen.last() {
+            Some(last) if last.rev == s.rev => {
+                if d < best {
+                    *chosen.last_mut().expect("not empty") = s;
+                    best = d;
+                }
+            }
+            _ => {
+                chosen.push(s);
+                best = d;
+            }
+        }
+    }
+    chosen.into_iter()
 }
 
 fn check_finite_commands(rec: &Recording) -> Result<(), CalibrationError> {

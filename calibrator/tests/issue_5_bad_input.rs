@@ -62,7 +62,7 @@ fn a_nan_is_invalid() {
     let lidar = rec.lidar.as_mut().unwrap();
     let row = lidar
         .iter_mut()
-        .find(|s| s.angle_deg == 0 && s.rev == 20)
+        .find(|s| s.angle_deg == 0.0 && s.rev == 20)
         .unwrap();
     row.range_m = f64::NAN;
     let err = em_err(&rec);

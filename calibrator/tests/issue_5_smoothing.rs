@@ -40,7 +40,7 @@ fn a_calibration_trained_at_one_speed_smooths_another() {
         .as_ref()
         .unwrap()
         .iter()
-        .filter(|s| s.angle_deg == 0)
+        .filter(|s| s.angle_deg == 0.0)
         .count();
     assert_eq!(est.len(), revolutions, "one estimate per revolution");
     assert!(est.windows(2).all(|w| w[1].t_s > w[0].t_s));

@@ -62,7 +62,7 @@ fn synthetic(stops: usize, cylinders: &[Cylinder]) -> Recording {
                 lidar.push(LidarSample {
                     t_s,
                     rev,
-                    angle_deg: a,
+                    angle_deg: f64::from(a),
                     range_m: if valid {
                         (horner(&PAPER_ALPHA, hit) * 1000.0).round() / 1000.0
                     } else {

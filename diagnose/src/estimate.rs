@@ -232,7 +232,7 @@ impl Matcher<'_> {
         rows: &[&LidarSample],
         correction: &mut [f64; 3],
     ) -> Option<(Knot, [f64; 3])> {
-        let start = rows[0].t_s - f64::from(rows[0].angle_deg) * self.period;
+        let start = rows[0].t_s - rows[0].angle_deg * self.period;
         let valid: Vec<&&LidarSample> = rows
             .iter()
             .filter(|s| !s.invalid && s.range_m > 0.0)
@@ -247,7 +247,7 @@ impl Matcher<'_> {
             .map(|s| LidarQuery {
                 t_s: s.t_s,
                 rev_start_s: start,
-                angle_deg: f64::from(s.angle_deg),
+                angle_deg: s.angle_deg,
             })
             .collect();
         let y: Vec<f64> = used.iter().map(|s| s.range_m).collect();

@@ -165,7 +165,7 @@ fn recording(seconds: f64, start: Pose, kappa: f64, wave: f64, seed: u64) -> Rec
             lidar.push(LidarSample {
                 t_s: t,
                 rev,
-                angle_deg: (angle.round()) as u16,
+                angle_deg: angle.round(),
                 range_m: ((mean + SD * e) * 1000.0).round() / 1000.0,
                 strength: 300,
                 invalid: false,

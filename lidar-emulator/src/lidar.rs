@@ -70,7 +70,7 @@ impl LidarReading {
         LidarSample {
             t_s: hilsim_sim::exact_time_s(self.t_s),
             rev: self.rev,
-            angle_deg: self.angle_deg,
+            angle_deg: f64::from(self.angle_deg),
             range_m: f64::from(self.distance_mm) / 1000.0,
             strength: self.strength,
             invalid: self.error_code.is_some(),

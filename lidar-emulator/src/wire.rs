@@ -118,7 +118,7 @@ impl WireTimeline {
             out.push(LidarSample {
                 t_s: hilsim_sim::exact_time_s(reading_time_s(start_s, angle, rpm)),
                 rev,
-                angle_deg: angle,
+                angle_deg: f64::from(angle),
                 range_m: reading.range_m().unwrap_or(0.0),
                 strength: reading.strength,
                 invalid: reading.invalid,

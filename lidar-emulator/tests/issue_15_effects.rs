@@ -39,7 +39,7 @@ fn record(s: &Scenario) -> Recording {
 fn at(readings: &[LidarSample], angle: f64) -> &LidarSample {
     readings
         .iter()
-        .find(|r| r.rev == 0 && (f64::from(r.angle_deg) - angle).abs() < 1e-9)
+        .find(|r| r.rev == 0 && (r.angle_deg - angle).abs() < 1e-9)
         .unwrap()
 }
 

@@ -40,7 +40,10 @@ fn lidar(s: &Scenario) -> Vec<LidarSample> {
 
 /// The reading at `angle` of the first revolution.
 fn at(readings: &[LidarSample], angle: u16) -> &LidarSample {
-    readings.iter().find(|r| r.angle_deg == angle).unwrap()
+    readings
+        .iter()
+        .find(|r| r.angle_deg == f64::from(angle))
+        .unwrap()
 }
 
 #[test]
@@ -123,7 +126,7 @@ fn warmup_drift_settles_exponentially() {
     let (a, b) = (lidar(&long), lidar(&warm));
     assert_eq!(a.len(), b.len());
     let mut checked = 0;
-    for (ra, rb) in a.iter().zip(&b).filter(|(r, _)| r.angle_deg == 0) {
+    for (ra, rb) in a.iter().zip(&b).filter(|(r, _)| r.angle_deg == 0.0) {
         // 3 m to the wall ahead: k d² e^{−t/τ} = 36 mm at power-on.
         let d = ra.true_range_m.unwrap();
         let expected = d + k * d * d * (-ra.t_s / tau).exp();
@@ -196,7 +199,7 @@ fn a_per_revolution_lidar_takes_the_revolution_from_its_start_pose() {
         let u = (t0 - p.t_s) / (q.t_s - p.t_s);
         let start = Pose::new(p.x_m, p.y_m, p.yaw_rad).lerp(&Pose::new(q.x_m, q.y_m, q.yaw_rad), u);
         for r in rows.iter().step_by(7) {
-            let heading = start.yaw + f64::from(r.angle_deg).to_radians();
+            let heading = start.yaw + r.angle_deg.to_radians();
             let d = world
                 .cast_ray([start.x, start.y], heading, 12.0)
                 .unwrap()
@@ -217,7 +220,7 @@ fn a_per_revolution_lidar_takes_the_revolution_from_its_start_pose() {
     let late_differs = readings
         .iter()
         .zip(&per_reading)
-        .filter(|(a, b)| a.angle_deg > 300 && a.rev == 2 && (a.range_m - b.range_m).abs() > 0.01)
+        .filter(|(a, b)| a.angle_deg > 300.0 && a.rev == 2 && (a.range_m - b.range_m).abs() > 0.01)
         .count();
     assert!(late_differs > 20, "{late_differs}");
 }

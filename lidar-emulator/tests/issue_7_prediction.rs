@@ -32,7 +32,7 @@ fn readings(s: &Scenario, angle: u16) -> Vec<f64> {
     rec.lidar
         .unwrap()
         .iter()
-        .filter(|r| r.angle_deg == angle && !r.invalid)
+        .filter(|r| r.angle_deg == f64::from(angle) && !r.invalid)
         .map(|r| r.range_m)
         .collect()
 }

@@ -164,7 +164,7 @@ mod tests {
                 .map(|i| LidarSample {
                     t_s: i as f64 * 0.000_555,
                     rev: (i / 360) as u64,
-                    angle_deg: (i % 360) as u16,
+                    angle_deg: (i % 360) as f64,
                     range_m: 1.0 + (i % 7) as f64 * 0.125,
                     strength: 40,
                     invalid: i % 11 == 0,

@@ -39,6 +39,16 @@ impl Recording {
     }
 }
 
+impl Meta {
+    /// Reads and checks a `meta.toml` (as [`Recording::read_dir`] does).
+    ///
+    /// # Errors
+    /// The file cannot be read or is not a valid `meta.toml`, naming it (and the line).
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        read_meta(path)
+    }
+}
+
 fn optional<T>(
     dir: &Path,
     name: &str,
@@ -176,10 +186,10 @@ fn read_lidar(path: &Path) -> Result<Vec<LidarSample>, Error> {
         |c, row| {
             let t_s = row.f64(c.t)?;
             row.check_time(t_s, &mut prev)?;
-            let angle_deg: u16 = row.uint(c.angle)?;
-            if angle_deg >= 360 {
+            let angle_deg = row.f64(c.angle)?;
+            if !(0.0..360.0).contains(&angle_deg) {
                 return Err(row.error(format!(
-                    "column `angle_deg`: expected 0..359, found {angle_deg}"
+                    "column `angle_deg`: expected a number in [0, 360), found {angle_deg}"
                 )));
             }
             let range_m = row.f64(c.range)?;
@@ -405,7 +415,7 @@ mod tests {
         rec.lidar = Some(vec![LidarSample {
             t_s: 0.1 + 0.2,
             rev: 0,
-            angle_deg: 359,
+            angle_deg: 359.5,
             range_m: 1.234,
             strength: 3000,
             invalid: false,

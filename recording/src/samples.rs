@@ -29,9 +29,10 @@ pub struct LidarSample {
     pub t_s: f64,
     /// Revolution counter, from 0.
     pub rev: u64,
-    /// Beam angle in the lidar's own frame, whole degrees 0..359, counter-clockwise from its
-    /// forward axis (ROS REP 103).
-    pub angle_deg: u16,
+    /// Beam angle in the lidar's own frame, degrees in [0, 360), counter-clockwise from its
+    /// forward axis (ROS REP 103). The XV-11 gives the whole degrees 0..359; another lidar any
+    /// number of readings per revolution at any spacing.
+    pub angle_deg: f64,
     /// Range as reported, metres (millimetres / 1000); 0 when invalid.
     pub range_m: f64,
     /// Signal strength as reported (the XV-11's 16-bit field).

@@ -231,6 +231,12 @@ impl RecordingStream {
         &self.dir
     }
 
+    /// The `meta.toml` to be written when finished, to complete with what only the samples
+    /// tell (an importer learns a sensor's beam from its messages).
+    pub fn meta_mut(&mut self) -> &mut Meta {
+        &mut self.meta
+    }
+
     /// Completes every file, writes `meta.toml` and puts the recording in place of `dir`.
     ///
     /// # Errors
@@ -391,7 +397,7 @@ mod tests {
                 .map(|i| LidarSample {
                     t_s: f64::from(i) * 0.01,
                     rev: 0,
-                    angle_deg: i as u16,
+                    angle_deg: f64::from(i) * 0.5,
                     range_m: 1.25,
                     strength: 40,
                     invalid: i == 1,

@@ -135,7 +135,8 @@ pub(crate) mod rows {
         s.push(',');
         push_int(s, r.rev);
         s.push(',');
-        push_int(s, r.angle_deg);
+        // A whole angle prints as the integer it is ("90"), as the XV-11's always did.
+        push_f64(s, r.angle_deg);
         s.push(',');
         push_f64(s, r.range_m);
         s.push(',');

@@ -21,7 +21,7 @@ fn synthetic(rows: usize) -> Recording {
                 LidarSample {
                     t_s: i as f64 / 1800.0,
                     rev: (i / 360) as u64,
-                    angle_deg: (i % 360) as u16,
+                    angle_deg: (i % 360) as f64,
                     range_m: (true_range_m * 1000.0).round() / 1000.0,
                     strength: (1000 + i % 3000) as u16,
                     invalid: i % 97 == 0,

@@ -106,7 +106,7 @@ impl<'a> View<'a> {
             .map(|s| Scored {
                 t_s: s.t_s,
                 rev: s.rev,
-                angle_deg: f64::from(s.angle_deg),
+                angle_deg: s.angle_deg,
                 reading_m: s.range_m,
                 true_m: s.true_range_m.unwrap_or_else(|| {
                     cast(
@@ -186,7 +186,7 @@ impl<'a> View<'a> {
 /// The beam's direction in the lidar's frame, radians.
 #[must_use]
 pub fn beam_rad(s: &LidarSample) -> f64 {
-    f64::from(s.angle_deg).to_radians()
+    s.angle_deg.to_radians()
 }
 
 /// The pose at `t` on `path`, interpolated (held at the ends); `None` for an empty path.

@@ -38,7 +38,7 @@ pub fn of_run(run: &Run) -> Metrics {
         put("lidar.readings", lidar.len() as f64);
         let revs = lidar
             .last()
-            .map_or(0, |r| r.rev + u64::from(r.angle_deg == 359));
+            .map_or(0, |r| r.rev + u64::from(r.angle_deg == 359.0));
         put("lidar.revolutions", revs as f64);
         let valid: Vec<_> = lidar.iter().filter(|r| !r.invalid).collect();
         if !lidar.is_empty() {

@@ -2,14 +2,14 @@
 //! `hilsim smooth RECORDING --calibration FILE [--csv OUT]` (the EM paper's Sec. V reuse).
 
 use std::fmt::Write as _;
-use std::io::{Read, Write};
-use std::path::Path;
+use std::io::Write;
+
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
 use hilsim_calibrator::smoothing;
-use hilsim_calibrator::{em, Calibration, Method, SampleOptions, Settings};
+use hilsim_calibrator::{em, Method, SampleOptions, Settings};
 use hilsim_recording::{is_same_file, write_file_atomically, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
@@ -115,7 +115,7 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
             }
         }
     }
-    let trained = read_calibration(&args.calibration)?;
+    let trained = super::read_calibration(&args.calibration)?;
     let rec = Recording::read_dir(&args.recording)?;
     let (estimates, checks) =
         smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))
@@ -157,27 +157,4 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
         failed.len()
     );
     Ok(ExitCode::from(1))
-}
-
-/// Reads the JSON that `hilsim calibrate --json` printed.
-fn read_calibration(path: &Path) -> Result<Calibration> {
-    let text = read_calibration_text(path)?;
-    Ok(Calibration::from_json(&text, &path.display().to_string())?)
-}
-
-/// The text of a calibration's JSON file (`calibrate --json`'s, or a run's `results.json`),
-/// read within a bound whatever the path is.
-pub(crate) fn read_calibration_text(path: &Path) -> Result<String> {
-    // A calibration is a few hundred bytes and a run's results a few kilobytes.
-    const MAX_CALIBRATION_BYTES: u64 = 1 << 20;
-    let file =
-        std::fs::File::open(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut text = String::new();
-    file.take(MAX_CALIBRATION_BYTES + 1)
-        .read_to_string(&mut text)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    if text.len() as u64 > MAX_CALIBRATION_BYTES {
-        bail!("{}: larger than 1 MiB; not a calibration", path.display());
-    }
-    Ok(text)
 }

@@ -17,5 +17,11 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let mut sink = BackgroundStream::spawn(stream)?;
     emulation.record_into(&mut sink)?;
     sink.finish()?;
+    if let Some(mcap) = &args.mcap {
+        // The recording as written (it streamed to disk, so it is read back).
+        let world = super::export::world(&scenario);
+        let recording = hilsim_recording::Recording::read_dir(&args.out)?;
+        super::export::write_mcap(&recording, Some(&world), mcap)?;
+    }
     Ok(())
 }

@@ -6,7 +6,6 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use hilsim_calibrator::Calibration;
 use hilsim_recording::{write_file_atomically, Recording};
 use hilsim_report::Inputs;
 use hilsim_sim::Scenario;
@@ -23,10 +22,7 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .clone()
         .or_else(|| beside.is_file().then_some(beside));
     let calibrations = match &calibration_file {
-        Some(path) => {
-            let text = super::calibrate::read_calibration_text(path)?;
-            Calibration::all_from_json(&text, &path.display().to_string())?
-        }
+        Some(path) => super::read_calibrations(path)?,
         None => Vec::new(),
     };
     let name = args.recording.display().to_string();

@@ -22,6 +22,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         cli::Via::Memory => Via::Memory,
         cli::Via::Serial => Via::Serial,
     };
+    let world = super::export::world(&scenario);
     let report = hilsim_scenarios::execute(scenario, &origin, via)?;
     if args.json {
         out.write_all(report.results_json().as_bytes())?;
@@ -51,6 +52,12 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         super::report::write_report_page(dir, &html)?;
         if !args.json {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
+        }
+    }
+    if let Some(mcap) = &args.mcap {
+        super::export::write_mcap(&report.run.recording, Some(&world), mcap)?;
+        if !args.json {
+            writeln!(out, "wrote {}", mcap.display())?;
         }
     }
     Ok(if report.passed() {

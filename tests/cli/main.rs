@@ -12,6 +12,7 @@ mod limits;
 mod outputs;
 mod record;
 mod report;
+mod ros2;
 mod run;
 mod scenario_test;
 mod serve;

@@ -164,7 +164,7 @@ pub fn synthetic_recording(revolutions: usize, rng: &mut impl Rng) -> Recording 
         lidar.push(LidarSample {
             t_s: t,
             rev: k as u64,
-            angle_deg: 0,
+            angle_deg: 0.0,
             range_m: (y * 1000.0).round() / 1000.0,
             strength: 300,
             invalid: false,

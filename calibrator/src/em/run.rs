@@ -335,7 +335,7 @@ fn push_notes(
     notes.push(format!(
         "samples: {} revolutions, {valid} valid lidar readings at beam {}°, start distance {start} m",
         samples.len(),
-        opts.beam_deg.round().rem_euclid(360.0)
+        opts.beam_deg.rem_euclid(360.0)
     ));
     if !opts.priors.is_empty() {
         let list: Vec<String> = opts.priors.list().iter().map(ToString::to_string).collect();

@@ -23,7 +23,7 @@ mod judge;
 use self::judge::judge;
 use super::circle_fit::{dist, fit_free};
 use super::options::DetectionOptions;
-use super::scan::{StopScan, BEAMS};
+use super::scan::StopScan;
 
 /// One landmark seen at one stop.
 #[derive(Debug, Clone, PartialEq)]
@@ -147,9 +147,9 @@ impl Rejections {
 /// A run of neighbouring valid beams without a range jump.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Segment {
-    /// First beam (degrees, lidar frame).
+    /// First beam (its index in the scan's grid).
     pub first: usize,
-    /// Number of beams; beam `first + i` wraps modulo 360.
+    /// Number of beams; beam `first + i` wraps modulo the beams of a revolution.
     pub len: usize,
 }
 
@@ -160,6 +160,7 @@ const FREE_FIT_MIN_BEAMS: usize = 6;
 #[must_use]
 pub fn segments(scan: &StopScan, opts: &DetectionOptions) -> Vec<Segment> {
     let b = &scan.beams;
+    let beams_n = b.len();
     let jump = |i: usize, j: usize| -> bool {
         let (x, y) = (&b[i], &b[j]);
         let sigma = (x.sem_m().powi(2) + y.sem_m().powi(2)).sqrt();
@@ -169,13 +170,14 @@ pub fn segments(scan: &StopScan, opts: &DetectionOptions) -> Vec<Segment> {
         (x.mean_m - y.mean_m).abs() > tol
     };
     let breaks_before = |i: usize| {
-        !b[i].valid || !b[(i + BEAMS - 1) % BEAMS].valid || jump((i + BEAMS - 1) % BEAMS, i)
+        let prev = (i + beams_n - 1) % beams_n;
+        !b[i].valid || !b[prev].valid || jump(prev, i)
     };
-    let Some(start) = (0..BEAMS).find(|&i| breaks_before(i)) else {
+    let Some(start) = (0..beams_n).find(|&i| breaks_before(i)) else {
         return if b.iter().all(|x| x.valid) {
             vec![Segment {
                 first: 0,
-                len: BEAMS,
+                len: beams_n,
             }]
         } else {
             Vec::new()
@@ -183,8 +185,8 @@ pub fn segments(scan: &StopScan, opts: &DetectionOptions) -> Vec<Segment> {
     };
     let mut out = Vec::new();
     let mut current: Option<Segment> = None;
-    for k in 0..BEAMS {
-        let i = (start + k) % BEAMS;
+    for k in 0..beams_n {
+        let i = (start + k) % beams_n;
         if !b[i].valid {
             out.extend(current.take());
             continue;
@@ -258,7 +260,7 @@ pub fn candidate_radii(scan: &StopScan, opts: &DetectionOptions) -> Vec<f64> {
 }
 
 fn beam(scan: &StopScan, seg: Segment, i: usize) -> &super::scan::Beam {
-    &scan.beams[(seg.first + i) % BEAMS]
+    &scan.beams[(seg.first + i) % scan.beams.len()]
 }
 
 /// The segment's averaged points in the lidar frame and their beam angles (radians, unwrapped
@@ -266,7 +268,7 @@ fn beam(scan: &StopScan, seg: Segment, i: usize) -> &super::scan::Beam {
 fn points(scan: &StopScan, seg: Segment) -> (Vec<[f64; 2]>, Vec<f64>) {
     (0..seg.len)
         .map(|i| {
-            let a = ((seg.first + i) as f64).to_radians();
+            let a = scan.grid.angle_rad(seg.first + i);
             let m = beam(scan, seg, i).mean_m;
             ([m * a.cos(), m * a.sin()], a)
         })
@@ -275,13 +277,14 @@ fn points(scan: &StopScan, seg: Segment) -> (Vec<[f64; 2]>, Vec<f64>) {
 
 /// A neighbour just outside the segment is valid and nearer than the segment's end next to it.
 fn occluded(scan: &StopScan, seg: Segment) -> bool {
-    if seg.len >= BEAMS {
+    let b = &scan.beams;
+    let beams_n = b.len();
+    if seg.len >= beams_n {
         return false;
     }
-    let b = &scan.beams;
-    let before = &b[(seg.first + BEAMS - 1) % BEAMS];
-    let after = &b[(seg.first + seg.len) % BEAMS];
+    let before = &b[(seg.first + beams_n - 1) % beams_n];
+    let after = &b[(seg.first + seg.len) % beams_n];
     let first = &b[seg.first];
-    let last = &b[(seg.first + seg.len - 1) % BEAMS];
+    let last = &b[(seg.first + seg.len - 1) % beams_n];
     (before.valid && before.mean_m < first.mean_m) || (after.valid && after.mean_m < last.mean_m)
 }

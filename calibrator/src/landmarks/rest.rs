@@ -156,7 +156,7 @@ fn scans_settle(lidar: &[LidarSample], t0: f64, t1: f64) -> Option<f64> {
     // Revolutions wholly inside: not the one the window starts or ends inside.
     let starts_inside = |rev: u64| first == 0 || lidar[first - 1].rev != rev;
     let ends_inside = |rev: u64| last == lidar.len() || lidar[last].rev != rev;
-    let mut revolutions: Vec<(f64, Vec<(u16, f64)>)> = Vec::new();
+    let mut revolutions: Vec<(f64, Vec<(i64, f64)>)> = Vec::new();
     let mut current: Option<u64> = None;
     for s in window
         .iter()
@@ -168,7 +168,7 @@ fn scans_settle(lidar: &[LidarSample], t0: f64, t1: f64) -> Option<f64> {
         }
         if let Some((_, beams)) = revolutions.last_mut() {
             if !s.invalid && s.range_m > 0.0 && s.range_m.is_finite() {
-                beams.push((s.angle_deg, s.range_m));
+                beams.push((angle_key(s.angle_deg), s.range_m));
             }
         }
     }
@@ -193,8 +193,14 @@ fn scans_settle(lidar: &[LidarSample], t0: f64, t1: f64) -> Option<f64> {
     Some(revolutions[settled_from].0)
 }
 
+/// A beam's angle as a key that the same beam of another revolution shares: millidegrees (a
+/// lidar's angles repeat from one revolution to the next to far better than that).
+fn angle_key(angle_deg: f64) -> i64 {
+    (angle_deg * 1e3).round() as i64
+}
+
 /// The median over the beams both revolutions read of how much their ranges differ.
-fn median_change(a: &[(u16, f64)], b: &[(u16, f64)]) -> Option<f64> {
+fn median_change(a: &[(i64, f64)], b: &[(i64, f64)]) -> Option<f64> {
     let mut by_angle = std::collections::HashMap::with_capacity(a.len());
     for &(angle, r) in a {
         by_angle.insert(angle, r);
@@ -225,7 +231,7 @@ mod tests {
             out.push(LidarSample {
                 t_s: t,
                 rev: i / 360,
-                angle_deg: angle,
+                angle_deg: f64::from(angle),
                 range_m: range(t, angle),
                 strength: 100,
                 invalid: false,

@@ -15,8 +15,79 @@ use super::options::DetectionOptions;
 use super::stops::Stop;
 use crate::stats::median;
 
-/// Beams per revolution: the XV-11 takes one reading per degree.
+/// Beams per revolution of the XV-11, one reading per degree (a scan's own count is
+/// [`StopScan::beams`]'s length).
 pub const BEAMS: usize = 360;
+
+/// A lidar's beams: `count` a revolution, beam `i` at `offset_deg + i·step_deg` (lidar frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamGrid {
+    /// Beams per revolution.
+    pub count: usize,
+    /// Degrees between neighbouring beams (360 / count).
+    pub step_deg: f64,
+    /// Beam 0's angle, degrees in [0, step).
+    pub offset_deg: f64,
+}
+
+impl BeamGrid {
+    /// The XV-11's: 360 beams, one per whole degree.
+    pub const XV11: BeamGrid = BeamGrid {
+        count: BEAMS,
+        step_deg: 1.0,
+        offset_deg: 0.0,
+    };
+
+    /// The grid of the readings: the spacing is the median step between consecutive readings
+    /// of a revolution, made a whole fraction of a turn; the XV-11's when there are too few
+    /// readings to tell.
+    #[must_use]
+    pub fn of(lidar: &[LidarSample]) -> Self {
+        let mut steps: Vec<f64> = lidar
+            .windows(2)
+            .filter(|w| w[0].rev == w[1].rev)
+            // The angle between neighbours, whichever way the lidar turns and across 0°.
+            .map(|w| {
+                let d = (w[1].angle_deg - w[0].angle_deg).rem_euclid(360.0);
+                d.min(360.0 - d)
+            })
+            .filter(|d| *d > 1e-6)
+            .collect();
+        if steps.is_empty() {
+            return Self::XV11;
+        }
+        let step = median(&mut steps);
+        // At most a reading every 0.01° (36,000 a revolution): finer is not a lidar's grid.
+        let count = ((360.0 / step).round() as usize).clamp(1, 36_000);
+        let step_deg = 360.0 / count as f64;
+        let offset_deg = lidar[0].angle_deg.rem_euclid(step_deg);
+        // An offset of nearly a whole step is beam 0 itself.
+        let offset_deg = if step_deg - offset_deg < 1e-6 {
+            0.0
+        } else {
+            offset_deg
+        };
+        Self {
+            count,
+            step_deg,
+            offset_deg,
+        }
+    }
+
+    /// The beam a reading at `angle_deg` belongs to.
+    #[must_use]
+    pub fn index(&self, angle_deg: f64) -> usize {
+        let i = ((angle_deg - self.offset_deg) / self.step_deg).round();
+        (i.rem_euclid(self.count as f64) as usize) % self.count
+    }
+
+    /// Beam `i`'s angle, radians (`i` may run past a turn: segments are unwrapped).
+    #[must_use]
+    pub fn angle_rad(&self, i: usize) -> f64 {
+        // The XV-11's (0 + i·1) is exactly the whole degree i.
+        (self.offset_deg + i as f64 * self.step_deg).to_radians()
+    }
+}
 
 /// One reading kept for a beam.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,11 +127,13 @@ impl Beam {
     }
 }
 
-/// A stop's averaged scan, beam `i` at `i` degrees in the lidar frame.
+/// A stop's averaged scan, beam `i` at `grid.angle_rad(i)` in the lidar frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StopScan {
-    /// The 360 beams.
+    /// The beams of one revolution (`grid.count`).
     pub beams: Vec<Beam>,
+    /// Where each beam points.
+    pub grid: BeamGrid,
     /// Revolutions (complete or not) that contributed.
     pub revolutions: usize,
 }
@@ -71,14 +144,16 @@ pub fn average_stop(lidar: &[LidarSample], stop: &Stop, opts: &DetectionOptions)
     let first = lidar.partition_point(|s| s.t_s < stop.t_start_s);
     let last = lidar.partition_point(|s| s.t_s <= stop.t_end_s);
     let window = &lidar[first..last];
-    let mut raw: Vec<Vec<Reading>> = vec![Vec::new(); BEAMS];
-    let mut sampled = vec![0usize; BEAMS];
+    let grid = BeamGrid::of(window);
+    let beams_n = grid.count;
+    let mut raw: Vec<Vec<Reading>> = vec![Vec::new(); beams_n];
+    let mut sampled = vec![0usize; beams_n];
     let mut revs: Vec<u64> = Vec::new();
     for s in window {
         if revs.last() != Some(&s.rev) {
             revs.push(s.rev);
         }
-        let i = usize::from(s.angle_deg) % BEAMS;
+        let i = grid.index(s.angle_deg);
         sampled[i] += 1;
         if !s.invalid && s.range_m > 0.0 && s.range_m.is_finite() {
             raw[i].push(Reading {
@@ -105,10 +180,10 @@ pub fn average_stop(lidar: &[LidarSample], stop: &Stop, opts: &DetectionOptions)
         .collect();
     // Second pass: a beam between two neighbours at clearly different ranges (an edge) keeps the
     // readings on its majority's side of the midpoint between them.
-    let beams = (0..BEAMS)
+    let beams = (0..beams_n)
         .map(|i| {
-            let prev = levels[(i + BEAMS - 1) % BEAMS];
-            let next = levels[(i + 1) % BEAMS];
+            let prev = levels[(i + beams_n - 1) % beams_n];
+            let next = levels[(i + 1) % beams_n];
             let split = match (prev, next) {
                 (Some((a, sa)), Some((b, sb))) => {
                     let (lo, hi) = (a.min(b), a.max(b));
@@ -122,6 +197,7 @@ pub fn average_stop(lidar: &[LidarSample], stop: &Stop, opts: &DetectionOptions)
         .collect();
     StopScan {
         beams,
+        grid,
         revolutions: revs.len(),
     }
 }
@@ -177,6 +253,50 @@ fn average(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn revolution(angles: impl Iterator<Item = f64>) -> Vec<LidarSample> {
+        angles
+            .map(|angle_deg| LidarSample {
+                t_s: 0.0,
+                rev: 0,
+                angle_deg,
+                range_m: 1.0,
+                strength: 1,
+                invalid: false,
+                warning: false,
+                true_range_m: None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_beam_grid_is_the_lidars_own() {
+        assert_eq!(
+            BeamGrid::of(&revolution((0..360).map(f64::from))),
+            BeamGrid::XV11
+        );
+        let half = BeamGrid::of(&revolution((0..720).map(|i| f64::from(i) * 0.5)));
+        assert_eq!(
+            (half.count, half.step_deg, half.offset_deg),
+            (720, 0.5, 0.0)
+        );
+        assert_eq!(half.index(359.5), 719);
+        assert_eq!(half.index(359.9), 0);
+        // 1,080 readings a third of a degree apart, starting a sixth of a degree off 0; a lost
+        // reading (a step of two) does not change the grid.
+        let third = 360.0 / 1080.0;
+        let angles = (0..1080)
+            .filter(|i| *i != 7)
+            .map(|i| (f64::from(i) + 0.5) * third);
+        let grid = BeamGrid::of(&revolution(angles));
+        assert_eq!(grid.count, 1080);
+        assert!((grid.offset_deg - third / 2.0).abs() < 1e-9);
+        assert_eq!(grid.index((8.5) * third), 8);
+        // A lidar turning clockwise from 180° (a LaserScan from +π with a negative increment).
+        let clockwise = (0..720).map(|i| (180.0 - f64::from(i) * 0.5).rem_euclid(360.0));
+        assert_eq!(BeamGrid::of(&revolution(clockwise)).count, 720);
+        assert!((grid.angle_rad(8) - (8.5 * third).to_radians()).abs() < 1e-12);
+    }
 
     #[test]
     fn an_edge_beam_keeps_its_majority_surface() {

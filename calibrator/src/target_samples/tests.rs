@@ -10,7 +10,7 @@ fn rec_with(commands: Vec<CommandSample>, revs: u64) -> Recording {
             .map(|r| LidarSample {
                 t_s: r as f64 * 0.2,
                 rev: r,
-                angle_deg: 0,
+                angle_deg: 0.0,
                 range_m: 1.0,
                 strength: 100,
                 invalid: r == 1,

@@ -40,7 +40,7 @@ pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
     for s in samples {
         rev_start
             .entry(s.rev)
-            .or_insert(s.t_s - f64::from(s.angle_deg) * period);
+            .or_insert(s.t_s - s.angle_deg * period);
     }
     let valid: Vec<_> = samples
         .iter()
@@ -51,7 +51,7 @@ pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
         .map(|s| LidarQuery {
             t_s: s.t_s,
             rev_start_s: rev_start[&s.rev],
-            angle_deg: f64::from(s.angle_deg),
+            angle_deg: s.angle_deg,
         })
         .collect();
     let nominal = ctx

@@ -5,7 +5,7 @@
 use super::{beam, occluded, points, Detection, Reject, Segment, FREE_FIT_MIN_BEAMS};
 use crate::landmarks::circle_fit::{dist, fit_free, fit_known_radius, line_rms};
 use crate::landmarks::options::DetectionOptions;
-use crate::landmarks::scan::{Beam, StopScan, BEAMS};
+use crate::landmarks::scan::{Beam, StopScan};
 use hilsim_recording::wrap_angle;
 
 /// A segment's verdict: each test a cylinder of radius `r` passes and a wall or clutter does not,
@@ -30,11 +30,14 @@ pub(super) fn judge(
     let circle = fit_cylinder(scan, seg, &pts, &angles, r, opts)?;
     let free_radius_m = free_radius(scan, seg, &pts, r, opts)?;
     // The edges' bearing, unless it disagrees with the circle fit by more than the fit's own
-    // uncertainty allows (a degree plus a quarter of the landmark's angular width): then
+    // uncertainty allows (a beam spacing plus a quarter of the landmark's angular width): then
     // something else shapes the hit profile.
     let psi_fit = circle.psi;
     let (psi, from_edges) = match edge_bearing(scan, seg, &angles) {
-        Some(b) if (b - psi_fit).abs() < 1f64.to_radians() + circle.half.to_radians() / 2.0 => {
+        Some(b)
+            if (b - psi_fit).abs()
+                < scan.grid.step_deg.to_radians() + circle.half.to_radians() / 2.0 =>
+        {
             (b, true)
         }
         _ => (psi_fit, false),
@@ -104,7 +107,7 @@ fn fit_cylinder(
         return Err(Reject::Far);
     }
     // Beam spacing at the segment's range, plus the noise of the averaged ends.
-    let spacing = near * 1f64.to_radians();
+    let spacing = near * scan.grid.step_deg.to_radians();
     let end_noise = 2.0 * (beam(scan, seg, 0).sem_m() + beam(scan, seg, n - 1).sem_m());
     if dist(pts[0], pts[n - 1]) > 2.0 * r + 2.0 * spacing + end_noise + 0.02 {
         return Err(Reject::TooLong);
@@ -233,7 +236,7 @@ fn central_range(
 fn edge_bearing(scan: &StopScan, seg: Segment, angles: &[f64]) -> Option<f64> {
     let b = &scan.beams;
     let n = seg.len;
-    let at = |k: isize| &b[(seg.first as isize + k).rem_euclid(BEAMS as isize) as usize];
+    let at = |k: isize| &b[(seg.first as isize + k).rem_euclid(b.len() as isize) as usize];
     let side = |edge: &Beam, out: &Beam| -> Option<f64> {
         if out.valid {
             let gap = out.mean_m - edge.mean_m;
@@ -245,7 +248,9 @@ fn edge_bearing(scan: &StopScan, seg: Segment, angles: &[f64]) -> Option<f64> {
     };
     let left = side(at(0), at(-1))?;
     let right = side(at(n as isize - 1), at(n as isize))?;
-    let step = angles.get(1).map_or(1f64.to_radians(), |a| a - angles[0]);
+    let step = angles
+        .get(1)
+        .map_or(scan.grid.step_deg.to_radians(), |a| a - angles[0]);
     let (mut sw, mut swa) = (0.0, 0.0);
     for k in -2..(n as isize + 2) {
         let beam = at(k);

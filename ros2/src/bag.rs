@@ -1,0 +1,365 @@
+//! Reading a ROS 2 bag's MCAP files as a stream of records: never the whole file in memory
+//! (mcap's sans-I/O linear reader, fed from the file in pieces; a chunk is decompressed as it
+//! is read), so a bag of any size reads in bounded memory.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{Read, Seek};
+use std::path::{Path, PathBuf};
+
+use mcap::records::Record;
+use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
+use mcap::McapError;
+
+use crate::Error;
+
+/// The largest record read whole (a message, a schema): far above any scan (a 3,600-reading
+/// LaserScan with intensities is 29 kB) and below what would exhaust memory on purpose.
+const RECORD_LENGTH_LIMIT: usize = 64 << 20;
+
+/// A topic of one MCAP file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Channel {
+    /// The channel's id in its file.
+    pub id: u16,
+    /// The topic, e.g. `/scan`.
+    pub topic: String,
+    /// The message type as the schema names it, e.g. `sensor_msgs/msg/LaserScan`.
+    pub type_name: String,
+    /// How messages are encoded (`cdr` for ROS 2).
+    pub message_encoding: String,
+}
+
+/// A record of interest in a file's stream.
+pub(crate) enum Item<'a> {
+    /// A channel, before its first message.
+    Channel(Channel),
+    /// A message.
+    Message {
+        channel_id: u16,
+        log_time: u64,
+        data: &'a [u8],
+    },
+    /// A metadata record (name, key/value pairs).
+    Metadata(mcap::records::Metadata),
+}
+
+/// The MCAP files of a bag: the file itself, or those a bag directory's `metadata.yaml` lists
+/// (in order; split bags have several).
+///
+/// # Errors
+/// Not a file or a bag directory, a directory without `metadata.yaml`, a bag whose storage is
+/// not MCAP.
+pub fn bag_files(bag: &Path) -> Result<Vec<PathBuf>, Error> {
+    let meta = std::fs::metadata(bag).map_err(|err| Error::bag(bag, err.to_string()))?;
+    if meta.is_file() {
+        return Ok(vec![bag.to_path_buf()]);
+    }
+    if !meta.is_dir() {
+        return Err(Error::bag(bag, "neither an MCAP file nor a bag directory"));
+    }
+    let yaml_path = bag.join("metadata.yaml");
+    let yaml = read_small(&yaml_path)?;
+    if let Some(storage) = yaml_value(&yaml, "storage_identifier") {
+        if storage != "mcap" {
+            return Err(Error::bag(
+                &yaml_path,
+                format!(
+                    "storage `{storage}`, not MCAP: convert it first (`ros2 bag convert` to \
+                     storage mcap)"
+                ),
+            ));
+        }
+    }
+    let mut files: Vec<PathBuf> = listed_files(&yaml)
+        .into_iter()
+        .map(|name| bag.join(name))
+        .collect();
+    if files.is_empty() {
+        // No list: every .mcap file, split files in their index order (`name_2` before
+        // `name_10`).
+        let entries = std::fs::read_dir(bag).map_err(|err| Error::bag(bag, err.to_string()))?;
+        for entry in entries {
+            let path = entry
+                .map_err(|err| Error::bag(bag, err.to_string()))?
+                .path();
+            if path.extension().is_some_and(|e| e == "mcap") {
+                files.push(path);
+            }
+        }
+        files.sort_by_key(|p| {
+            let stem = p
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .to_string();
+            let digits = stem.len() - stem.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+            let index: u64 = stem[stem.len() - digits..].parse().unwrap_or(0);
+            (stem[..stem.len() - digits].to_string(), index)
+        });
+    }
+    if files.is_empty() {
+        return Err(Error::bag(bag, "a bag directory without an .mcap file"));
+    }
+    Ok(files)
+}
+
+fn read_small(path: &Path) -> Result<String, Error> {
+    let file = File::open(path).map_err(|err| Error::bag(path, err.to_string()))?;
+    let mut text = String::new();
+    // metadata.yaml is a few kB; a larger one is not a bag's.
+    file.take(1 << 20)
+        .read_to_string(&mut text)
+        .map_err(|err| Error::bag(path, format!("not a bag's metadata.yaml ({err})")))?;
+    Ok(text)
+}
+
+/// The value of `key: value` at any depth of a YAML text (enough for rosbag2's scalars).
+fn yaml_value<'a>(yaml: &'a str, key: &str) -> Option<&'a str> {
+    yaml.lines().find_map(|line| {
+        let (k, v) = line.trim().split_once(':')?;
+        (k == key).then(|| v.trim().trim_matches(['"', '\'']))
+    })
+}
+
+/// rosbag2's `relative_file_paths:` list.
+fn listed_files(yaml: &str) -> Vec<String> {
+    let mut lines = yaml.lines().map(str::trim);
+    if !lines.any(|l| l == "relative_file_paths:") {
+        return Vec::new();
+    }
+    lines
+        .map_while(|l| l.strip_prefix("- "))
+        .map(|name| name.trim().trim_matches(['"', '\'']).to_string())
+        .collect()
+}
+
+/// One line for an MCAP error.
+fn mcap_error(path: &Path, err: McapError) -> Error {
+    let message = match err {
+        McapError::BadMagic => "not an MCAP file (a ROS 2 bag's storage must be MCAP)".to_string(),
+        McapError::UnsupportedCompression(name) => {
+            format!(
+                "a chunk compressed with `{name}`, which hilsim cannot read (zstd and lz4 only)"
+            )
+        }
+        McapError::UnexpectedEof | McapError::UnexpectedEoc => {
+            "truncated: the file ends inside a record".to_string()
+        }
+        McapError::Io(err) => err.to_string(),
+        other => format!("not a readable MCAP file ({other})"),
+    };
+    Error::bag(path, message)
+}
+
+/// The channels of an MCAP file: from its summary section when it has one (a read of the end
+/// of the file), else from a pass over the whole file.
+///
+/// # Errors
+/// The file cannot be read, or is not MCAP.
+pub fn channels(path: &Path) -> Result<Vec<Channel>, Error> {
+    if let Some(found) = summary_channels(path)? {
+        if !found.is_empty() {
+            return Ok(found);
+        }
+    }
+    let mut found = Vec::new();
+    stream(path, |item| {
+        if let Item::Channel(channel) = item {
+            found.push(channel);
+        }
+        Ok(())
+    })?;
+    Ok(found)
+}
+
+/// The summary's channels; `None` when there is no summary or it cannot be read (the full pass
+/// then decides whether the file is good).
+fn summary_channels(path: &Path) -> Result<Option<Vec<Channel>>, Error> {
+    let mut file = File::open(path).map_err(|err| Error::bag(path, err.to_string()))?;
+    let size = file
+        .metadata()
+        .map_err(|err| Error::bag(path, err.to_string()))?
+        .len();
+    let mut reader = SummaryReader::new_with_options(
+        SummaryReaderOptions::default()
+            .with_file_size(size)
+            .with_record_length_limit(RECORD_LENGTH_LIMIT),
+    );
+    while let Some(event) = reader.next_event() {
+        let Ok(event) = event else { return Ok(None) };
+        match event {
+            SummaryReadEvent::ReadRequest(need) => {
+                let Ok(read) = file.read(reader.insert(need)) else {
+                    return Ok(None);
+                };
+                reader.notify_read(read);
+            }
+            SummaryReadEvent::SeekRequest(to) => {
+                let Ok(at) = file.seek(to) else {
+                    return Ok(None);
+                };
+                reader.notify_seeked(at);
+            }
+        }
+    }
+    let Some(summary) = reader.finish() else {
+        return Ok(None);
+    };
+    let mut found: Vec<Channel> = summary
+        .channels
+        .values()
+        .map(|c| Channel {
+            id: c.id,
+            topic: c.topic.clone(),
+            type_name: c
+                .schema
+                .as_ref()
+                .map(|s| s.name.clone())
+                .unwrap_or_default(),
+            message_encoding: c.message_encoding.clone(),
+        })
+        .collect();
+    found.sort_by_key(|c| c.id);
+    Ok(Some(found))
+}
+
+/// The number of messages in an MCAP file, by reading it whole (every chunk decompressed and
+/// its CRC checked, no message decoded).
+///
+/// # Errors
+/// As [`channels`], and a truncated or corrupt file.
+pub fn count_messages(path: &Path) -> Result<u64, Error> {
+    let mut count = 0;
+    stream(path, |item| {
+        if let Item::Message { .. } = item {
+            count += 1;
+        }
+        Ok(())
+    })?;
+    Ok(count)
+}
+
+/// Reads an MCAP file from start to end, handing each channel, message and metadata record to
+/// `visit` in file order; `visit`'s error ends the read.
+///
+/// # Errors
+/// The file cannot be read, is not MCAP, is truncated or corrupt (chunk CRCs are checked), or a
+/// chunk uses a compression this build lacks; or `visit`'s error.
+pub(crate) fn stream(
+    path: &Path,
+    mut visit: impl FnMut(Item<'_>) -> Result<(), Error>,
+) -> Result<(), Error> {
+    stream_while(path, |item| visit(item).map(|()| true))
+}
+
+/// As [`stream`], until `visit` returns `false`.
+///
+/// # Errors
+/// As [`stream`].
+pub(crate) fn stream_while(
+    path: &Path,
+    mut visit: impl FnMut(Item<'_>) -> Result<bool, Error>,
+) -> Result<(), Error> {
+    let mut file = File::open(path).map_err(|err| Error::bag(path, err.to_string()))?;
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_validate_chunk_crcs(true)
+            .with_record_length_limit(RECORD_LENGTH_LIMIT),
+    );
+    let mut schemas: HashMap<u16, String> = HashMap::new();
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|err| mcap_error(path, err))? {
+            LinearReadEvent::ReadRequest(need) => {
+                // Large reads: the reader asks for what the next record needs, often a few
+                // bytes; 1 MiB at a time keeps system calls rare and memory flat.
+                let read = file
+                    .read(reader.insert(need.max(1 << 20)))
+                    .map_err(|err| Error::bag(path, err.to_string()))?;
+                reader.notify_read(read);
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                let go_on =
+                    match mcap::parse_record(opcode, data).map_err(|err| mcap_error(path, err))? {
+                        Record::Schema { header, .. } => {
+                            schemas.insert(header.id, header.name);
+                            true
+                        }
+                        Record::Channel(c) => visit(Item::Channel(Channel {
+                            id: c.id,
+                            topic: c.topic,
+                            type_name: schemas.get(&c.schema_id).cloned().unwrap_or_default(),
+                            message_encoding: c.message_encoding,
+                        }))?,
+                        Record::Message { header, data } => visit(Item::Message {
+                            channel_id: header.channel_id,
+                            log_time: header.log_time,
+                            data: &data,
+                        })?,
+                        Record::Metadata(m) => visit(Item::Metadata(m))?,
+                        _ => true,
+                    };
+                if !go_on {
+                    return Ok(());
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rosbag2_metadata_lists_its_files() {
+        let yaml = "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  \
+                    relative_file_paths:\n    - run_0.mcap\n    - 'run_1.mcap'\n  \
+                    starting_time:\n    nanoseconds_since_epoch: 1\n";
+        assert_eq!(yaml_value(yaml, "storage_identifier"), Some("mcap"));
+        assert_eq!(listed_files(yaml), vec!["run_0.mcap", "run_1.mcap"]);
+    }
+
+    #[test]
+    fn a_sqlite_bag_and_a_missing_one_are_one_line_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = bag_files(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("metadata.yaml"), "{err}");
+        std::fs::write(
+            dir.path().join("metadata.yaml"),
+            "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n",
+        )
+        .unwrap();
+        let err = bag_files(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("storage `sqlite3`, not MCAP"), "{err}");
+        std::fs::write(dir.path().join("metadata.yaml"), "x: 1\n").unwrap();
+        for name in ["b_10.mcap", "b_2.mcap", "b_0.mcap"] {
+            std::fs::write(dir.path().join(name), b"").unwrap();
+        }
+        let names: Vec<_> = bag_files(dir.path())
+            .unwrap()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(names, ["b_0.mcap", "b_2.mcap", "b_10.mcap"]);
+    }
+
+    #[test]
+    fn not_mcap_and_truncated_files_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.mcap");
+        std::fs::write(&path, b"hello, this is not an MCAP file at all").unwrap();
+        let err = stream(&path, |_| Ok(())).unwrap_err().to_string();
+        assert!(err.contains("x.mcap: not an MCAP file"), "{err}");
+        // The magic and half a header record.
+        std::fs::write(
+            &path,
+            b"\x89MCAP0\r\n\x01\x40\x00\x00\x00\x00\x00\x00\x00ros2",
+        )
+        .unwrap();
+        let err = stream(&path, |_| Ok(())).unwrap_err().to_string();
+        assert!(err.starts_with(&format!("{}: ", path.display())), "{err}");
+    }
+}

@@ -1,0 +1,46 @@
+//! The crate's error: what is wrong and with which file.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Why a bag could not be imported or a recording exported.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Error {
+    /// The bag (or the MCAP file being written) is not what it must be: its path and the one
+    /// thing wrong.
+    Bag {
+        /// The file or bag directory.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writing or reading the recording failed (the recording crate's error names the file).
+    Recording(hilsim_recording::Error),
+}
+
+impl Error {
+    pub(crate) fn bag(path: &Path, message: impl Into<String>) -> Self {
+        Self::Bag {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Bag { path, message } => write!(f, "{}: {message}", path.display()),
+            Self::Recording(err) => err.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<hilsim_recording::Error> for Error {
+    fn from(err: hilsim_recording::Error) -> Self {
+        Self::Recording(err)
+    }
+}

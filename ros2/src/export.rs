@@ -1,0 +1,639 @@
+//! A recording as an MCAP file of ROS 2 messages (profile `ros2`, schemas `ros2msg`, messages
+//! CDR), what `ros2 bag play`, RViz and Foxglove read. Topics and frames:
+//!
+//! | topic | type | frame |
+//! |---|---|---|
+//! | `/scan` | `sensor_msgs/msg/LaserScan`, one per revolution | `laser` |
+//! | `/sonar` | `sensor_msgs/msg/Range` | `sonar` |
+//! | `/odom` | `nav_msgs/msg/Odometry` (the wheel travel dead-reckoned) | `odom` → `base_link` |
+//! | `/cmd_vel` | `geometry_msgs/msg/TwistStamped` | `base_link` |
+//! | `/ground_truth/pose` | `geometry_msgs/msg/PoseStamped` | `map` |
+//! | `/tf` | `tf2_msgs/msg/TFMessage`: `map` → `base_link` (truth; else `odom` → `base_link`) | |
+//! | `/tf_static` | `tf2_msgs/msg/TFMessage`: `base_link` → `laser`, `base_link` → `sonar` | |
+//! | `/world` | `visualization_msgs/msg/MarkerArray` (with a world) | `map` |
+//! | `/scan_calibrated` | `sensor_msgs/msg/LaserScan` (with calibrated ranges) | `laser` |
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+
+use hilsim_recording::{AtomicFile, LidarSample, Recording};
+use mcap::records::{MessageHeader, Metadata};
+use mcap::write::NoSeek;
+use mcap::{Compression, WriteOptions};
+
+use crate::cdr::encode;
+use crate::definitions::schema_text;
+use crate::import::{ODOMETRY_START_KEYS, START_KEY, START_METADATA};
+use crate::msgs::{
+    ColorRgba, Header, LaserScan, Marker, MarkerArray, Odometry, Pose, PoseStamped, Quaternion,
+    Range, TfMessage, Time, Transform, TransformStamped, Twist, TwistStamped, Vector3,
+};
+use crate::Error;
+
+/// The stamp of the recording's t = 0: one second after the epoch, not zero, which ROS reads
+/// as "no time" (tf2 takes a zero stamp as "the latest").
+pub const START_NS: i64 = 1_000_000_000;
+
+/// What of the world is drawn, in the world (`map`) frame, metres and radians.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct World {
+    /// Walls as segments (from, to).
+    pub walls: Vec<[[f64; 2]; 2]>,
+    /// Upright cylinders (centre, radius).
+    pub cylinders: Vec<([f64; 2], f64)>,
+    /// Boards (centre, length, thickness, direction of the length from the x axis).
+    pub boards: Vec<([f64; 2], f64, f64, f64)>,
+}
+
+/// What an export wrote.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ExportReport {
+    /// Messages per topic.
+    pub messages: BTreeMap<String, u64>,
+}
+
+/// A recording's t_s as a stamp.
+fn stamp_ns(t_s: f64) -> i64 {
+    START_NS + (t_s * 1e9).round() as i64
+}
+
+fn header(t_ns: i64, frame: &str) -> Header {
+    Header {
+        stamp: Time::from_ns(t_ns),
+        frame_id: frame.to_string(),
+    }
+}
+
+/// rosbag2's QoS for a channel: `/tf_static` is latched (transient local), so a player sends it
+/// to subscribers that join late; the rest reliable and volatile.
+fn qos(latched: bool) -> String {
+    let never = "    sec: 2147483647\n    nsec: 4294967295\n";
+    format!(
+        "- history: 3\n  depth: 0\n  reliability: 1\n  durability: {}\n  deadline:\n{never}  \
+         lifespan:\n{never}  liveliness: 1\n  liveliness_lease_duration:\n{never}  \
+         avoid_ros_namespace_conventions: false\n",
+        if latched { 1 } else { 2 }
+    )
+}
+
+/// An MCAP file being written: channels by topic and a reused message buffer.
+struct Bag<W: Write> {
+    writer: mcap::Writer<NoSeek<W>>,
+    channels: BTreeMap<&'static str, u16>,
+    sequence: u32,
+    buffer: Vec<u8>,
+    report: ExportReport,
+}
+
+impl<W: Write> Bag<W> {
+    fn channel(&mut self, topic: &'static str, type_name: &str) -> Result<u16, mcap::McapError> {
+        if let Some(&id) = self.channels.get(topic) {
+            return Ok(id);
+        }
+        let text = schema_text(type_name).unwrap_or_default();
+        let schema = self
+            .writer
+            .add_schema(type_name, "ros2msg", text.as_bytes())?;
+        let metadata = BTreeMap::from([(
+            "offered_qos_profiles".to_string(),
+            qos(topic == "/tf_static"),
+        )]);
+        let id = self.writer.add_channel(schema, topic, "cdr", &metadata)?;
+        self.channels.insert(topic, id);
+        Ok(id)
+    }
+
+    fn write<T: serde::Serialize>(
+        &mut self,
+        topic: &'static str,
+        type_name: &str,
+        t_ns: i64,
+        message: &T,
+    ) -> Result<(), mcap::McapError> {
+        let channel_id = self.channel(topic, type_name)?;
+        encode(message, &mut self.buffer);
+        let time = u64::try_from(t_ns).unwrap_or(0);
+        self.sequence = self.sequence.wrapping_add(1);
+        self.writer.write_to_known_channel(
+            &MessageHeader {
+                channel_id,
+                sequence: self.sequence,
+                log_time: time,
+                publish_time: time,
+            },
+            &self.buffer,
+        )?;
+        *self.report.messages.entry(topic.to_string()).or_insert(0) += 1;
+        Ok(())
+    }
+}
+
+/// One message to write, in time order.
+#[derive(Clone, Copy)]
+enum Event {
+    /// A revolution: the range of lidar rows.
+    Scan(usize, usize),
+    Sonar(usize),
+    Odometry(usize),
+    Command(usize),
+    Truth(usize),
+}
+
+/// Writes `recording` as an MCAP file at `out` (atomically: a temporary sibling renamed into
+/// place when complete), with `world` drawn as markers when given; chunks zstd-compressed (as
+/// `ros2 bag record --storage-preset-profile zstd_fast` writes them).
+///
+/// # Errors
+/// The file cannot be written.
+pub fn export(
+    recording: &Recording,
+    world: Option<&World>,
+    out: &Path,
+) -> Result<ExportReport, Error> {
+    let options = ExportOptions {
+        world,
+        ..ExportOptions::default()
+    };
+    export_with(recording, &options, out)
+}
+
+/// What an export writes besides the recording.
+#[derive(Debug, Clone, Copy)]
+pub struct ExportOptions<'a> {
+    /// The world, drawn as markers (`/world`).
+    pub world: Option<&'a World>,
+    /// zstd chunks (else plain, as rosbag2's default preset writes them).
+    pub compress: bool,
+    /// A calibrated range for each lidar row (NaN for none), sent as `/scan_calibrated`.
+    pub calibrated_m: Option<&'a [f64]>,
+}
+
+impl Default for ExportOptions<'_> {
+    fn default() -> Self {
+        Self {
+            world: None,
+            compress: true,
+            calibrated_m: None,
+        }
+    }
+}
+
+/// As [`export`], with the options given.
+///
+/// # Errors
+/// The file cannot be written, or `calibrated_m` is not one range per lidar row.
+pub fn export_with(
+    recording: &Recording,
+    options: &ExportOptions<'_>,
+    out: &Path,
+) -> Result<ExportReport, Error> {
+    let rows = recording.lidar.as_ref().map_or(0, Vec::len);
+    if options.calibrated_m.is_some_and(|c| c.len() != rows) {
+        return Err(Error::bag(out, "calibrated ranges: not one per lidar row"));
+    }
+    let (world, compress) = (options.world, options.compress);
+    let file = AtomicFile::create(out)?;
+    let fail = |err: mcap::McapError| Error::bag(out, err.to_string());
+    let writer = WriteOptions::new()
+        .profile("ros2")
+        .library(concat!("hilsim ", env!("CARGO_PKG_VERSION")))
+        .compression(compress.then_some(Compression::Zstd))
+        .disable_seeking(true)
+        .create(NoSeek::new(file))
+        .map_err(fail)?;
+    let mut bag = Bag {
+        writer,
+        channels: BTreeMap::new(),
+        sequence: 0,
+        buffer: Vec::with_capacity(1 << 14),
+        report: ExportReport::default(),
+    };
+    write_all(&mut bag, recording, world, options.calibrated_m).map_err(fail)?;
+    bag.writer.finish().map_err(fail)?;
+    let report = std::mem::take(&mut bag.report);
+    let file = bag.writer.into_inner().into_inner();
+    file.commit()?;
+    Ok(report)
+}
+
+fn write_all<W: Write>(
+    bag: &mut Bag<W>,
+    rec: &Recording,
+    world: Option<&World>,
+    calibrated_m: Option<&[f64]>,
+) -> Result<(), mcap::McapError> {
+    let mut metadata = BTreeMap::from([(START_KEY.to_string(), START_NS.to_string())]);
+    if let Some(first) = rec.odometry.as_ref().and_then(|o| o.first()) {
+        for (key, value) in ODOMETRY_START_KEYS
+            .iter()
+            .zip([first.left_m, first.right_m])
+        {
+            metadata.insert((*key).to_string(), value.to_string());
+        }
+    }
+    bag.writer.write_metadata(&Metadata {
+        name: START_METADATA.to_string(),
+        metadata,
+    })?;
+    // The sensors' mounts, once.
+    let mut mounts = Vec::new();
+    if rec.lidar.is_some() {
+        let lidar = rec.meta.lidar.unwrap_or_default();
+        mounts.push(transform(
+            START_NS,
+            "base_link",
+            "laser",
+            lidar.x_m,
+            lidar.y_m,
+            lidar.yaw_rad(),
+        ));
+    }
+    if let (Some(_), Some(sonar)) = (&rec.sonar, &rec.meta.sonar) {
+        mounts.push(transform(
+            START_NS,
+            "base_link",
+            "sonar",
+            sonar.x_m,
+            sonar.y_m,
+            sonar.yaw_deg.to_radians(),
+        ));
+    }
+    if !mounts.is_empty() {
+        bag.write(
+            "/tf_static",
+            "tf2_msgs/msg/TFMessage",
+            START_NS,
+            &TfMessage { transforms: mounts },
+        )?;
+    }
+    if let Some(world) = world {
+        bag.write(
+            "/world",
+            "visualization_msgs/msg/MarkerArray",
+            START_NS,
+            &markers(world),
+        )?;
+    }
+    let events = events(rec);
+    let lidar = rec.lidar.as_deref().unwrap_or_default();
+    let sonar = rec.sonar.as_deref().unwrap_or_default();
+    let truth = rec.truth.as_deref().unwrap_or_default();
+    let odometry = rec.odometry.as_deref().unwrap_or_default();
+    let range_max = lidar
+        .iter()
+        .filter(|s| !s.invalid)
+        .map(|s| s.range_m as f32)
+        .fold(1.0f32, f32::max);
+    let sonar_max = sonar
+        .iter()
+        .map(|s| s.range_m as f32)
+        .fold(1.0f32, f32::max);
+    let sonar_fov = rec
+        .meta
+        .sonar
+        .as_ref()
+        .map_or(0.0, |s| (2.0 * s.half_angle_deg).to_radians() as f32);
+    let wheel_base = rec.meta.robot.wheel_base_m;
+    let mut dead_reckoning = DeadReckoning::default();
+    for (t_s, event) in events {
+        let t_ns = stamp_ns(t_s);
+        match event {
+            Event::Scan(from, to) => {
+                let mut scan = laser_scan(&lidar[from..to], range_max);
+                bag.write("/scan", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
+                if let Some(calibrated) = calibrated_m {
+                    // The same revolution, each reading replaced by its calibrated range.
+                    let reported = laser_scan_ranges(&lidar[from..to], |i| {
+                        let d = calibrated[from + i];
+                        if d.is_finite() {
+                            d as f32
+                        } else {
+                            f32::NAN
+                        }
+                    });
+                    scan.ranges = reported;
+                    scan.range_max = f32::MAX;
+                    bag.write("/scan_calibrated", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
+                }
+            }
+            Event::Sonar(i) => {
+                let range = Range {
+                    header: header(t_ns, "sonar"),
+                    radiation_type: 0,
+                    field_of_view: sonar_fov,
+                    min_range: 0.0,
+                    max_range: sonar_max,
+                    range: sonar[i].range_m as f32,
+                };
+                bag.write("/sonar", "sensor_msgs/msg/Range", t_ns, &range)?;
+            }
+            Event::Command(i) => {
+                let c = &rec.commands[i];
+                let twist = TwistStamped {
+                    header: header(t_ns, "base_link"),
+                    twist: twist(
+                        0.5 * (c.left_mps + c.right_mps),
+                        (c.right_mps - c.left_mps) / wheel_base,
+                    ),
+                };
+                bag.write("/cmd_vel", "geometry_msgs/msg/TwistStamped", t_ns, &twist)?;
+            }
+            Event::Odometry(i) => {
+                let o = &odometry[i];
+                let (pose, velocity) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
+                let mut message = Odometry {
+                    header: header(t_ns, "odom"),
+                    child_frame_id: "base_link".into(),
+                    ..Odometry::default()
+                };
+                message.pose.pose = pose;
+                message.twist.twist = velocity;
+                bag.write("/odom", "nav_msgs/msg/Odometry", t_ns, &message)?;
+                if truth.is_empty() {
+                    let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
+                    let tf = transform(t_ns, "odom", "base_link", x, y, yaw);
+                    bag.write(
+                        "/tf",
+                        "tf2_msgs/msg/TFMessage",
+                        t_ns,
+                        &TfMessage {
+                            transforms: vec![tf],
+                        },
+                    )?;
+                }
+            }
+            Event::Truth(i) => {
+                let p = &truth[i];
+                let pose = PoseStamped {
+                    header: header(t_ns, "map"),
+                    pose: pose(p.x_m, p.y_m, p.yaw_rad),
+                };
+                bag.write(
+                    "/ground_truth/pose",
+                    "geometry_msgs/msg/PoseStamped",
+                    t_ns,
+                    &pose,
+                )?;
+                let tf = transform(t_ns, "map", "base_link", p.x_m, p.y_m, p.yaw_rad);
+                bag.write(
+                    "/tf",
+                    "tf2_msgs/msg/TFMessage",
+                    t_ns,
+                    &TfMessage {
+                        transforms: vec![tf],
+                    },
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every message's time and what it is, in time order (a stable sort: ties keep table order).
+fn events(rec: &Recording) -> Vec<(f64, Event)> {
+    let mut events = Vec::new();
+    if let Some(lidar) = &rec.lidar {
+        let mut from = 0;
+        for i in 1..=lidar.len() {
+            if i == lidar.len() || lidar[i].rev != lidar[from].rev {
+                events.push((lidar[from].t_s, Event::Scan(from, i)));
+                from = i;
+            }
+        }
+    }
+    let table = |n: usize, t: &dyn Fn(usize) -> f64, e: fn(usize) -> Event| {
+        (0..n).map(|i| (t(i), e(i))).collect::<Vec<_>>()
+    };
+    events.extend(table(
+        rec.commands.len(),
+        &|i| rec.commands[i].t_s,
+        Event::Command,
+    ));
+    if let Some(o) = &rec.odometry {
+        events.extend(table(o.len(), &|i| o[i].t_s, Event::Odometry));
+    }
+    if let Some(s) = &rec.sonar {
+        events.extend(table(s.len(), &|i| s[i].t_s, Event::Sonar));
+    }
+    if let Some(p) = &rec.truth {
+        events.extend(table(p.len(), &|i| p[i].t_s, Event::Truth));
+    }
+    events.sort_by(|a, b| a.0.total_cmp(&b.0));
+    events
+}
+
+/// A revolution's angles unwrapped into one increasing turn from the first, degrees from it,
+/// and the step between neighbouring slots (the smallest between the angles).
+fn slots(rev: &[LidarSample]) -> (Vec<f64>, f64) {
+    let first = rev[0].angle_deg;
+    let mut turns = 0.0;
+    let mut previous = first;
+    let unwrapped: Vec<f64> = rev
+        .iter()
+        .map(|s| {
+            if s.angle_deg < previous {
+                turns += 360.0;
+            }
+            previous = s.angle_deg;
+            s.angle_deg + turns - first
+        })
+        .collect();
+    let step = unwrapped
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 1e-9)
+        .fold(f64::INFINITY, f64::min);
+    (unwrapped, if step.is_finite() { step } else { 1.0 })
+}
+
+/// A reading's slot: a revolution of wildly uneven angles is capped at 100,000 slots.
+fn slot(a: f64, step: f64) -> usize {
+    ((a / step).round() as usize).min(99_999)
+}
+
+/// A LaserScan's ranges for a revolution, `range(i)` for its row i, NaN where none.
+fn laser_scan_ranges(rev: &[LidarSample], range: impl Fn(usize) -> f32) -> Vec<f32> {
+    let (unwrapped, step) = slots(rev);
+    let slots = unwrapped.last().map_or(1, |&a| slot(a, step) + 1);
+    let mut ranges = vec![f32::NAN; slots];
+    for (i, &a) in unwrapped.iter().enumerate() {
+        ranges[slot(a, step)] = range(i);
+    }
+    ranges
+}
+
+/// One revolution as a LaserScan: readings placed at `angle_min + i·angle_increment`, the
+/// increment the smallest step between the revolution's angles (a reading lost leaves a NaN);
+/// invalid readings are NaN, strengths the intensities.
+fn laser_scan(rev: &[LidarSample], range_max: f32) -> LaserScan {
+    let first = rev[0].angle_deg;
+    let (unwrapped, step) = slots(rev);
+    let slot = |a: f64| slot(a, step);
+    let slots = unwrapped.last().map_or(1, |&a| slot(a) + 1);
+    let mut ranges = vec![f32::NAN; slots];
+    let mut intensities = vec![0.0f32; slots];
+    for (s, &a) in rev.iter().zip(&unwrapped) {
+        let i = slot(a);
+        ranges[i] = if s.invalid {
+            f32::NAN
+        } else {
+            s.range_m as f32
+        };
+        intensities[i] = f32::from(s.strength);
+    }
+    let last_slot = slot(*unwrapped.last().unwrap_or(&0.0));
+    let time_increment = if last_slot > 0 {
+        (rev[rev.len() - 1].t_s - rev[0].t_s) / last_slot as f64
+    } else {
+        0.0
+    };
+    let angle_min = first.to_radians();
+    let increment = step.to_radians();
+    LaserScan {
+        header: header(stamp_ns(rev[0].t_s), "laser"),
+        angle_min: angle_min as f32,
+        angle_max: (angle_min + (slots - 1) as f64 * increment) as f32,
+        angle_increment: increment as f32,
+        time_increment: time_increment as f32,
+        scan_time: (time_increment * 360.0 / step) as f32,
+        range_min: 0.0,
+        range_max,
+        ranges,
+        intensities,
+    }
+}
+
+fn twist(v: f64, w: f64) -> Twist {
+    Twist {
+        linear: Vector3 {
+            x: v,
+            y: 0.0,
+            z: 0.0,
+        },
+        angular: Vector3 {
+            x: 0.0,
+            y: 0.0,
+            z: w,
+        },
+    }
+}
+
+fn pose(x: f64, y: f64, yaw: f64) -> Pose {
+    Pose {
+        position: Vector3 { x, y, z: 0.0 },
+        orientation: Quaternion::from_yaw(yaw),
+    }
+}
+
+fn transform(t_ns: i64, parent: &str, child: &str, x: f64, y: f64, yaw: f64) -> TransformStamped {
+    TransformStamped {
+        header: header(t_ns, parent),
+        child_frame_id: child.to_string(),
+        transform: Transform {
+            translation: Vector3 { x, y, z: 0.0 },
+            rotation: Quaternion::from_yaw(yaw),
+        },
+    }
+}
+
+/// The odometer's pose from its wheel travel: over a step the robot turns by (dr − dl)/b and
+/// moves (dl + dr)/2 along its mean heading (the midpoint rule, which the import inverts).
+#[derive(Default)]
+struct DeadReckoning {
+    last: Option<(f64, f64, f64)>,
+    x: f64,
+    y: f64,
+    yaw: f64,
+}
+
+impl DeadReckoning {
+    fn step(&mut self, t_s: f64, left: f64, right: f64, wheel_base: f64) -> (Pose, Twist) {
+        let mut velocity = Twist::default();
+        if let Some((t0, l0, r0)) = self.last {
+            let (dl, dr) = (left - l0, right - r0);
+            let ds = 0.5 * (dl + dr);
+            let turn = (dr - dl) / wheel_base;
+            let heading = self.yaw + 0.5 * turn;
+            self.x += ds * heading.cos();
+            self.y += ds * heading.sin();
+            self.yaw = hilsim_recording::wrap_angle(self.yaw + turn);
+            let dt = t_s - t0;
+            if dt > 0.0 {
+                velocity = twist(ds / dt, turn / dt);
+            }
+        }
+        self.last = Some((t_s, left, right));
+        (pose(self.x, self.y, self.yaw), velocity)
+    }
+}
+
+/// The world as markers: walls and boards as thin boxes 0.3 m high, cylinders as cylinders.
+fn markers(world: &World) -> MarkerArray {
+    const HEIGHT_M: f64 = 0.3;
+    let wall_colour = ColorRgba {
+        r: 0.6,
+        g: 0.6,
+        b: 0.65,
+        a: 1.0,
+    };
+    let board_colour = ColorRgba {
+        r: 0.8,
+        g: 0.6,
+        b: 0.35,
+        a: 1.0,
+    };
+    let cylinder_colour = ColorRgba {
+        r: 0.2,
+        g: 0.5,
+        b: 0.9,
+        a: 1.0,
+    };
+    let mut markers = Vec::new();
+    let mut add = |ns: &str, kind: i32, pose: Pose, scale: Vector3, color: ColorRgba| {
+        markers.push(Marker {
+            header: header(START_NS, "map"),
+            ns: ns.to_string(),
+            id: i32::try_from(markers.len()).unwrap_or(i32::MAX),
+            kind,
+            action: 0,
+            pose,
+            scale,
+            color,
+            ..Marker::default()
+        });
+    };
+    for [from, to] in &world.walls {
+        let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
+        let centre = [0.5 * (from[0] + to[0]), 0.5 * (from[1] + to[1])];
+        let mut p = pose(centre[0], centre[1], dy.atan2(dx));
+        p.position.z = 0.5 * HEIGHT_M;
+        let scale = Vector3 {
+            x: dx.hypot(dy),
+            y: 0.02,
+            z: HEIGHT_M,
+        };
+        add("walls", Marker::CUBE, p, scale, wall_colour);
+    }
+    for &(centre, length, thickness, yaw) in &world.boards {
+        let mut p = pose(centre[0], centre[1], yaw);
+        p.position.z = 0.5 * HEIGHT_M;
+        let scale = Vector3 {
+            x: length,
+            y: thickness,
+            z: HEIGHT_M,
+        };
+        add("boards", Marker::CUBE, p, scale, board_colour);
+    }
+    for &(centre, radius) in &world.cylinders {
+        let mut p = pose(centre[0], centre[1], 0.0);
+        p.position.z = 0.5 * HEIGHT_M;
+        let scale = Vector3 {
+            x: 2.0 * radius,
+            y: 2.0 * radius,
+            z: HEIGHT_M,
+        };
+        add("cylinders", Marker::CYLINDER, p, scale, cylinder_colour);
+    }
+    MarkerArray { markers }
+}

@@ -1,0 +1,788 @@
+//! A ROS 2 bag into a recording: each chosen topic's messages into its table as they are read
+//! (see `docs/ros2.md` for what becomes of each field).
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+use hilsim_recording::{
+    wrap_angle, CommandSample, LidarSample, Meta, OdometrySample, RecordingStream, SampleSink,
+    SonarMount, SonarSample, Tables, TruthSample,
+};
+
+use crate::bag::{self, Item};
+use crate::cdr::decode;
+use crate::msgs::{JointState, LaserScan, Odometry, PoseStamped, Range, Time, Twist, TwistStamped};
+use crate::topics::{self, Chosen, Kind, Role};
+use crate::Error;
+
+/// The metadata record an exported file starts with: its `start_ns` is the recording's t = 0,
+/// so that importing an export gives back the recording's times even when no message is at 0.
+pub(crate) const START_METADATA: &str = "hilsim";
+/// The key of the recording's t = 0 (nanoseconds, as the messages' stamps).
+pub(crate) const START_KEY: &str = "start_ns";
+/// The keys of the wheel travel at the first odometry row (an `Odometry` pose starts from
+/// nothing; a recording's encoders may not).
+pub(crate) const ODOMETRY_START_KEYS: [&str; 2] = ["odometry_left_m", "odometry_right_m"];
+
+/// Above this difference between a stamp and its log time the two come from different clocks
+/// (simulated time against the recorder's wall clock): unstamped messages (`Twist`) are then
+/// put on the stamps' clock. Below it, the difference is transport delay and is left alone.
+const OTHER_CLOCK_NS: i64 = 60_000_000_000;
+
+/// Unstamped commands held until the first stamped message says which clock they are on.
+const MAX_PENDING_COMMANDS: usize = 1 << 20;
+
+/// What `import` is told besides the bag.
+#[derive(Debug, Clone, Default)]
+pub struct ImportOptions {
+    /// Topics named for roles (the rest are found by type).
+    pub topics: BTreeMap<Role, String>,
+    /// `meta.toml` to write (mounts, wheel base, world); `None`: a minimal one.
+    pub meta: Option<Meta>,
+    /// The wheels' radius, for odometry from `JointState` wheel angles.
+    pub wheel_radius_m: Option<f64>,
+}
+
+/// What an import did.
+#[derive(Debug, Clone, Default)]
+pub struct ImportReport {
+    /// The topic read into each table, and its type.
+    pub chosen: Chosen,
+    /// Rows written into each table.
+    pub rows: BTreeMap<Role, u64>,
+    /// Bytes of MCAP read.
+    pub bytes: u64,
+    /// Sentences for people: what was assumed, skipped or repaired.
+    pub notes: Vec<String>,
+}
+
+/// Imports the bag at `bag` (an MCAP file or a bag directory) as a recording at `out`, written
+/// as it is read and put in place when complete ([`RecordingStream`]).
+///
+/// # Errors
+/// The bag cannot be read (not MCAP, truncated, an unreadable compression, a message that does
+/// not decode as its type); the topics are ambiguous; the output cannot be written.
+pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, Error> {
+    let files = bag::bag_files(bag)?;
+    let mut channels = Vec::new();
+    for file in &files {
+        channels.extend(bag::channels(file)?);
+    }
+    let topic_types = topics::topic_types(bag, &channels)?;
+    let chosen = topics::choose(bag, &topic_types, &options.topics)?;
+    for (topic, _) in chosen.values() {
+        if let Some(c) = channels.iter().find(|c| &c.topic == topic) {
+            if c.message_encoding != "cdr" {
+                return Err(Error::bag(
+                    bag,
+                    format!(
+                        "topic {topic}: message encoding `{}`, not `cdr` (ROS 2)",
+                        c.message_encoding
+                    ),
+                ));
+            }
+        }
+    }
+    let mut notes = Vec::new();
+    if chosen.is_empty() {
+        let all: Vec<_> = topic_types
+            .iter()
+            .map(|(t, ty)| format!("{t} ({ty})"))
+            .collect();
+        return Err(Error::bag(
+            bag,
+            format!(
+                "no topic of a type hilsim reads (LaserScan, Odometry, JointState, Twist, \
+                 TwistStamped, Range, PoseStamped); topics: {}",
+                if all.is_empty() {
+                    "none".to_string()
+                } else {
+                    all.join(", ")
+                }
+            ),
+        ));
+    }
+    let meta = options.meta.clone().unwrap_or_else(|| {
+        let meta = Meta::default();
+        notes.push(format!(
+            "no --meta: a minimal meta.toml (wheel base {} m, sensors at the robot's centre \
+             facing forward); give your robot's with --meta FILE",
+            meta.robot.wheel_base_m
+        ));
+        meta
+    });
+    let mut chosen = chosen;
+    if let Some((topic, Kind::JointState)) = chosen.get(&Role::Odometry) {
+        if options.wheel_radius_m.is_none() {
+            notes.push(format!(
+                "{topic} (JointState) skipped: wheel angles need --wheel-radius-m to become \
+                 wheel travel"
+            ));
+            chosen.remove(&Role::Odometry);
+        }
+    }
+    let tables = Tables {
+        odometry: chosen.contains_key(&Role::Odometry),
+        lidar: chosen.contains_key(&Role::Lidar),
+        sonar: chosen.contains_key(&Role::Sonar),
+        truth: chosen.contains_key(&Role::Truth),
+    };
+    let mut stream = RecordingStream::create(out, meta.clone(), tables)?;
+    let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m);
+    converter.t0_ns = earliest_time(&files[0], &chosen)?;
+    let mut bytes = 0;
+    for file in &files {
+        bytes += std::fs::metadata(file).map_or(0, |m| m.len());
+        read_file(file, &mut converter, &mut stream)?;
+    }
+    converter.finish(&mut stream)?;
+    // What the bag says of the sensors, where meta.toml did not.
+    let final_meta = stream.meta_mut();
+    if tables.lidar && final_meta.lidar.is_none() {
+        final_meta.lidar = Some(hilsim_recording::Mount::default());
+    }
+    if let (true, None, Some(fov)) = (tables.sonar, &final_meta.sonar, converter.sonar_fov_rad) {
+        let half_angle_deg = (0.5 * fov).to_degrees();
+        if half_angle_deg.is_finite() && (0.0..90.0).contains(&half_angle_deg) {
+            final_meta.sonar = Some(SonarMount {
+                x_m: 0.0,
+                y_m: 0.0,
+                yaw_deg: 0.0,
+                half_angle_deg: decimal_of_f32(half_angle_deg as f32),
+            });
+        }
+    }
+    stream.finish()?;
+    notes.extend(converter.notes());
+    Ok(ImportReport {
+        chosen,
+        rows: converter.rows,
+        bytes,
+        notes,
+    })
+}
+
+/// Streams one MCAP file through the converter.
+///
+/// # Errors
+/// As [`import`].
+pub fn read_file<S>(file: &Path, converter: &mut Converter, sink: &mut S) -> Result<(), Error>
+where
+    S: SampleSink<Error = hilsim_recording::Error>,
+{
+    let mut roles: HashMap<u16, (Role, Kind, String)> = HashMap::new();
+    bag::stream(file, |item| match item {
+        Item::Channel(c) => {
+            if let Some((role, (_, kind))) = converter
+                .chosen
+                .iter()
+                .find(|(_, (topic, _))| *topic == c.topic)
+            {
+                roles.insert(c.id, (*role, *kind, c.topic));
+            }
+            Ok(())
+        }
+        Item::Metadata(m) => {
+            if m.name == START_METADATA {
+                let number = |key: &str| m.metadata.get(key).and_then(|v| v.parse::<f64>().ok());
+                if converter.t0_ns.is_none() {
+                    converter.t0_ns = m.metadata.get(START_KEY).and_then(|v| v.parse().ok());
+                }
+                if let [Some(l), Some(r)] = ODOMETRY_START_KEYS.map(number) {
+                    converter.odometry_start_m = (l, r);
+                }
+            }
+            Ok(())
+        }
+        Item::Message {
+            channel_id,
+            log_time,
+            data,
+        } => {
+            let Some((role, kind, topic)) = roles.get(&channel_id) else {
+                return Ok(());
+            };
+            let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
+            converter
+                .message(*role, *kind, log_ns, data, sink)
+                .map_err(|err| match err {
+                    Fault::Message(message) => {
+                        Error::bag(file, format!("topic {topic}: {message}"))
+                    }
+                    Fault::Sink(err) => Error::Recording(err),
+                })
+        }
+    })
+}
+
+/// How far into a bag (log time) the earliest message is looked for: a scan's stamp is its first
+/// reading's, logged a revolution or more later, after other topics' messages.
+const EARLIEST_WITHIN_NS: u64 = 10_000_000_000;
+
+/// The recording's t = 0: an export's own start, else the earliest time among the first messages
+/// of the chosen topics (each topic's first within the bag's first 10 s of log time): its header
+/// stamp, or the log time of an unstamped one on the same clock. `None` when none is found
+/// (the first message converted then sets it).
+///
+/// # Errors
+/// As [`bag::stream`].
+fn earliest_time(file: &Path, chosen: &Chosen) -> Result<Option<i64>, Error> {
+    let mut roles: HashMap<u16, Kind> = HashMap::new();
+    let mut stamped: Option<i64> = None;
+    let mut unstamped: Option<i64> = None;
+    let mut start = None;
+    let mut first_log = None;
+    bag::stream_while(file, |item| {
+        match item {
+            Item::Channel(c) => {
+                if let Some((_, kind)) = chosen.values().find(|(topic, _)| *topic == c.topic) {
+                    roles.insert(c.id, *kind);
+                }
+            }
+            Item::Metadata(m) if m.name == START_METADATA => {
+                start = m
+                    .metadata
+                    .get(START_KEY)
+                    .and_then(|v| v.parse::<i64>().ok());
+                return Ok(start.is_none());
+            }
+            Item::Metadata(_) => {}
+            Item::Message {
+                channel_id,
+                log_time,
+                data,
+            } => {
+                let first = *first_log.get_or_insert(log_time);
+                if log_time.saturating_sub(first) > EARLIEST_WITHIN_NS {
+                    return Ok(false);
+                }
+                let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
+                match roles.get(&channel_id) {
+                    // Every stamped message starts with its header.
+                    Some(Kind::Twist) => {
+                        unstamped = Some(unstamped.map_or(log_ns, |t| t.min(log_ns)));
+                    }
+                    Some(_) => {
+                        if let Ok(header) = decode::<crate::msgs::Header>(data) {
+                            if !header.stamp.is_zero() {
+                                let ns = header.stamp.ns();
+                                stamped = Some(stamped.map_or(ns, |t| t.min(ns)));
+                            }
+                        }
+                    }
+                    None => {}
+                }
+            }
+        }
+        Ok(true)
+    })?;
+    if start.is_some() {
+        return Ok(start);
+    }
+    Ok(match (stamped, unstamped) {
+        // Unstamped messages count when they are on the stamps' clock.
+        (Some(s), Some(u)) if (s - u).abs() <= OTHER_CLOCK_NS => Some(s.min(u)),
+        (Some(s), _) => Some(s),
+        (None, u) => u,
+    })
+}
+
+/// Why a message could not be converted.
+pub enum Fault {
+    /// The message is bad (what is wrong).
+    Message(String),
+    /// The recording could not take the sample.
+    Sink(hilsim_recording::Error),
+}
+
+impl From<hilsim_recording::Error> for Fault {
+    fn from(err: hilsim_recording::Error) -> Self {
+        Self::Sink(err)
+    }
+}
+
+/// Messages into samples: times, revolutions, wheel travel and the order of each table.
+pub struct Converter {
+    chosen: Chosen,
+    wheel_base_m: f64,
+    wheel_radius_m: Option<f64>,
+    /// The recording's t = 0 on the stamps' clock, ns.
+    t0_ns: Option<i64>,
+    /// Stamp clock minus log clock, once a stamped message has said.
+    clock_offset_ns: Option<i64>,
+    pending_commands: Vec<(i64, Twist)>,
+    /// The latest time written into each table, and how many rows came earlier than it.
+    last_t: BTreeMap<Role, f64>,
+    reordered: BTreeMap<Role, (u64, f64)>,
+    rows: BTreeMap<Role, u64>,
+    rev: u64,
+    odometry: Option<OdometryState>,
+    /// The wheel travel at the first odometry message.
+    odometry_start_m: (f64, f64),
+    sonar_out_of_range: u64,
+    sonar_fov_rad: Option<f64>,
+}
+
+/// The last pose (or wheel angles) and the wheel travel so far.
+enum OdometryState {
+    Pose {
+        x: f64,
+        y: f64,
+        yaw: f64,
+        left_m: f64,
+        right_m: f64,
+    },
+    Joints {
+        left: usize,
+        right: usize,
+        left0: f64,
+        right0: f64,
+    },
+}
+
+impl Converter {
+    /// A converter of the `chosen` topics, for a robot of this wheel base (and wheel radius, for
+    /// joint angles).
+    #[must_use]
+    pub fn new(chosen: &Chosen, wheel_base_m: f64, wheel_radius_m: Option<f64>) -> Self {
+        Self {
+            chosen: chosen.clone(),
+            wheel_base_m,
+            wheel_radius_m,
+            t0_ns: None,
+            clock_offset_ns: None,
+            pending_commands: Vec::new(),
+            last_t: BTreeMap::new(),
+            reordered: BTreeMap::new(),
+            rows: BTreeMap::new(),
+            rev: 0,
+            odometry: None,
+            odometry_start_m: (0.0, 0.0),
+            sonar_out_of_range: 0,
+            sonar_fov_rad: None,
+        }
+    }
+
+    /// The time of a stamped message on the stamps' clock (a zero stamp, which a driver that
+    /// sets none leaves, is replaced by the log time).
+    fn stamped(&mut self, stamp: Time, log_ns: i64) -> i64 {
+        if stamp.is_zero() {
+            return log_ns + self.clock_offset_ns.unwrap_or(0);
+        }
+        let ns = stamp.ns();
+        if self.clock_offset_ns.is_none() {
+            let offset = ns - log_ns;
+            let offset = if offset.abs() > OTHER_CLOCK_NS {
+                offset
+            } else {
+                0
+            };
+            self.clock_offset_ns = Some(offset);
+            let first_pending = self.pending_commands.first().map(|(log, _)| log + offset);
+            if self.t0_ns.is_none() {
+                self.t0_ns = Some(first_pending.map_or(ns, |p| p.min(ns)));
+            }
+        }
+        ns
+    }
+
+    /// Seconds from t = 0, to the microsecond (what a recording keeps: `0.15`, not
+    /// `0.15000000000000002`; far below any sensor's timing), in the table's order.
+    /// `ns` on the stamps' clock plus `extra_ns` (a reading's offset within its scan): the
+    /// difference from t = 0 is taken in integers first, as a stamp (~1.7e18 ns) is finer than
+    /// an f64 resolves.
+    fn seconds(&mut self, role: Role, ns: i64, extra_ns: f64) -> f64 {
+        let t0 = *self.t0_ns.get_or_insert(ns);
+        let t = (((ns - t0) as f64 + extra_ns) / 1e3).round() / 1e6;
+        let last = self.last_t.entry(role).or_insert(0.0);
+        if t < *last {
+            let (count, worst) = self.reordered.entry(role).or_insert((0, 0.0));
+            *count += 1;
+            *worst = f64::max(*worst, *last - t);
+            return *last;
+        }
+        *last = t;
+        t
+    }
+
+    fn count(&mut self, role: Role, n: u64) {
+        *self.rows.entry(role).or_insert(0) += n;
+    }
+
+    /// Converts one message of `role`'s topic into samples for `sink`.
+    ///
+    /// # Errors
+    /// The message does not decode as `kind`, or `sink` fails.
+    pub fn message<S>(
+        &mut self,
+        role: Role,
+        kind: Kind,
+        log_ns: i64,
+        data: &[u8],
+        sink: &mut S,
+    ) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        self.convert(role, kind, log_ns, data, sink)?;
+        // Commands held for want of a clock go out as soon as a stamped message gives it,
+        // before any later command.
+        if let Some(offset) = self.clock_offset_ns {
+            for (log_ns, twist) in std::mem::take(&mut self.pending_commands) {
+                self.command(log_ns + offset, &twist, sink)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn convert<S>(
+        &mut self,
+        role: Role,
+        kind: Kind,
+        log_ns: i64,
+        data: &[u8],
+        sink: &mut S,
+    ) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let bad = |err: String| Fault::Message(format!("not a {} ({err})", kind.ros_name()));
+        match (role, kind) {
+            (Role::Lidar, _) => {
+                let scan: LaserScan = decode(data).map_err(bad)?;
+                self.scan(&scan, log_ns, sink)
+            }
+            (Role::Sonar, _) => {
+                let range: Range = decode(data).map_err(bad)?;
+                let ns = self.stamped(range.header.stamp, log_ns);
+                self.sonar_fov_rad
+                    .get_or_insert(f64::from(range.field_of_view));
+                let valid = range.range.is_finite()
+                    && range.range >= range.min_range
+                    && range.range <= range.max_range;
+                if !valid {
+                    self.sonar_out_of_range += 1;
+                    return Ok(());
+                }
+                let t_s = self.seconds(role, ns, 0.0);
+                self.count(role, 1);
+                Ok(sink.sonar(&SonarSample {
+                    t_s,
+                    range_m: decimal_of_f32(range.range),
+                    true_range_m: None,
+                })?)
+            }
+            (Role::Commands, Kind::TwistStamped) => {
+                let twist: TwistStamped = decode(data).map_err(bad)?;
+                let ns = self.stamped(twist.header.stamp, log_ns);
+                self.command(ns, &twist.twist, sink)
+            }
+            (Role::Commands, _) => {
+                let twist: Twist = decode(data).map_err(bad)?;
+                match self.clock_offset_ns {
+                    Some(offset) => self.command(log_ns + offset, &twist, sink),
+                    None if self.pending_commands.len() < MAX_PENDING_COMMANDS => {
+                        self.pending_commands.push((log_ns, twist));
+                        Ok(())
+                    }
+                    None => Err(Fault::Message(format!(
+                        "{MAX_PENDING_COMMANDS} commands (unstamped Twist) before any stamped \
+                         message: no clock to put them on; record them as TwistStamped"
+                    ))),
+                }
+            }
+            (Role::Truth, Kind::Odometry) => {
+                let odometry: Odometry = decode(data).map_err(bad)?;
+                let ns = self.stamped(odometry.header.stamp, log_ns);
+                self.truth(ns, &odometry.pose.pose, sink)
+            }
+            (Role::Truth, _) => {
+                let pose: PoseStamped = decode(data).map_err(bad)?;
+                let ns = self.stamped(pose.header.stamp, log_ns);
+                self.truth(ns, &pose.pose, sink)
+            }
+            (Role::Odometry, Kind::JointState) => {
+                let joints: JointState = decode(data).map_err(bad)?;
+                let ns = self.stamped(joints.header.stamp, log_ns);
+                self.joints(ns, &joints, sink)
+            }
+            (Role::Odometry, _) => {
+                let odometry: Odometry = decode(data).map_err(bad)?;
+                let ns = self.stamped(odometry.header.stamp, log_ns);
+                self.odometry(ns, &odometry, sink)
+            }
+        }
+    }
+
+    /// One revolution: reading i at `angle_min + i·angle_increment` (wrapped into [0, 360)),
+    /// taken at the stamp plus `i·time_increment`.
+    fn scan<S>(&mut self, scan: &LaserScan, log_ns: i64, sink: &mut S) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let ns = self.stamped(scan.header.stamp, log_ns);
+        if scan.ranges.is_empty() {
+            return Ok(());
+        }
+        let angle_min = decimal_of_f32(scan.angle_min);
+        let increment = decimal_of_f32(scan.angle_increment);
+        let time_increment_ns = decimal_of_f32(scan.time_increment) * 1e9;
+        let (range_min, range_max) = (scan.range_min, scan.range_max);
+        for (i, &range) in scan.ranges.iter().enumerate() {
+            let i_f = i as f64;
+            let t_s = self.seconds(Role::Lidar, ns, i_f * time_increment_ns);
+            let valid = range.is_finite() && range >= range_min && range <= range_max;
+            let strength = scan
+                .intensities
+                .get(i)
+                .filter(|s| s.is_finite())
+                .map_or(0, |&s| s.round().clamp(0.0, f32::from(u16::MAX)) as u16);
+            sink.lidar(&LidarSample {
+                t_s,
+                rev: self.rev,
+                angle_deg: angle_deg(angle_min + i_f * increment),
+                range_m: if valid { decimal_of_f32(range) } else { 0.0 },
+                strength,
+                invalid: !valid,
+                warning: false,
+                true_range_m: None,
+            })?;
+        }
+        self.count(Role::Lidar, scan.ranges.len() as u64);
+        self.rev += 1;
+        Ok(())
+    }
+
+    /// A velocity command as the wheel speeds of a differential drive.
+    fn command<S>(&mut self, ns: i64, twist: &Twist, sink: &mut S) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let t_s = self.seconds(Role::Commands, ns, 0.0);
+        let (v, w) = (twist.linear.x, twist.angular.z);
+        let half = 0.5 * self.wheel_base_m * w;
+        self.count(Role::Commands, 1);
+        Ok(sink.command(&CommandSample {
+            t_s,
+            left_mps: v - half,
+            right_mps: v + half,
+        })?)
+    }
+
+    fn truth<S>(&mut self, ns: i64, pose: &crate::msgs::Pose, sink: &mut S) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let t_s = self.seconds(Role::Truth, ns, 0.0);
+        self.count(Role::Truth, 1);
+        Ok(sink.truth(&TruthSample {
+            t_s,
+            x_m: pose.position.x,
+            y_m: pose.position.y,
+            yaw_rad: pose.orientation.yaw(),
+        })?)
+    }
+
+    /// Wheel travel rebuilt from the pose increments: over a step the robot turns by dθ and
+    /// moves ds along its mean heading (the midpoint rule of differential-drive odometry), so
+    /// the wheels, b apart, travel ds ∓ dθ·b/2.
+    fn odometry<S>(&mut self, ns: i64, odometry: &Odometry, sink: &mut S) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let pose = &odometry.pose.pose;
+        let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
+        if ![x, y, yaw].iter().all(|v| v.is_finite()) {
+            return Err(Fault::Message("a pose that is not finite".into()));
+        }
+        let (left_m, right_m) = match &mut self.odometry {
+            Some(OdometryState::Pose {
+                x: x0,
+                y: y0,
+                yaw: yaw0,
+                left_m,
+                right_m,
+            }) => {
+                let turn = wrap_angle(yaw - *yaw0);
+                let heading = *yaw0 + 0.5 * turn;
+                let ds = (x - *x0) * heading.cos() + (y - *y0) * heading.sin();
+                *left_m += ds - 0.5 * turn * self.wheel_base_m;
+                *right_m += ds + 0.5 * turn * self.wheel_base_m;
+                (*x0, *y0, *yaw0) = (x, y, yaw);
+                // To the nanometre, far below any encoder's tick: the rounding error of the
+                // sums (1e-17 m a step) does not show, and a millimetre stays `0.002`.
+                let nm = |m: f64| (m * 1e9).round() / 1e9;
+                (nm(*left_m), nm(*right_m))
+            }
+            _ => {
+                let (left_m, right_m) = self.odometry_start_m;
+                self.odometry = Some(OdometryState::Pose {
+                    x,
+                    y,
+                    yaw,
+                    left_m,
+                    right_m,
+                });
+                (left_m, right_m)
+            }
+        };
+        let t_s = self.seconds(Role::Odometry, ns, 0.0);
+        self.count(Role::Odometry, 1);
+        Ok(sink.odometry(&OdometrySample {
+            t_s,
+            left_m,
+            right_m,
+        })?)
+    }
+
+    /// Wheel travel from the wheel joints' angles (the joints named `…left…` and `…right…`).
+    fn joints<S>(&mut self, ns: i64, joints: &JointState, sink: &mut S) -> Result<(), Fault>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let radius = self.wheel_radius_m.unwrap_or(0.0);
+        if self.odometry.is_none() {
+            let find = |side: &str| {
+                let matches: Vec<usize> = joints
+                    .name
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, n)| n.to_lowercase().contains(side))
+                    .map(|(i, _)| i)
+                    .collect();
+                match matches.as_slice() {
+                    [one] => Ok(*one),
+                    _ => Err(Fault::Message(format!(
+                        "no one joint named `{side}` among {:?}: which are the wheels?",
+                        joints.name
+                    ))),
+                }
+            };
+            let (left, right) = (find("left")?, find("right")?);
+            let (Some(&l0), Some(&r0)) = (joints.position.get(left), joints.position.get(right))
+            else {
+                return Err(Fault::Message("fewer positions than joint names".into()));
+            };
+            self.odometry = Some(OdometryState::Joints {
+                left,
+                right,
+                left0: l0,
+                right0: r0,
+            });
+        }
+        let Some(OdometryState::Joints {
+            left,
+            right,
+            left0,
+            right0,
+        }) = self.odometry
+        else {
+            return Ok(());
+        };
+        let (Some(&l), Some(&r)) = (joints.position.get(left), joints.position.get(right)) else {
+            return Err(Fault::Message("fewer positions than joint names".into()));
+        };
+        let t_s = self.seconds(Role::Odometry, ns, 0.0);
+        self.count(Role::Odometry, 1);
+        Ok(sink.odometry(&OdometrySample {
+            t_s,
+            left_m: (l - left0) * radius,
+            right_m: (r - right0) * radius,
+        })?)
+    }
+
+    /// Writes what waits for the end: commands that never met a stamped message.
+    ///
+    /// # Errors
+    /// `sink` fails.
+    pub fn finish<S>(&mut self, sink: &mut S) -> Result<(), Error>
+    where
+        S: SampleSink<Error = hilsim_recording::Error>,
+    {
+        let offset = *self.clock_offset_ns.get_or_insert(0);
+        for (log_ns, twist) in std::mem::take(&mut self.pending_commands) {
+            self.command(log_ns + offset, &twist, sink)
+                .map_err(|err| match err {
+                    Fault::Sink(err) => Error::Recording(err),
+                    Fault::Message(m) => Error::Bag {
+                        path: "commands".into(),
+                        message: m,
+                    },
+                })?;
+        }
+        Ok(())
+    }
+
+    /// Sentences on what was repaired or skipped.
+    #[must_use]
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        for (role, (count, worst)) in &self.reordered {
+            notes.push(format!(
+                "{count} {role} rows came before the row written ahead of them (by up to {:.3} \
+                 ms) and were put at its time",
+                worst * 1e3
+            ));
+        }
+        if self.sonar_out_of_range > 0 {
+            notes.push(format!(
+                "{} sonar readings out of their min..max range (no echo) skipped",
+                self.sonar_out_of_range
+            ));
+        }
+        notes
+    }
+}
+
+/// A float32 field as the decimal it was written as: the shortest decimal that reads back as
+/// that float32 (`1.234`, not `1.2339999675750732`), so that millimetre ranges stay millimetres
+/// and a recording exported and imported keeps its numbers.
+#[must_use]
+pub fn decimal_of_f32(x: f32) -> f64 {
+    if !x.is_finite() {
+        return f64::from(x);
+    }
+    let mut buffer = zmij::Buffer::new();
+    buffer
+        .format_finite(x)
+        .parse()
+        .unwrap_or_else(|_| f64::from(x))
+}
+
+/// A LaserScan angle (radians, any turn) as a recording's degrees in [0, 360), to 1e-4°: the
+/// float32 angle and increment put reading i of a 360-reading scan about 1e-5° off its nominal
+/// angle, and no lidar resolves 1e-4°.
+#[must_use]
+pub fn angle_deg(angle_rad: f64) -> f64 {
+    let deg = ((angle_rad.to_degrees() * 1e4).round() / 1e4).rem_euclid(360.0);
+    if deg >= 360.0 {
+        0.0
+    } else {
+        deg
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn float32_fields_keep_their_decimals() {
+        assert_eq!(decimal_of_f32(1.234), 1.234);
+        assert_eq!(decimal_of_f32(0.5), 0.5);
+        assert_eq!(decimal_of_f32(6.0), 6.0);
+    }
+
+    #[test]
+    fn angles_wrap_and_round() {
+        let step = (1.0f64.to_radians() as f32) as f64;
+        assert_eq!(angle_deg(359.0 * step), 359.0);
+        assert_eq!(angle_deg(-std::f64::consts::FRAC_PI_2), 270.0);
+        assert_eq!(angle_deg(2.0 * std::f64::consts::PI), 0.0);
+        assert_eq!(angle_deg(-1e-12), 0.0);
+        let half = decimal_of_f32(0.5f64.to_radians() as f32);
+        for i in 0..720 {
+            assert_eq!(angle_deg(f64::from(i) * half), f64::from(i) * 0.5, "{i}");
+        }
+    }
+}

@@ -1,0 +1,38 @@
+//! ROS 2 bags in and out: a bag (MCAP storage, CDR messages) read into a hilsim recording
+//! ([`import()`]), and a recording written as an MCAP file of standard ROS 2 messages that
+//! `ros2 bag play`, RViz and Foxglove read ([`export()`]).
+//!
+//! Bags stream: an import holds one record (a message, or a chunk being decompressed) at a
+//! time, whatever the bag's size. The crate knows the recording format only through
+//! `hilsim-recording`; a scenario's world reaches the exporter as plain shapes ([`World`]).
+//!
+//! ```
+//! use hilsim_recording::{CommandSample, Meta, Recording};
+//! let dir = tempfile::tempdir().unwrap();
+//! let mut rec = Recording::new(Meta::default());
+//! rec.commands.push(CommandSample { t_s: 0.5, left_mps: 0.1, right_mps: 0.2 });
+//! let bag = dir.path().join("run.mcap");
+//! hilsim_ros2::export(&rec, None, &bag).unwrap();
+//! let out = dir.path().join("back");
+//! hilsim_ros2::import(&bag, &out, &hilsim_ros2::ImportOptions::default()).unwrap();
+//! let back = Recording::read_dir(&out).unwrap();
+//! assert_eq!(back.commands[0].t_s, 0.5);
+//! assert!((back.commands[0].right_mps - 0.2).abs() < 1e-12);
+//! ```
+#![warn(missing_docs)]
+
+pub mod bag;
+mod cdr;
+pub mod definitions;
+mod error;
+mod export;
+mod import;
+pub mod msgs;
+pub mod topics;
+
+pub use error::Error;
+pub use export::{export, export_with, ExportOptions, ExportReport, World, START_NS};
+pub use import::{
+    angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,
+};
+pub use topics::{Kind, Role};

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Third-party ROS 2 libraries (rosbags, mcap and mcap-ros2-support from PyPI, in a virtual
+# environment made here): a bag rosbags writes is what `hilsim import` reads, and `hilsim
+# export`'s file is what rosbags and mcap-ros2-support read, message for message.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/../.." && pwd)"
+cd "$root"
+venv="$root/target/ros2-venv"
+if [ ! -x "$venv/bin/python" ]; then
+    python3 -m venv "$venv"
+fi
+"$venv/bin/pip" install --quiet --disable-pip-version-check \
+    "rosbags==0.11.9" "mcap==1.6.0" "mcap-ros2-support==0.6.0"
+
+cargo build --quiet
+hilsim="$root/target/debug/hilsim"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+check="tests/third_party/rosbags_check.py"
+
+# rosbags → hilsim import (a bag directory, metadata.yaml and MCAP), with the robot's meta.toml.
+"$venv/bin/python" "$check" write "$tmp/bag"
+printf 'format = "hilsim-recording/1"\n[robot]\nwheel_base_m = 0.3\n' > "$tmp/meta.toml"
+"$hilsim" import "$tmp/bag" --out "$tmp/imported" --meta "$tmp/meta.toml"
+"$venv/bin/python" "$check" imported "$tmp/bag" "$tmp/imported"
+# The same messages in single MCAP files from the mcap library's writer, chunks compressed.
+for compression in zstd lz4; do
+    "$venv/bin/python" "$check" rewrite "$tmp/bag" "$tmp/$compression.mcap" "$compression"
+    "$hilsim" import "$tmp/$compression.mcap" --out "$tmp/$compression" --meta "$tmp/meta.toml"
+    "$venv/bin/python" "$check" imported "$tmp/$compression.mcap" "$tmp/$compression"
+done
+
+# hilsim record --mcap → rosbags and mcap-ros2-support.
+scenario=scenarios/straight-board.toml
+"$hilsim" record "$scenario" --out "$tmp/rec" --mcap "$tmp/run.mcap"
+"$venv/bin/python" "$check" exported "$tmp/run.mcap" "$tmp/rec"
+echo "rosbags.sh: ok"

@@ -1,0 +1,310 @@
+"""Third-party ROS 2 libraries against `hilsim import` and `hilsim export` (issue 17).
+
+    rosbags_check.py write BAGDIR            write a ROS 2 bag with rosbags (MCAP storage)
+    rosbags_check.py rewrite BAGDIR OUT C    the same messages through the mcap library's
+                                             writer, chunks compressed with C (zstd, lz4)
+    rosbags_check.py imported BAGDIR RECDIR  check hilsim's import of that bag
+    rosbags_check.py exported MCAP RECDIR    read hilsim's export with rosbags and mcap-ros2
+
+Each check compares message contents with the recording's CSV files and exits non-zero with a
+line saying what differs.
+"""
+
+import csv
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+
+# The bag: a lidar of 720 readings 0.5 degrees apart at 10 Hz, odometry at 20 Hz, unstamped
+# Twist commands at 5 Hz and a sonar at 10 Hz, for 3 s, stamped from a clock that starts at
+# 1,700,000,000 s (wall time, as a real robot's).
+T0_NS = 1_700_000_000 * 10**9
+SCANS = 30
+READINGS = 720
+WHEEL_BASE = 0.3
+RANGE_MIN, RANGE_MAX = 0.1, 12.0
+ODOM_AFTER_NS = 20_000_000
+
+
+def scan_ranges(k):
+    """Ranges of scan k: a smooth room with NaN, +inf, below-minimum and above-maximum holes."""
+    out = []
+    for i in range(READINGS):
+        r = 2.0 + math.sin(math.radians(0.5 * i) * 3 + 0.1 * k)
+        if i % 97 == 0:
+            r = float("nan")
+        elif i % 89 == 0:
+            r = float("inf")
+        elif i % 83 == 0:
+            r = 0.05
+        elif i % 79 == 0:
+            r = 20.0
+        out.append(r)
+    return np.array(out, dtype=np.float32)
+
+
+def odom_pose(j):
+    """The robot's pose at odometry message j: driving a gentle left arc."""
+    t = 0.05 * j
+    yaw = 0.4 * t
+    return 0.2 * t * math.cos(0.2 * t), 0.2 * t * math.sin(0.2 * t), yaw
+
+
+def write(bagdir):
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    t = store.types
+    Time = t["builtin_interfaces/msg/Time"]
+    Header = t["std_msgs/msg/Header"]
+
+    def header(ns, frame):
+        return Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=frame)
+
+    Vector3 = t["geometry_msgs/msg/Vector3"]
+    Point = t["geometry_msgs/msg/Point"]
+    Quaternion = t["geometry_msgs/msg/Quaternion"]
+    Pose = t["geometry_msgs/msg/Pose"]
+    Twist = t["geometry_msgs/msg/Twist"]
+    cov = np.zeros(36, dtype=np.float64)
+    with Writer(bagdir, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+        scan_c = writer.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
+        odom_c = writer.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=store)
+        cmd_c = writer.add_connection("/cmd_vel", "geometry_msgs/msg/Twist", typestore=store)
+        sonar_c = writer.add_connection("/range", "sensor_msgs/msg/Range", typestore=store)
+        events = []
+        for k in range(SCANS):
+            ns = T0_NS + k * 100_000_000
+            msg = t["sensor_msgs/msg/LaserScan"](
+                header=header(ns, "laser"),
+                angle_min=0.0,
+                angle_max=math.radians(359.5),
+                angle_increment=math.radians(0.5),
+                time_increment=0.1 / READINGS,
+                scan_time=0.1,
+                range_min=RANGE_MIN,
+                range_max=RANGE_MAX,
+                ranges=scan_ranges(k),
+                intensities=np.full(READINGS, 100.0 + k, dtype=np.float32),
+            )
+            # Logged when the revolution ends, after the odometry stamped later: t = 0 is
+            # still the first scan's stamp.
+            events.append((ns + 100_000_000, scan_c, msg, "sensor_msgs/msg/LaserScan"))
+            sonar = t["sensor_msgs/msg/Range"](
+                header=header(ns + 5_000_000, "sonar"),
+                radiation_type=0,
+                field_of_view=math.radians(30.0),
+                min_range=0.02,
+                max_range=4.0,
+                range=float("inf") if k == 3 else 1.0 + 0.01 * k,
+            )
+            events.append((ns + 5_000_000, sonar_c, sonar, "sensor_msgs/msg/Range"))
+        for j in range(2 * SCANS):
+            ns = T0_NS + ODOM_AFTER_NS + j * 50_000_000
+            x, y, yaw = odom_pose(j)
+            odom = t["nav_msgs/msg/Odometry"](
+                header=header(ns, "odom"),
+                child_frame_id="base_link",
+                pose=t["geometry_msgs/msg/PoseWithCovariance"](
+                    pose=Pose(
+                        position=Point(x=x, y=y, z=0.0),
+                        orientation=Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
+                    ),
+                    covariance=cov,
+                ),
+                twist=t["geometry_msgs/msg/TwistWithCovariance"](
+                    twist=Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4)),
+                    covariance=cov,
+                ),
+            )
+            events.append((ns, odom_c, odom, "nav_msgs/msg/Odometry"))
+        for c in range(SCANS // 2):
+            # Unstamped: the recorder's log time is its time (on the stamps' clock here).
+            ns = T0_NS + c * 200_000_000 + 1_000_000
+            twist = Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4 + 0.01 * c))
+            events.append((ns, cmd_c, twist, "geometry_msgs/msg/Twist"))
+        for ns, conn, msg, kind in sorted(events, key=lambda e: e[0]):
+            writer.write(conn, ns, store.serialize_cdr(msg, kind))
+
+
+def table(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def fail(what):
+    print(f"rosbags_check: {what}", file=sys.stderr)
+    sys.exit(1)
+
+
+def close(a, b, tol, what):
+    if not abs(a - b) <= tol:
+        fail(f"{what}: {a} != {b} (tolerance {tol})")
+
+
+def imported(bagdir, rec):
+    rec = Path(rec)
+    lidar = table(rec / "lidar.csv")
+    if len(lidar) != SCANS * READINGS:
+        fail(f"lidar.csv has {len(lidar)} rows, expected {SCANS * READINGS}")
+    for k in range(SCANS):
+        ranges = scan_ranges(k)
+        for i in range(READINGS):
+            row = lidar[k * READINGS + i]
+            r = float(ranges[i])
+            valid = math.isfinite(r) and RANGE_MIN <= r <= RANGE_MAX
+            want_t = k * 0.1 + i * float(np.float32(0.1 / READINGS))
+            close(float(row["t_s"]), want_t, 1.01e-6, f"lidar row {k},{i} t_s")
+            if int(row["rev"]) != k or float(row["angle_deg"]) != 0.5 * i:
+                fail(f"lidar row {k},{i}: rev {row['rev']} angle {row['angle_deg']}")
+            if int(row["invalid"]) != (0 if valid else 1):
+                fail(f"lidar row {k},{i}: invalid {row['invalid']} for range {r}")
+            close(float(row["range_m"]), r if valid else 0.0, 1e-6, f"lidar row {k},{i} range")
+            if int(row["strength"]) != 100 + k:
+                fail(f"lidar row {k},{i}: strength {row['strength']}")
+    odometry = table(rec / "odometry.csv")
+    if len(odometry) != 2 * SCANS:
+        fail(f"odometry.csv has {len(odometry)} rows")
+    left = right = 0.0
+    for j in range(1, 2 * SCANS):
+        (x0, y0, a0), (x1, y1, a1) = odom_pose(j - 1), odom_pose(j)
+        turn = a1 - a0
+        heading = a0 + turn / 2
+        ds = (x1 - x0) * math.cos(heading) + (y1 - y0) * math.sin(heading)
+        left += ds - turn * WHEEL_BASE / 2
+        right += ds + turn * WHEEL_BASE / 2
+        close(float(odometry[j]["left_m"]), left, 1e-8, f"odometry row {j} left")
+        close(float(odometry[j]["right_m"]), right, 1e-8, f"odometry row {j} right")
+        close(float(odometry[j]["t_s"]), 0.02 + 0.05 * j, 1e-9, f"odometry row {j} t_s")
+    commands = table(rec / "commands.csv")
+    if len(commands) != SCANS // 2:
+        fail(f"commands.csv has {len(commands)} rows")
+    for c, row in enumerate(commands):
+        w = 0.4 + 0.01 * c
+        close(float(row["t_s"]), 0.2 * c + 0.001, 1e-9, f"command {c} t_s")
+        close(float(row["left_mps"]), 0.2 - w * WHEEL_BASE / 2, 1e-12, f"command {c} left")
+        close(float(row["right_mps"]), 0.2 + w * WHEEL_BASE / 2, 1e-12, f"command {c} right")
+    sonar = table(rec / "sonar.csv")
+    if len(sonar) != SCANS - 1:
+        fail(f"sonar.csv has {len(sonar)} rows (the +inf one is no echo)")
+    for row, k in zip(sonar, [k for k in range(SCANS) if k != 3]):
+        close(float(row["range_m"]), 1.0 + 0.01 * k, 1e-6, f"sonar {k}")
+        close(float(row["t_s"]), 0.1 * k + 0.005, 1e-9, f"sonar {k} t_s")
+    print(f"rosbags_check: hilsim imported the rosbags bag: {len(lidar)} lidar readings, "
+          f"{len(odometry)} odometry, {len(commands)} commands, {len(sonar)} sonar rows agree")
+
+
+def yaw_of(q):
+    return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+
+
+def check_messages(name, messages, rec):
+    """`messages`: (topic, log time ns, decoded message) of hilsim's export, in file order."""
+    lidar = table(rec / "lidar.csv")
+    truth = table(rec / "truth.csv")
+    commands = table(rec / "commands.csv")
+    sonar = table(rec / "sonar.csv") if (rec / "sonar.csv").exists() else []
+    by_topic = {}
+    for topic, _, msg in messages:
+        by_topic.setdefault(topic, []).append(msg)
+    revs = {}
+    for row in lidar:
+        revs.setdefault(int(row["rev"]), []).append(row)
+    scans = by_topic.get("/scan", [])
+    if len(scans) != len(revs):
+        fail(f"{name}: {len(scans)} LaserScans for {len(revs)} revolutions")
+    for scan, (rev, rows) in zip(scans, sorted(revs.items())):
+        if scan.header.frame_id != "laser":
+            fail(f"{name}: scan frame {scan.header.frame_id}")
+        stamp = scan.header.stamp.sec + scan.header.stamp.nanosec * 1e-9 - 1.0
+        close(stamp, float(rows[0]["t_s"]), 1e-9, f"{name}: revolution {rev} stamp")
+        for row in rows:
+            angle = math.radians(float(row["angle_deg"]))
+            i = round((angle - scan.angle_min) / scan.angle_increment)
+            r = float(scan.ranges[i])
+            if int(row["invalid"]):
+                if not math.isnan(r):
+                    fail(f"{name}: revolution {rev} reading {i}: invalid but {r}")
+            else:
+                close(r, float(row["range_m"]), 1e-6, f"{name}: revolution {rev} reading {i}")
+            close(float(scan.intensities[i]), float(row["strength"]), 0, f"{name}: strength")
+    poses = by_topic.get("/ground_truth/pose", [])
+    if len(poses) != len(truth):
+        fail(f"{name}: {len(poses)} poses for {len(truth)} truth rows")
+    for pose, row in zip(poses, truth):
+        close(pose.pose.position.x, float(row["x_m"]), 0, f"{name}: truth x")
+        close(pose.pose.position.y, float(row["y_m"]), 0, f"{name}: truth y")
+        d = yaw_of(pose.pose.orientation) - float(row["yaw_rad"])
+        close(math.remainder(d, 2 * math.pi), 0.0, 1e-12, f"{name}: truth yaw")
+    twists = by_topic.get("/cmd_vel", [])
+    if len(twists) != len(commands):
+        fail(f"{name}: {len(twists)} commands for {len(commands)} rows")
+    for twist, row in zip(twists, commands):
+        v = 0.5 * (float(row["left_mps"]) + float(row["right_mps"]))
+        close(twist.twist.linear.x, v, 1e-12, f"{name}: command speed")
+    ranges = by_topic.get("/sonar", [])
+    if len(ranges) != len(sonar):
+        fail(f"{name}: {len(ranges)} Range messages for {len(sonar)} sonar rows")
+    for msg, row in zip(ranges, sonar):
+        close(msg.range, float(row["range_m"]), 1e-6, f"{name}: sonar")
+    tfs = [tf for m in by_topic.get("/tf", []) for tf in m.transforms]
+    if len(tfs) != len(truth) or any(tf.child_frame_id != "base_link" for tf in tfs):
+        fail(f"{name}: {len(tfs)} map->base_link transforms for {len(truth)} truth rows")
+    static = [tf.child_frame_id for m in by_topic.get("/tf_static", []) for tf in m.transforms]
+    if "laser" not in static:
+        fail(f"{name}: no base_link->laser in /tf_static ({static})")
+    markers = [m for a in by_topic.get("/world", []) for m in a.markers]
+    if not markers:
+        fail(f"{name}: no world markers")
+    print(f"rosbags_check: {name} read hilsim's export: {len(scans)} scans, {len(poses)} poses, "
+          f"{len(twists)} commands, {len(ranges)} ranges, {len(markers)} markers agree")
+
+
+def exported(mcap_path, rec):
+    rec = Path(rec)
+    with AnyReader([Path(mcap_path)]) as reader:
+        messages = [
+            (c.topic, ts, reader.deserialize(raw, c.msgtype))
+            for c, ts, raw in reader.messages()
+        ]
+    check_messages("rosbags", messages, rec)
+    from mcap_ros2.reader import read_ros2_messages
+
+    messages = [
+        (m.channel.topic, m.log_time_ns, m.ros_msg)
+        for m in read_ros2_messages(mcap_path, log_time_order=False)
+    ]
+    check_messages("mcap-ros2-support", messages, rec)
+
+
+def rewrite(bagdir, out, compression):
+    from mcap.writer import CompressionType, Writer as McapWriter
+    from rosbags.rosbag2 import Reader
+
+    with Reader(bagdir) as reader, open(out, "wb") as f:
+        writer = McapWriter(f, compression=CompressionType[compression.upper()], chunk_size=1 << 16)
+        writer.start(profile="ros2", library="rosbags_check")
+        channels = {}
+        for c in reader.connections:
+            schema = writer.register_schema(c.msgtype, "ros2msg", c.msgdef.data.encode())
+            channels[c.id] = writer.register_channel(c.topic, "cdr", schema)
+        for c, ts, raw in reader.messages():
+            writer.add_message(channels[c.id], log_time=ts, data=bytes(raw), publish_time=ts)
+        writer.finish()
+
+
+if __name__ == "__main__":
+    mode = sys.argv[1]
+    if mode == "write":
+        write(Path(sys.argv[2]))
+    elif mode == "rewrite":
+        rewrite(Path(sys.argv[2]), sys.argv[3], sys.argv[4])
+    elif mode == "imported":
+        imported(sys.argv[2], sys.argv[3])
+    elif mode == "exported":
+        exported(sys.argv[2], sys.argv[3])
+    else:
+        fail(f"unknown mode {mode}")

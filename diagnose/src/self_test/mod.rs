@@ -16,6 +16,9 @@ mod trial;
 pub const MAX_TRIALS: u64 = 100_000;
 
 pub use draw::Drawn;
-pub use run::{one, run, run_with_progress, Plan, SelfTest, TrialRun};
-pub use score::{Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_PARAM_ERROR};
+pub use draw::OUTSIDE;
+pub use run::{one, run, run_with_progress, Plan, Reality, SelfTest, TrialRun};
+pub use score::{
+    Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_OUTSIDE, GOAL_PARAM_ERROR,
+};
 pub use trial::Outcome;

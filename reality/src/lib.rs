@@ -95,3 +95,83 @@ pub fn record(
         truth: Some(run.truth(seed)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A robot standing 2 m in front of a wall, every sensor, for 10 s.
+    fn facing_a_wall() -> Scenario {
+        Scenario::from_toml(
+            r#"name = "wall"
+[world]
+walls = [{ from = [3.0, -2.0], to = [3.0, 2.0] }]
+[robot]
+start = { x = 1.0, y = 0.0, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+[[drive]]
+stop_s = 10.0
+[sensors.lidar]
+bias = [0.0, 1.0]
+noise = [0.01]
+[sensors.sonar]
+bias = [0.0, 1.0]
+noise = [0.008]
+[sensors.odometer]
+noise_m = 0.002
+"#,
+            std::path::Path::new("wall.toml"),
+        )
+        .unwrap()
+    }
+
+    fn mean(v: &[f64]) -> f64 {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+
+    #[test]
+    fn a_wall_two_metres_ahead_reads_two_metres_and_a_hot_room_reads_short() {
+        let s = facing_a_wall();
+        let r = record(&s, &[], Nuisances::default(), 7);
+        let ahead: Vec<f64> = r
+            .lidar
+            .as_ref()
+            .unwrap()
+            .iter()
+            .filter(|l| f64::from(l.angle_deg) == 0.0 && !l.invalid)
+            .map(|l| l.range_m)
+            .collect();
+        // 50 revolutions of noise 10 mm: the mean within 4σ/√50 = 5.7 mm of 2 m.
+        assert_eq!(ahead.len(), 50);
+        assert!((mean(&ahead) - 2.0).abs() < 0.0057, "{}", mean(&ahead));
+        let sonar: Vec<f64> = r
+            .sonar
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|p| p.range_m)
+            .collect();
+        assert!((mean(&sonar) - 2.0).abs() < 0.004, "{}", mean(&sonar));
+        // Air at 40 °C against a calibration at 20 °C: ranges × c(20)/c(40) = 0.9686.
+        let hot = record(
+            &s,
+            &[Concealed::SonarSpeedOfSound {
+                air_temperature_c: 40.0,
+                calibrated_at_c: 20.0,
+            }],
+            Nuisances::default(),
+            7,
+        );
+        let hot: Vec<f64> = hot.sonar.unwrap().iter().map(|p| p.range_m).collect();
+        assert!((mean(&hot) - 2.0 * 0.9686).abs() < 0.004, "{}", mean(&hot));
+        // The same seed, the same recording.
+        assert_eq!(record(&s, &[], Nuisances::default(), 7), r);
+    }
+
+    #[test]
+    fn nuisances_are_drawn_from_the_seed_alone() {
+        let a = Nuisances::draw(&mut Stream::new(3, "n"));
+        assert_eq!(a, Nuisances::draw(&mut Stream::new(3, "n")));
+        assert_ne!(a, Nuisances::draw(&mut Stream::new(4, "n")));
+    }
+}

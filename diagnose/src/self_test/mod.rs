@@ -5,6 +5,7 @@
 //! told, and scores the answer. Trial `i` is a function of (S, i) alone.
 
 mod draw;
+mod plan;
 mod report;
 mod run;
 mod score;
@@ -17,7 +18,8 @@ pub const MAX_TRIALS: u64 = 100_000;
 
 pub use draw::Drawn;
 pub use draw::OUTSIDE;
-pub use run::{one, run, run_with_progress, Plan, Reality, SelfTest, TrialRun};
+pub use plan::{Plan, Reality};
+pub use run::{one, run, run_with_progress, SelfTest, TrialRun};
 pub use score::{
     Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_OUTSIDE, GOAL_PARAM_ERROR,
 };

@@ -5,7 +5,7 @@ use std::fmt::Write;
 use serde_json::{json, Value};
 
 use super::draw::OUTSIDE;
-use super::run::Reality;
+use super::plan::Reality;
 use super::score::median;
 use super::trial::{label, verdict_label};
 use super::SelfTest;

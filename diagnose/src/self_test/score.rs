@@ -1,7 +1,7 @@
 //! The self-test's score over its trials: the confusion matrix and the goals of issues 7 and 14.
 
 use super::draw::OUTSIDE;
-use super::run::Reality;
+use super::plan::Reality;
 use super::trial::{label, verdict_label, Outcome};
 use crate::{Effect, Verdict};
 

@@ -9,7 +9,7 @@ use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
 use super::draw::{draw_independent, real_scenario, Drawn, Draws};
-use super::run::{Plan, Reality};
+use super::plan::{Plan, Reality};
 use crate::{Diagnosis, Effect, Options, SimPhysics, Verdict};
 
 /// One trial's outcome.

@@ -177,9 +177,11 @@ impl Run<'_> {
             }
         }
         let theta = hit.incidence_rad.min(MAX_INCIDENCE_RAD);
-        let mut reading = poly(&cfg.bias, d) + poly(&cfg.noise, d) * e;
+        // The effects move the distance the unit measures; its calibration (the bias
+        // polynomial) then maps that distance to the reading, as it maps the true one.
+        let mut measured = d;
         for c in self.concealed {
-            reading += match *c {
+            measured += match *c {
                 Concealed::LidarIncidence { coefficient } => coefficient * d * theta.tan(),
                 Concealed::LidarReflectivity {
                     coefficient_m,
@@ -196,6 +198,7 @@ impl Run<'_> {
                 _ => 0.0,
             };
         }
+        let reading = poly(&cfg.bias, measured) + poly(&cfg.noise, d) * e;
         let intensity =
             INTENSITY_AT_1M * hit.reflectivity / 0.8 * hit.incidence_rad.cos() * d.powf(-0.7);
         Some((reading.max(0.0), Some(hit.range_m), intensity))

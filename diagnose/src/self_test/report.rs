@@ -28,6 +28,7 @@ impl SelfTest {
                     "outside": o.outside,
                     "named": o.named.iter().map(|e| e.name()).collect::<Vec<_>>(),
                     "unexplained": o.unexplained,
+                    "param_errors": o.param_errors.iter().map(|(e, v)| (e.name().to_string(), json!(v.is_finite().then_some(*v)))).collect::<serde_json::Map<_, _>>(),
                     "drawn": o.drawn.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
                     "verdict": verdict_label(&o.verdict),
                     "refusal": o.verdict.as_ref().err(),

@@ -88,6 +88,11 @@ fn select_in(
             break;
         };
         chosen.push(pool.swap_remove(k));
+        // Only an effect that gains on its own is tried on top of the others: one that does
+        // not explains nothing the others leave (the gains of effects of one sensor add up to
+        // about their joint gain unless they mimic each other, and then the second gains less,
+        // not more), and each refit costs a whole fit.
+        pool.retain(|c| c.heldout_gain > options.min_gain);
         if pool.is_empty() || chosen.len() == MAX_PER_SENSOR {
             break;
         }

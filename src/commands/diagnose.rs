@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{bail, Context, Result};
-use hilsim_diagnose::self_test::{self, Plan};
+use hilsim_diagnose::self_test::{self, Plan, Reality};
 use hilsim_diagnose::{show, Effect, Floors, Options, SimPhysics, Stage};
 use hilsim_recording::{write_file_atomically, Recording};
 use hilsim_sim::Scenario;
@@ -49,6 +49,13 @@ pub struct DiagnoseArgs {
     /// study one class.
     #[arg(long, value_name = "EFFECT", requires = "self_test")]
     pub only: Option<String>,
+    /// Self-test: what makes the "real" recordings: `hilsim` (its own simulator with the drawn
+    /// effect switched on) or `independent` (a generator that shares no model code with it,
+    /// with random nuisances, two effects at once in a fifth of the trials and an effect
+    /// outside the catalogue).
+    #[arg(long, value_name = "REALITY", requires = "self_test", default_value = "hilsim",
+          value_parser = ["hilsim", "independent"])]
+    pub reality: String,
     /// Self-test: run only trial I (of the N), print its whole diagnosis and, with `--report`,
     /// write its report and its "real" recording (`DIR/recording`).
     #[arg(long, value_name = "I", requires = "self_test")]
@@ -122,9 +129,17 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             None => hilsim_scenarios::builtin::diagnose_room()?,
         };
         let seed = args.seed.unwrap_or(1);
+        let reality = if args.reality == "independent" {
+            Reality::Independent
+        } else {
+            Reality::Hilsim
+        };
         let only = match args.only.as_deref() {
             None => None,
             Some("none") => Some(0),
+            Some(name) if name == self_test::OUTSIDE && reality == Reality::Independent => {
+                Some(1 + Effect::ALL.len())
+            }
             Some(name) => match Effect::from_name(name) {
                 Some(e) => Some(1 + Effect::ALL.iter().position(|x| *x == e).unwrap_or(0)),
                 None => bail!("--only: expected `none` or a catalogued effect, found `{name}`"),
@@ -135,6 +150,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             seed,
             strength: args.strength,
             only,
+            reality,
         };
         if let Some(i) = args.trial {
             if i >= n {
@@ -169,6 +185,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
         if args.strength != 1.0 {
             command += &format!(" --strength {}", args.strength);
+        }
+        if reality != Reality::Hilsim {
+            command += &format!(" --reality {}", reality.name());
         }
         let started = std::time::Instant::now();
         let progress = TrialProgress::new(n, !args.json);

@@ -7,7 +7,7 @@ use super::Effect;
 
 /// The reference reflectivity of `[effects.lidar_reflectivity]` (the catalogue's coefficient is
 /// the range walk on a surface of half of it).
-const REFERENCE_REFLECTIVITY: f64 = 0.8;
+pub(crate) const REFERENCE_REFLECTIVITY: f64 = 0.8;
 /// The temperature the sonar's speed of sound is calibrated at, °C.
 const CALIBRATED_AT_C: f64 = 20.0;
 

@@ -184,6 +184,38 @@ pub(crate) fn sonar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
     let nominal = ctx
         .physics
         .sonar(ctx.trajectory, &times, &Hypothesis::nominal());
+    // As the lidar's near its range limit (`away_from_limits`): whether a ping near the
+    // farthest echo is reported depends on the unit's rule (its true distance or its reading
+    // against the limit), so pings within 3σ of the farthest reading, or whose predicted
+    // reading is within 6σ of it, are not compared. The limit is the recording's own farthest
+    // reading: the declared one bounds the echo, not the reading (which the bias stretches).
+    let farthest = rows
+        .iter()
+        .map(|s| s.range_m)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let keep: Vec<bool> = rows
+        .iter()
+        .zip(&nominal)
+        .map(|(s, p)| {
+            p.reading.is_none_or(|g| {
+                s.range_m <= farthest - LIMIT_GUARD_SD * g.sd_m
+                    && g.mean_m <= farthest - LIMIT_GUARD_TRUE_SD * g.sd_m
+            })
+        })
+        .collect();
+    let rows: Vec<_> = rows
+        .iter()
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .map(|(s, _)| *s)
+        .collect();
+    let nominal: Vec<_> = nominal
+        .into_iter()
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .map(|(p, _)| p)
+        .collect();
+    let times: Vec<f64> = rows.iter().map(|s| s.t_s).collect();
     let mut cov: Vec<(Covariate, Vec<f64>)> = [
         Covariate::Range,
         Covariate::OffAxisNearer,

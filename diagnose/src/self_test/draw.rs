@@ -5,7 +5,9 @@ use hilsim_sim::Scenario;
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 use rand_xoshiro::SplitMix64;
 
-use crate::catalogue::{DrawSource, SelfTestRange};
+use hilsim_reality::{Concealed, Nuisances, Stream};
+
+use crate::catalogue::{DrawSource, SelfTestRange, REFERENCE_REFLECTIVITY};
 use crate::Effect;
 
 /// The trial's draws, from (S, i) alone: SplitMix64 started from a mix of the two.
@@ -47,6 +49,142 @@ pub struct Drawn {
     pub truth: Option<f64>,
     /// Every parameter drawn, for the report.
     pub params: Vec<(String, f64)>,
+    /// A second concealed catalogued effect and its scored parameter's true value (the
+    /// independent reality only).
+    pub second: Option<(Effect, f64)>,
+    /// A concealed effect outside the catalogue (the independent reality only).
+    pub outside: bool,
+    /// Every effect concealed, as the independent reality takes it.
+    pub concealed: Vec<Concealed>,
+}
+
+impl Drawn {
+    /// The concealed catalogued effects with their scored parameters' true values.
+    #[must_use]
+    pub fn catalogued(&self) -> Vec<(Effect, f64)> {
+        self.effect
+            .zip(self.truth)
+            .into_iter()
+            .chain(self.second)
+            .collect()
+    }
+
+    /// What was concealed, in words.
+    #[must_use]
+    pub fn label(&self) -> String {
+        let mut names: Vec<&str> = self.catalogued().iter().map(|(e, _)| e.name()).collect();
+        if self.outside {
+            names.push(OUTSIDE);
+        }
+        if names.is_empty() {
+            "none".to_string()
+        } else {
+            names.join("+")
+        }
+    }
+}
+
+/// The name of the outside-the-catalogue effect the independent reality conceals.
+pub const OUTSIDE: &str = "lidar_periodic_range";
+
+/// Share of the independent reality's trials that conceal two catalogued effects (issue 14).
+const TWO_EFFECTS: f64 = 0.2;
+
+/// The catalogue effect `effect` with `values` as the independent reality takes it.
+pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
+    let p = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match effect {
+        Effect::LidarIncidenceAngle => Concealed::LidarIncidence { coefficient: p(0) },
+        Effect::LidarReflectivity => Concealed::LidarReflectivity {
+            coefficient_m: p(0),
+            reference: REFERENCE_REFLECTIVITY,
+        },
+        Effect::LidarMixedPixels => Concealed::LidarMixedPixels {
+            half_width_deg: p(0),
+        },
+        Effect::LidarMotionSkew => Concealed::LidarMotionSkew,
+        Effect::LidarWarmupDrift => Concealed::LidarWarmup {
+            coefficient_per_m: p(0),
+            time_constant_s: p(1),
+        },
+        Effect::SonarBeamWidth => Concealed::SonarBeamWidth {
+            half_angle_deg: p(0),
+        },
+        Effect::SonarSpeedOfSound => Concealed::SonarSpeedOfSound {
+            air_temperature_c: p(0),
+            calibrated_at_c: 20.0,
+        },
+        Effect::OdometerWheelSlip => Concealed::WheelSlip { gain_s: p(0) },
+        Effect::DriveMotorLag => Concealed::MotorLag {
+            time_constant_s: p(0),
+        },
+    }
+}
+
+/// Trial `i`'s concealment in the independent reality: with probability 1/5 two different
+/// catalogued effects, else one of eleven classes (none, the nine effects, a periodic range
+/// error outside the catalogue: amplitude ±[1, 4] cm × strength, period [0.3, 1] m), or the
+/// `only` one (0 none, 1..=9 the catalogue, 10 outside); and the run's nuisances.
+pub(crate) fn draw_independent(
+    d: &mut Draws,
+    strength: f64,
+    nominal: &Scenario,
+    only: Option<usize>,
+) -> (Drawn, Nuisances) {
+    let two = only.is_none() && d.unit() < TWO_EFFECTS;
+    let class = only.unwrap_or_else(|| (d.unit() * 11.0).floor() as usize);
+    let mut effects: Vec<Effect> = Vec::new();
+    if two {
+        let a = (d.unit() * 9.0).floor() as usize;
+        let b = (a + 1 + (d.unit() * 8.0).floor() as usize) % 9;
+        effects.push(Effect::ALL[a.min(8)]);
+        effects.push(Effect::ALL[b.min(8)]);
+    } else if let Some(e) = class.checked_sub(1).and_then(|k| Effect::ALL.get(k)) {
+        effects.push(*e);
+    }
+    let mut drawn = Drawn {
+        effect: None,
+        effects: nominal.effects.clone(),
+        truth: None,
+        params: Vec::new(),
+        second: None,
+        outside: !two && class == 10,
+        concealed: Vec::new(),
+    };
+    for (k, e) in effects.iter().enumerate() {
+        let specs = e.params();
+        let values: Vec<f64> = specs
+            .iter()
+            .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
+            .collect();
+        let truth = specs[0].self_test.scored(values[0]);
+        if k == 0 {
+            drawn.effect = Some(*e);
+            drawn.truth = Some(truth);
+        } else {
+            drawn.second = Some((*e, truth));
+        }
+        drawn.concealed.push(concealed(*e, &values));
+        for (spec, v) in specs.iter().zip(&values) {
+            drawn
+                .params
+                .push((format!("{}.{}", e.name(), spec.name), *v));
+        }
+    }
+    if drawn.outside {
+        let amplitude = d.sign() * d.between(0.01, 0.04) * strength;
+        let period = d.between(0.3, 1.0);
+        drawn.concealed.push(Concealed::LidarPeriodicRange {
+            amplitude_m: amplitude,
+            period_m: period,
+        });
+        drawn
+            .params
+            .push((format!("{OUTSIDE}.amplitude_m"), amplitude));
+        drawn.params.push((format!("{OUTSIDE}.period_m"), period));
+    }
+    let mut nuisance_draws = Stream::new(d.next(), "nuisances");
+    (drawn, Nuisances::draw(&mut nuisance_draws))
 }
 
 /// Draws trial `i`'s effect: none, or one of the catalogue (each with probability 1/10, or the
@@ -63,6 +201,9 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
             effects,
             truth: None,
             params: Vec::new(),
+            second: None,
+            outside: false,
+            concealed: Vec::new(),
         };
     };
     let specs = effect.params();
@@ -80,6 +221,9 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
             .zip(&values)
             .map(|(spec, &v)| (spec.name.to_string(), v))
             .collect(),
+        second: None,
+        outside: false,
+        concealed: vec![concealed(effect, &values)],
     }
 }
 

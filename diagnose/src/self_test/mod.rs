@@ -5,6 +5,7 @@
 //! told, and scores the answer. Trial `i` is a function of (S, i) alone.
 
 mod draw;
+mod plan;
 mod report;
 mod run;
 mod score;
@@ -16,6 +17,10 @@ mod trial;
 pub const MAX_TRIALS: u64 = 100_000;
 
 pub use draw::Drawn;
-pub use run::{one, run, run_with_progress, Plan, SelfTest, TrialRun};
-pub use score::{Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_PARAM_ERROR};
+pub use draw::OUTSIDE;
+pub use plan::{Plan, Reality};
+pub use run::{one, run, run_with_progress, SelfTest, TrialRun};
+pub use score::{
+    Score, GOAL_CORRECT, GOAL_FALSE_ALARMS, GOAL_HELDOUT_RATIO, GOAL_OUTSIDE, GOAL_PARAM_ERROR,
+};
 pub use trial::Outcome;

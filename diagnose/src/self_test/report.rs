@@ -4,6 +4,8 @@ use std::fmt::Write;
 
 use serde_json::{json, Value};
 
+use super::draw::OUTSIDE;
+use super::plan::Reality;
 use super::score::median;
 use super::trial::{label, verdict_label};
 use super::SelfTest;
@@ -22,6 +24,11 @@ impl SelfTest {
                 json!({
                     "trial": o.index,
                     "truth": label(o.truth),
+                    "second": o.second.map(Effect::name),
+                    "outside": o.outside,
+                    "named": o.named.iter().map(|e| e.name()).collect::<Vec<_>>(),
+                    "unexplained": o.unexplained,
+                    "param_errors": o.param_errors.iter().map(|(e, v)| (e.name().to_string(), json!(v.is_finite().then_some(*v)))).collect::<serde_json::Map<_, _>>(),
                     "drawn": o.drawn.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
                     "verdict": verdict_label(&o.verdict),
                     "refusal": o.verdict.as_ref().err(),
@@ -44,6 +51,9 @@ impl SelfTest {
             "correct": s.correct, "with_effect": s.with_effect, "correct_share": finite(s.correct_share()),
             "false_alarms": s.false_alarms, "without_effect": s.without_effect, "false_alarm_share": finite(s.false_alarm_share()),
             "param_within_20pct": s.param_within, "param_scored": s.param_scored, "param_median_error": finite(s.param_median_error),
+            "outside_unexplained": s.outside_unexplained, "outside": s.outside,
+            "named": s.named, "improved": s.improved, "two": s.two, "two_named": s.two_named,
+            "reality": self.reality.name(),
             "heldout_within_1_2": s.heldout_within, "heldout_scored": s.heldout_scored, "heldout_median_ratio": finite(s.heldout_median_ratio),
             "pass": s.passed(),
             "wall_s": wall_s,
@@ -62,9 +72,10 @@ impl SelfTest {
     fn write_text(&self, out: &mut String, command: &str, wall_s: f64) -> std::fmt::Result {
         writeln!(
             out,
-            "self-test: {} blind trials of `{}`, seed {}, strength {} ({wall_s:.0} s)",
+            "self-test: {} blind trials of `{}` on the {} reality, seed {}, strength {} ({wall_s:.0} s)",
             self.outcomes.len(),
             self.scenario,
+            self.reality.name(),
             self.seed,
             self.strength
         )?;
@@ -73,21 +84,47 @@ impl SelfTest {
         let misses: Vec<String> = self
             .outcomes
             .iter()
-            .filter(|o| match (&o.verdict, o.truth) {
-                (Ok(Verdict::Effect(v)), Some(t)) => *v != t,
-                (Ok(Verdict::None), None) => false,
-                _ => true,
+            .filter(|o| {
+                let concealed: Vec<Effect> = o.truth.into_iter().chain(o.second).collect();
+                let missed = concealed.iter().any(|e| !o.named.contains(e));
+                let outside_missed = o.outside && o.unexplained == 0;
+                let none_alarm = concealed.is_empty()
+                    && !o.outside
+                    && self.reality == Reality::Hilsim
+                    && !matches!(o.verdict, Ok(Verdict::None));
+                missed || outside_missed || none_alarm || o.names_absent() || o.verdict.is_err()
             })
             .map(|o| {
-                format!(
-                    "trial {}: {} → {}",
-                    o.index,
-                    label(o.truth),
-                    match &o.verdict {
-                        Ok(v) => v.name().to_string(),
-                        Err(e) => format!("refused ({e})"),
-                    }
-                )
+                let mut truth: Vec<&str> = o
+                    .truth
+                    .into_iter()
+                    .chain(o.second)
+                    .map(Effect::name)
+                    .collect();
+                if o.outside {
+                    truth.push(OUTSIDE);
+                }
+                let truth = if truth.is_empty() {
+                    "none".to_string()
+                } else {
+                    truth.join("+")
+                };
+                let answer = match &o.verdict {
+                    Ok(_) if o.named.is_empty() => verdict_label(&o.verdict).to_string(),
+                    Ok(_) => o
+                        .named
+                        .iter()
+                        .map(|e| e.name())
+                        .collect::<Vec<_>>()
+                        .join("+"),
+                    Err(e) => format!("refused ({e})"),
+                };
+                let extra = if o.unexplained > 0 && !o.named.is_empty() {
+                    format!(" (+{} unexplained)", o.unexplained)
+                } else {
+                    String::new()
+                };
+                format!("trial {}: {truth} → {answer}{extra}", o.index)
             })
             .collect();
         if !misses.is_empty() {
@@ -117,6 +154,8 @@ impl SelfTest {
         for (r, row) in s.matrix.iter().enumerate() {
             let name = if r == 0 {
                 "none".to_string()
+            } else if s.classes[r] == OUTSIDE {
+                format!("outside: {OUTSIDE}")
             } else {
                 format!("E{r} {}", s.classes[r])
             };
@@ -157,11 +196,43 @@ impl SelfTest {
         )?;
         writeln!(
             out,
-            "false alarms: {}/{} recordings without an effect ({}; goal ≤ 5 %): {}",
+            "false alarms: {}/{} {} ({}; goal ≤ 5 %): {}",
             s.false_alarms,
             s.without_effect,
+            match self.reality {
+                Reality::Hilsim => "recordings without an effect not `none`",
+                Reality::Independent => "trials naming an effect that was not there",
+            },
             pct(s.false_alarm_share()),
             verdict(1)
+        )?;
+        if s.two > 0 {
+            writeln!(
+                out,
+                "two effects at once: both named in {}/{} trials",
+                s.two_named, s.two
+            )?;
+        }
+        if self.reality == Reality::Independent {
+            writeln!(
+                out,
+                "outside the catalogue: {}/{} unexplained ({}; goal ≥ 90 %): {}",
+                s.outside_unexplained,
+                s.outside,
+                pct(if s.outside > 0 {
+                    s.outside_unexplained as f64 / s.outside as f64
+                } else {
+                    f64::NAN
+                }),
+                verdict(4)
+            )?;
+        }
+        writeln!(
+            out,
+            "held-out fit improved by every named effect: {}/{}: {}",
+            s.improved,
+            s.named,
+            verdict(5)
         )?;
         writeln!(
             out,
@@ -175,8 +246,9 @@ impl SelfTest {
             let mut errs: Vec<f64> = self
                 .outcomes
                 .iter()
-                .filter(|o| o.truth == Some(e))
-                .filter_map(|o| o.param_error)
+                .flat_map(|o| o.param_errors.iter())
+                .filter(|(x, _)| *x == e)
+                .map(|(_, err)| *err)
                 .collect();
             if errs.is_empty() {
                 continue;

@@ -2,29 +2,16 @@
 
 use std::fmt::Write;
 
-use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use super::draw::{real_scenario, Drawn};
+use super::draw::Drawn;
+use super::plan::{Plan, Reality};
 use super::score::Score;
-use super::trial::{label, trial, Outcome};
+use super::trial::{real_recording, trial, Outcome};
 use crate::{show, Diagnosis, MismatchError, Options, SimPhysics};
-
-/// What a self-test is asked: trials of a nominal scenario.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Plan {
-    /// Trials.
-    pub trials: u64,
-    /// The self-test's seed S: trial `i` is a function of (S, i) alone.
-    pub seed: u64,
-    /// The drawn parameters' scale (1: the documented moderate ranges).
-    pub strength: f64,
-    /// Draw only this class (0: none; 1..=9: the catalogue in order), or any.
-    pub only: Option<usize>,
-}
 
 /// A finished self-test.
 #[derive(Debug, Clone)]
@@ -35,6 +22,8 @@ pub struct SelfTest {
     pub seed: u64,
     /// The drawn parameters' scale.
     pub strength: f64,
+    /// What made the "real" recordings.
+    pub reality: Reality,
     /// Every trial's outcome, in trial order.
     pub outcomes: Vec<Outcome>,
     /// Their score.
@@ -78,16 +67,17 @@ pub fn run_with_progress(
     let outcomes: Vec<Outcome> = (0..plan.trials)
         .into_par_iter()
         .map(|i| {
-            let outcome = trial(nominal, plan.seed, i, plan.strength, plan.only);
+            let outcome = trial(nominal, plan, i);
             trial_done();
             outcome
         })
         .collect();
-    let score = Score::of(&outcomes);
+    let score = Score::of(&outcomes, plan.reality);
     Ok(SelfTest {
         scenario: nominal.name.clone(),
         seed: plan.seed,
         strength: plan.strength,
+        reality: plan.reality,
         outcomes,
         score,
     })
@@ -113,11 +103,8 @@ pub struct TrialRun {
 /// # Errors
 /// [`MismatchError`] when the "real" scenario cannot be emulated or the diagnosis refuses it.
 pub fn one(nominal: &Scenario, plan: Plan, index: u64) -> Result<TrialRun, MismatchError> {
-    let (real, drawn) = real_scenario(nominal, plan.seed, index, plan.strength, plan.only);
-    let recording = Emulation::new(&real, real.seed)
-        .map_err(|e| MismatchError::Input(e.to_string()))?
-        .run()
-        .recording;
+    let (drawn, recording) = real_recording(nominal, plan, index);
+    let recording = recording.map_err(MismatchError::Input)?;
     let physics = SimPhysics::new(nominal)?;
     let diagnosis = crate::diagnose(&physics, &recording, &Options::default())?;
     Ok(TrialRun {
@@ -136,7 +123,7 @@ impl TrialRun {
         let mut j = show::to_json(&self.diagnosis);
         j["trial"] = json!({
             "index": self.index,
-            "truth": label(self.drawn.effect),
+            "truth": self.drawn.label(),
             "drawn": self.drawn.params.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
         });
         j
@@ -155,7 +142,7 @@ impl TrialRun {
             "trial {} (seed {}): concealed {} {}\n",
             self.index,
             self.seed,
-            label(self.drawn.effect),
+            self.drawn.label(),
             drawn_text.join(", ")
         );
         out.push_str(&show::summary(&self.diagnosis));

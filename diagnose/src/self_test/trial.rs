@@ -1,23 +1,40 @@
-//! One blind trial: record a "real" run with the drawn effect, diagnose it against the nominal
+//! One blind trial: record a "real" run with the drawn effects (hilsim's simulator with them
+//! switched on, or the independent reality with its nuisances), diagnose it against the nominal
 //! scenario without being told, and score the answer.
 
 use std::time::Instant;
 
 use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
-use super::draw::real_scenario;
-use crate::{Effect, Options, SimPhysics, Verdict};
+use super::draw::{draw_independent, real_scenario, Drawn, Draws};
+use super::plan::{Plan, Reality};
+use crate::{Diagnosis, Effect, Options, SimPhysics, Verdict};
 
 /// One trial's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
     pub index: u64,
+    /// The first concealed catalogued effect.
     pub truth: Option<Effect>,
+    /// A second one (independent reality).
+    pub second: Option<Effect>,
+    /// Whether an effect outside the catalogue was concealed.
+    pub outside: bool,
     pub drawn: Vec<(String, f64)>,
     pub verdict: Result<Verdict, String>,
-    /// |fitted − true| / |true| of the scored parameter, when the verdict is right.
+    /// Every effect named.
+    pub named: Vec<Effect>,
+    /// Located mismatches no named effect explains.
+    pub unexplained: usize,
+    /// |fitted − true| / |true| of the scored parameter of the primary concealed effect, when
+    /// it is named.
     pub param_error: Option<f64>,
+    /// The same for every concealed effect named.
+    pub param_errors: Vec<(Effect, f64)>,
+    /// For every named effect: whether its held-out RMSE is lower with it than without.
+    pub improved: Vec<bool>,
     pub fitted: Vec<f64>,
     /// Held-out RMSE after the fix over the noise floor, and before over the floor.
     pub heldout: Option<(f64, f64)>,
@@ -26,24 +43,58 @@ pub struct Outcome {
     pub seconds: f64,
 }
 
-pub(crate) fn trial(
+impl Outcome {
+    /// Whether it names an effect that was not concealed.
+    #[must_use]
+    pub fn names_absent(&self) -> bool {
+        self.named
+            .iter()
+            .any(|e| Some(*e) != self.truth && Some(*e) != self.second)
+    }
+}
+
+/// Trial `i`'s "real" recording and what it conceals.
+pub(crate) fn real_recording(
     nominal: &Scenario,
-    seed: u64,
+    plan: Plan,
     i: u64,
-    strength: f64,
-    only: Option<usize>,
-) -> Outcome {
+) -> (Drawn, Result<Recording, String>) {
+    match plan.reality {
+        Reality::Hilsim => {
+            let (real, drawn) = real_scenario(nominal, plan.seed, i, plan.strength, plan.only);
+            let recording = Emulation::new(&real, real.seed)
+                .map(|e| e.run().recording)
+                .map_err(|e| e.to_string());
+            (drawn, recording)
+        }
+        Reality::Independent => {
+            let mut d = Draws::new(plan.seed, i);
+            let (drawn, nuisances) = draw_independent(&mut d, plan.strength, nominal, plan.only);
+            let seed = d.next() >> 1;
+            let recording = hilsim_reality::record(nominal, &drawn.concealed, nuisances, seed);
+            (drawn, Ok(recording))
+        }
+    }
+}
+
+pub(crate) fn trial(nominal: &Scenario, plan: Plan, i: u64) -> Outcome {
     let started = Instant::now();
-    let (real, drawn) = real_scenario(nominal, seed, i, strength, only);
-    let recording = match Emulation::new(&real, real.seed) {
-        Ok(e) => e.run().recording,
+    let (drawn, recording) = real_recording(nominal, plan, i);
+    let recording = match recording {
+        Ok(r) => r,
         Err(err) => {
             return Outcome {
                 index: i,
                 truth: drawn.effect,
+                second: drawn.second.map(|s| s.0),
+                outside: drawn.outside,
                 drawn: drawn.params,
-                verdict: Err(err.to_string()),
+                verdict: Err(err),
+                named: Vec::new(),
+                unexplained: 0,
                 param_error: None,
+                param_errors: Vec::new(),
+                improved: Vec::new(),
                 fitted: Vec::new(),
                 heldout: None,
                 strongest: (f64::NAN, f64::NAN),
@@ -57,42 +108,66 @@ pub(crate) fn trial(
         .and_then(|physics| {
             crate::diagnose(&physics, &recording, &Options::default()).map_err(|e| e.to_string())
         });
-    let mut strongest = (f64::NAN, f64::NAN);
-    let (verdict, param_error, fitted, heldout) = match result {
-        Err(e) => (Err(e), None, Vec::new(), None),
-        Ok(diag) => {
-            strongest = (
-                diag.sensors
-                    .iter()
-                    .map(|s| s.strongest)
-                    .fold(f64::NEG_INFINITY, f64::max),
-                diag.threshold,
-            );
-            let fit = diag.fitted.as_ref();
-            let fitted = fit.map(|f| f.params.clone()).unwrap_or_default();
-            let param_error = match (diag.verdict, drawn.effect, drawn.truth, fit) {
-                (Verdict::Effect(v), Some(e), Some(t), Some(f)) if v == e => {
-                    let got = e.params()[0].self_test.scored(f.params[0]);
-                    Some((got - t).abs() / t.abs())
-                }
-                _ => None,
-            };
-            let heldout =
-                fit.map(|f| (f.rmse_after / f.noise_floor, f.rmse_before / f.noise_floor));
-            (Ok(diag.verdict), param_error, fitted, heldout)
-        }
-    };
-    Outcome {
+    let mut outcome = Outcome {
         index: i,
         truth: drawn.effect,
-        drawn: drawn.params,
-        verdict,
-        param_error,
-        fitted,
-        heldout,
-        strongest,
-        seconds: started.elapsed().as_secs_f64(),
+        second: drawn.second.map(|s| s.0),
+        outside: drawn.outside,
+        drawn: drawn.params.clone(),
+        verdict: Err(String::new()),
+        named: Vec::new(),
+        unexplained: 0,
+        param_error: None,
+        param_errors: Vec::new(),
+        improved: Vec::new(),
+        fitted: Vec::new(),
+        heldout: None,
+        strongest: (f64::NAN, f64::NAN),
+        seconds: 0.0,
+    };
+    match result {
+        Err(e) => outcome.verdict = Err(e),
+        Ok(diag) => score_diagnosis(&mut outcome, &drawn, &diag),
     }
+    outcome.seconds = started.elapsed().as_secs_f64();
+    outcome
+}
+
+/// Fills `o` from the diagnosis `diag` of a recording that concealed `drawn`.
+fn score_diagnosis(o: &mut Outcome, drawn: &Drawn, diag: &Diagnosis) {
+    o.strongest = (
+        diag.sensors
+            .iter()
+            .map(|s| s.strongest)
+            .fold(f64::NEG_INFINITY, f64::max),
+        diag.threshold,
+    );
+    o.verdict = Ok(diag.verdict);
+    o.named = diag.effects.iter().map(|e| e.fit.effect).collect();
+    o.unexplained = diag.unexplained.len();
+    o.improved = diag
+        .effects
+        .iter()
+        .map(|e| e.fit.rmse_after < e.fit.rmse_before && e.fit.heldout_gain > 0.0)
+        .collect();
+    for (effect, truth) in drawn.catalogued() {
+        if let Some(named) = diag.effects.iter().find(|e| e.fit.effect == effect) {
+            let got = effect.params()[0].self_test.scored(named.fit.params[0]);
+            o.param_errors
+                .push((effect, (got - truth).abs() / truth.abs()));
+        }
+    }
+    let fit = diag.fitted.as_ref();
+    o.fitted = fit.map(|f| f.params.clone()).unwrap_or_default();
+    o.param_error = match (diag.verdict, drawn.effect) {
+        (Verdict::Effect(v), Some(e)) if v == e => o
+            .param_errors
+            .iter()
+            .find(|(x, _)| *x == e)
+            .map(|(_, err)| *err),
+        _ => None,
+    };
+    o.heldout = fit.map(|f| (f.rmse_after / f.noise_floor, f.rmse_before / f.noise_floor));
 }
 
 pub(crate) fn label(e: Option<Effect>) -> &'static str {

@@ -1,0 +1,41 @@
+//! What a self-test is asked: how many trials, their seed and strength, which class, and what
+//! makes the "real" recordings.
+
+/// What a self-test is asked: trials of a nominal scenario.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plan {
+    /// Trials.
+    pub trials: u64,
+    /// The self-test's seed S: trial `i` is a function of (S, i) alone.
+    pub seed: u64,
+    /// The drawn parameters' scale (1: the documented moderate ranges).
+    pub strength: f64,
+    /// Draw only this class (0: none; 1..=9: the catalogue in order; 10, the independent
+    /// reality only: the effect outside the catalogue), or any.
+    pub only: Option<usize>,
+    /// What makes the "real" recordings.
+    pub reality: Reality,
+}
+
+/// What makes a self-test's "real" recordings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reality {
+    /// hilsim's own simulator with the drawn effect switched on (its own noise seed).
+    #[default]
+    Hilsim,
+    /// `hilsim-reality`, which shares no model code with the simulator, with random
+    /// nuisances, two effects at once in a fifth of the trials and an effect outside the
+    /// catalogue.
+    Independent,
+}
+
+impl Reality {
+    /// Its name on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hilsim => "hilsim",
+            Self::Independent => "independent",
+        }
+    }
+}

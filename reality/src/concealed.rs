@@ -1,0 +1,63 @@
+//! What a "real" robot has that its scenario does not say: the catalogue's physics, written
+//! here again from its definitions (`docs/diagnose.md`, `scenarios/README.md` `[effects]`), and
+//! physics outside the catalogue.
+
+/// One concealed effect with its parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Concealed {
+    /// The lidar reads `κ d tan θ` long (θ the incidence angle, capped at 80°).
+    LidarIncidence { coefficient: f64 },
+    /// The lidar's range walks by `c (ρ_ref/ρ − 1)` on a surface of reflectivity ρ.
+    LidarReflectivity { coefficient_m: f64, reference: f64 },
+    /// The beam has an angular half-width; a footprint over several surfaces returns the
+    /// harmonic mean of their ranges weighted by `share · ρ cos θ / d²`.
+    LidarMixedPixels { half_width_deg: f64 },
+    /// Each reading's geometry is taken at its own instant (the head turns while the robot
+    /// moves), where the scenario says a revolution is one instant.
+    LidarMotionSkew,
+    /// The range error `k d² e^{−t/τ}` of a unit warming up.
+    LidarWarmup {
+        coefficient_per_m: f64,
+        time_constant_s: f64,
+    },
+    /// The sonar returns the nearest echo in a cone of this half-angle.
+    SonarBeamWidth { half_angle_deg: f64 },
+    /// Every sonar range scaled by `c(calibrated)/c(air)`, `c(T) = 331.3 √(1 + T/273.15)`.
+    SonarSpeedOfSound {
+        air_temperature_c: f64,
+        calibrated_at_c: f64,
+    },
+    /// The encoders lead the true travel by `g v` (slip at `g a`).
+    WheelSlip { gain_s: f64 },
+    /// Each wheel's speed follows its command with a first-order lag.
+    MotorLag { time_constant_s: f64 },
+    /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
+    /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
+    /// the sensor, which moves with 1/d; over a room's ranges it reads as a ripple in d).
+    LidarPeriodicRange { amplitude_m: f64, period_m: f64 },
+}
+
+impl Concealed {
+    /// A name for reports.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::LidarIncidence { .. } => "lidar_incidence_angle",
+            Self::LidarReflectivity { .. } => "lidar_reflectivity",
+            Self::LidarMixedPixels { .. } => "lidar_mixed_pixels",
+            Self::LidarMotionSkew => "lidar_motion_skew",
+            Self::LidarWarmup { .. } => "lidar_warmup_drift",
+            Self::SonarBeamWidth { .. } => "sonar_beam_width",
+            Self::SonarSpeedOfSound { .. } => "sonar_speed_of_sound",
+            Self::WheelSlip { .. } => "odometer_wheel_slip",
+            Self::MotorLag { .. } => "drive_motor_lag",
+            Self::LidarPeriodicRange { .. } => "lidar_periodic_range",
+        }
+    }
+}
+
+/// Speed of sound in air at `t_c` °C, m/s (ideal gas: `331.3 √(1 + T/273.15)`).
+#[must_use]
+pub fn speed_of_sound(t_c: f64) -> f64 {
+    331.3 * (1.0 + t_c / 273.15).sqrt()
+}

@@ -1,0 +1,177 @@
+//! An independent reality: recordings of a scenario made by a generator that shares no model
+//! code with hilsim's simulator (`hilsim-sim`) or sensor emulator (`hilsim-lidar-emulator`).
+//! Its geometry and ray casting, its noise, its timing and its drive are written here from the
+//! scenario format (`docs/formats/interfaces.md`, `scenarios/README.md`) and the papers' range
+//! model; it uses `hilsim_sim::scenario` only for the scenario file's parsed form and
+//! `hilsim-recording` for the output types. On top of the scenario it can conceal effects
+//! (the diagnosis catalogue's physics, written again here, and physics outside it) and the
+//! small differences between any two simulators that no catalogue is about ([`Nuisances`]).
+//! `hilsim diagnose --self-test N --reality independent` proves the diagnosis on it.
+
+mod concealed;
+mod motion;
+mod noise;
+mod nuisance;
+mod sensors;
+mod world;
+
+pub use concealed::Concealed;
+pub use noise::Stream;
+pub use nuisance::Nuisances;
+
+use hilsim_recording::{Meta, Mount, Pose, Recording, RobotMeta, SonarMount};
+use hilsim_sim::scenario::Scenario;
+
+use crate::motion::Drive;
+use crate::sensors::Run;
+use crate::world::{World, WorldOffsets};
+
+/// A recording of `scenario` by this generator, with `concealed` physics and `nuisances`,
+/// its noise drawn from `seed`.
+#[must_use]
+pub fn record(
+    scenario: &Scenario,
+    concealed: &[Concealed],
+    nuisances: Nuisances,
+    seed: u64,
+) -> Recording {
+    let world = World::new(
+        scenario,
+        WorldOffsets {
+            wall_shift_m: nuisances.wall_shift_m,
+            radius_change_m: nuisances.radius_change_m,
+        },
+    );
+    let spans = motion::program(scenario);
+    let end_s = motion::run_length(scenario, &spans);
+    let lag_s = concealed.iter().find_map(|c| match *c {
+        Concealed::MotorLag { time_constant_s } => Some(time_constant_s),
+        _ => None,
+    });
+    let start = Pose {
+        x: scenario.robot.start.x,
+        y: scenario.robot.start.y,
+        yaw: scenario.robot.start.yaw_deg.to_radians(),
+    };
+    let mut drive_noise = Stream::new(seed, "reality-drive");
+    let motion = motion::integrate(
+        &spans,
+        start,
+        scenario.robot.wheel_base_m,
+        end_s,
+        Drive {
+            lag_s,
+            speed_noise: nuisances.speed_noise,
+        },
+        &mut drive_noise,
+    );
+    let run = Run {
+        scenario,
+        world: &world,
+        motion: &motion,
+        end_s,
+        concealed,
+        nuisances,
+    };
+    let s = &scenario.sensors;
+    Recording {
+        meta: Meta {
+            robot: RobotMeta {
+                wheel_base_m: scenario.robot.wheel_base_m,
+            },
+            lidar: s.lidar.as_ref().map(|l| Mount::from(l.mount)),
+            sonar: s.sonar.as_ref().map(|u| SonarMount {
+                x_m: u.mount.x_m,
+                y_m: u.mount.y_m,
+                yaw_deg: u.mount.yaw_deg,
+                half_angle_deg: u.half_angle_deg,
+            }),
+            ..Meta::default()
+        },
+        commands: motion::commands(&spans, end_s),
+        odometry: run.odometer(seed),
+        lidar: run.lidar(seed),
+        sonar: run.sonar(seed),
+        truth: Some(run.truth(seed)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A robot standing 2 m in front of a wall, every sensor, for 10 s.
+    fn facing_a_wall() -> Scenario {
+        Scenario::from_toml(
+            r#"name = "wall"
+[world]
+walls = [{ from = [3.0, -2.0], to = [3.0, 2.0] }]
+[robot]
+start = { x = 1.0, y = 0.0, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+[[drive]]
+stop_s = 10.0
+[sensors.lidar]
+bias = [0.0, 1.0]
+noise = [0.01]
+[sensors.sonar]
+bias = [0.0, 1.0]
+noise = [0.008]
+[sensors.odometer]
+noise_m = 0.002
+"#,
+            std::path::Path::new("wall.toml"),
+        )
+        .unwrap()
+    }
+
+    fn mean(v: &[f64]) -> f64 {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+
+    #[test]
+    fn a_wall_two_metres_ahead_reads_two_metres_and_a_hot_room_reads_short() {
+        let s = facing_a_wall();
+        let r = record(&s, &[], Nuisances::default(), 7);
+        let ahead: Vec<f64> = r
+            .lidar
+            .as_ref()
+            .unwrap()
+            .iter()
+            .filter(|l| l.angle_deg == 0.0 && !l.invalid)
+            .map(|l| l.range_m)
+            .collect();
+        // 50 revolutions of noise 10 mm: the mean within 4σ/√50 = 5.7 mm of 2 m.
+        assert_eq!(ahead.len(), 50);
+        assert!((mean(&ahead) - 2.0).abs() < 0.0057, "{}", mean(&ahead));
+        let sonar: Vec<f64> = r
+            .sonar
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|p| p.range_m)
+            .collect();
+        assert!((mean(&sonar) - 2.0).abs() < 0.004, "{}", mean(&sonar));
+        // Air at 40 °C against a calibration at 20 °C: ranges × c(20)/c(40) = 0.9686.
+        let hot = record(
+            &s,
+            &[Concealed::SonarSpeedOfSound {
+                air_temperature_c: 40.0,
+                calibrated_at_c: 20.0,
+            }],
+            Nuisances::default(),
+            7,
+        );
+        let hot: Vec<f64> = hot.sonar.unwrap().iter().map(|p| p.range_m).collect();
+        assert!((mean(&hot) - 2.0 * 0.9686).abs() < 0.004, "{}", mean(&hot));
+        // The same seed, the same recording.
+        assert_eq!(record(&s, &[], Nuisances::default(), 7), r);
+    }
+
+    #[test]
+    fn nuisances_are_drawn_from_the_seed_alone() {
+        let a = Nuisances::draw(&mut Stream::new(3, "n"));
+        assert_eq!(a, Nuisances::draw(&mut Stream::new(3, "n")));
+        assert_ne!(a, Nuisances::draw(&mut Stream::new(4, "n")));
+    }
+}

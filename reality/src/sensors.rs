@@ -1,0 +1,335 @@
+//! The sensors: the papers' range model (reading = Σ αᵢ dⁱ + (Σ βᵢ dⁱ)·e, Saha et al. /
+//! the EM paper's eq. (2), coefficients from the scenario), rays cast in this crate's own
+//! world, and the concealed effects and nuisances of the run.
+
+use hilsim_recording::{LidarSample, OdometrySample, Pose, SonarSample, TruthSample};
+use hilsim_sim::scenario::{LidarTiming, Scenario};
+
+use crate::concealed::{speed_of_sound, Concealed};
+use crate::motion::Motion;
+use crate::noise::Stream;
+use crate::nuisance::Nuisances;
+use crate::world::World;
+
+/// Σ cᵢ dⁱ.
+fn poly(c: &[f64], d: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &k| acc * d + k)
+}
+
+/// The incidence angle's cap: beyond 80° the footprint's depth `d tan θ` has no meaning.
+const MAX_INCIDENCE_RAD: f64 = 80.0 * std::f64::consts::PI / 180.0;
+/// Directions a mixed-pixel footprint is sampled at (across the beam's width).
+const FOOTPRINT_SAMPLES: usize = 9;
+/// Intensity at 1 m on the default material, head-on; it falls as d^-0.7 (XV-11 captures).
+const INTENSITY_AT_1M: f64 = 9000.0;
+/// Below this intensity the unit sets its strength-warning flag.
+const WEAK_INTENSITY: f64 = 50.0;
+
+fn at_mount(p: Pose, x: f64, y: f64, yaw_deg: f64) -> ([f64; 2], f64) {
+    let (s, c) = p.yaw.sin_cos();
+    (
+        [p.x + c * x - s * y, p.y + s * x + c * y],
+        p.yaw + yaw_deg.to_radians(),
+    )
+}
+
+fn quantise(v: f64, step: f64) -> f64 {
+    if step > 0.0 {
+        (v / step).round() * step
+    } else {
+        v
+    }
+}
+
+/// Everything the sensors need.
+pub struct Run<'a> {
+    pub scenario: &'a Scenario,
+    pub world: &'a World,
+    pub motion: &'a Motion,
+    pub end_s: f64,
+    pub concealed: &'a [Concealed],
+    pub nuisances: Nuisances,
+}
+
+impl Run<'_> {
+    fn has(&self, f: impl Fn(&Concealed) -> bool) -> bool {
+        self.concealed.iter().any(f)
+    }
+
+    /// One range-noise deviate: Gaussian, or Student-t of unit variance.
+    fn deviate(&self, s: &mut Stream) -> f64 {
+        if self.nuisances.tail_dof > 0.0 {
+            s.student_unit_variance(self.nuisances.tail_dof)
+        } else {
+            s.normal()
+        }
+    }
+
+    /// The lidar's readings.
+    pub fn lidar(&self, seed: u64) -> Option<Vec<LidarSample>> {
+        let cfg = self.scenario.sensors.lidar.as_ref()?;
+        let n = &self.nuisances;
+        let mut noise = Stream::new(seed, "reality-lidar");
+        let mut drops = Stream::new(seed, "reality-lidar-drops");
+        let period = 60.0 / cfg.rpm;
+        let slot = period / 360.0;
+        let snapshot = cfg.timing == LidarTiming::PerRevolution
+            && !self.has(|c| matches!(c, Concealed::LidarMotionSkew));
+        let max_range = cfg.max_range_m * n.max_range_factor;
+        let mut out = Vec::new();
+        let revolutions = (self.end_s / period).floor() as u64;
+        for rev in 0..revolutions {
+            let t_rev = rev as f64 * period;
+            if drops.chance(n.dropped_revolutions) {
+                continue;
+            }
+            let mut dropped_packet = false;
+            for i in 0..360u16 {
+                if i % 4 == 0 {
+                    dropped_packet = drops.chance(n.dropped_packets);
+                }
+                let t = t_rev + f64::from(i) * slot;
+                let t_geometry = if snapshot {
+                    t_rev
+                } else {
+                    (t + n.reading_phase * slot).max(0.0)
+                };
+                let (origin, heading) = at_mount(
+                    self.motion.pose(t_geometry),
+                    cfg.mount.x_m,
+                    cfg.mount.y_m,
+                    cfg.mount.yaw_deg,
+                );
+                let direction = heading
+                    + f64::from(i).to_radians()
+                    + cfg.angle_noise_deg.to_radians() * noise.normal();
+                let e = self.deviate(&mut noise);
+                let spurious = noise.chance(n.spurious_share);
+                let spurious_at = noise.between(cfg.min_range_m, max_range);
+                let jitter = n.timestamp_jitter_s * noise.normal();
+                if dropped_packet {
+                    continue;
+                }
+                let reading = self.lidar_reading(cfg, origin, direction, t, e, max_range);
+                let (range, true_range, strength) = match reading {
+                    Some(r) => r,
+                    None => (0.0, None, 0.0),
+                };
+                let range = if spurious { spurious_at } else { range };
+                let range = quantise(range, n.lidar_resolution_m);
+                let valid_by = if n.validity_by_true_range && !spurious {
+                    true_range.unwrap_or(f64::INFINITY)
+                } else {
+                    range
+                };
+                let valid = range > 0.0 && valid_by >= cfg.min_range_m && valid_by <= max_range;
+                let strength = (strength * n.intensity_scale).clamp(0.0, f64::from(u16::MAX));
+                out.push(LidarSample {
+                    t_s: (t + jitter).max(0.0),
+                    rev,
+                    angle_deg: f64::from(i),
+                    range_m: if valid { range } else { 0.0 },
+                    strength: if valid { strength as u16 } else { 0 },
+                    invalid: !valid,
+                    warning: valid && strength < WEAK_INTENSITY,
+                    true_range_m: None,
+                });
+            }
+        }
+        out.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        Some(out)
+    }
+
+    /// One lidar reading (before rounding and validity): the reported range, the true range
+    /// and the intensity, or `None` when nothing is within reach.
+    fn lidar_reading(
+        &self,
+        cfg: &hilsim_sim::scenario::Lidar,
+        origin: [f64; 2],
+        direction: f64,
+        t: f64,
+        e: f64,
+        max_range: f64,
+    ) -> Option<(f64, Option<f64>, f64)> {
+        let reach = 2.0 * max_range;
+        let hit = self.world.cast(origin, direction, reach)?;
+        let mut d = hit.range_m;
+        for c in self.concealed {
+            if let Concealed::LidarMixedPixels { half_width_deg } = *c {
+                // A top-hat footprint sampled across its width: the triangulation camera sees
+                // every part and reports f b / x̄, the weighted harmonic mean of their ranges.
+                let (mut num, mut den) = (0.0, 0.0);
+                for k in 0..FOOTPRINT_SAMPLES {
+                    let u = (k as f64 + 0.5) / FOOTPRINT_SAMPLES as f64 * 2.0 - 1.0;
+                    let dir = direction + u * half_width_deg.to_radians();
+                    if let Some(h) = self.world.cast(origin, dir, reach) {
+                        let w = h.reflectivity * h.incidence_rad.cos() / (h.range_m * h.range_m);
+                        num += w;
+                        den += w / h.range_m;
+                    }
+                }
+                if den > 0.0 {
+                    d = num / den;
+                }
+            }
+        }
+        let theta = hit.incidence_rad.min(MAX_INCIDENCE_RAD);
+        // The effects move the distance the unit measures; its calibration (the bias
+        // polynomial) then maps that distance to the reading, as it maps the true one.
+        let mut measured = d;
+        for c in self.concealed {
+            measured += match *c {
+                Concealed::LidarIncidence { coefficient } => coefficient * d * theta.tan(),
+                Concealed::LidarReflectivity {
+                    coefficient_m,
+                    reference,
+                } => coefficient_m * (reference / hit.reflectivity - 1.0),
+                Concealed::LidarWarmup {
+                    coefficient_per_m,
+                    time_constant_s,
+                } => coefficient_per_m * d * d * (-t / time_constant_s).exp(),
+                Concealed::LidarPeriodicRange {
+                    amplitude_m,
+                    period_m,
+                } => amplitude_m * (std::f64::consts::TAU * d / period_m).sin(),
+                _ => 0.0,
+            };
+        }
+        let reading = poly(&cfg.bias, measured) + poly(&cfg.noise, d) * e;
+        let intensity =
+            INTENSITY_AT_1M * hit.reflectivity / 0.8 * hit.incidence_rad.cos() * d.powf(-0.7);
+        Some((reading.max(0.0), Some(hit.range_m), intensity))
+    }
+
+    /// The sonar's pings (none where no echo is within range).
+    pub fn sonar(&self, seed: u64) -> Option<Vec<SonarSample>> {
+        let cfg = self.scenario.sensors.sonar.as_ref()?;
+        let n = &self.nuisances;
+        let mut noise = Stream::new(seed, "reality-sonar");
+        let half_angle = self
+            .concealed
+            .iter()
+            .find_map(|c| match *c {
+                Concealed::SonarBeamWidth { half_angle_deg } => Some(half_angle_deg),
+                _ => None,
+            })
+            .unwrap_or(cfg.half_angle_deg);
+        let scale = self
+            .concealed
+            .iter()
+            .find_map(|c| match *c {
+                Concealed::SonarSpeedOfSound {
+                    air_temperature_c,
+                    calibrated_at_c,
+                } => Some(speed_of_sound(air_temperature_c) / speed_of_sound(calibrated_at_c)),
+                _ => None,
+            })
+            .unwrap_or(1.0);
+        let rate = cfg.rate_hz * n.rate_factor;
+        let mut out = Vec::new();
+        let mut k = 0u64;
+        loop {
+            let t = n.sample_phase_s + k as f64 / rate;
+            k += 1;
+            if t > self.end_s {
+                break;
+            }
+            let (origin, heading) = at_mount(
+                self.motion.pose(t),
+                cfg.mount.x_m,
+                cfg.mount.y_m,
+                cfg.mount.yaw_deg,
+            );
+            // The nearest echo in the cone, every 0.25° across it.
+            let steps = (half_angle / 0.25).ceil() as i64;
+            let nearest = (-steps..=steps)
+                .filter_map(|j| {
+                    let a = heading
+                        + (j as f64 * 0.25)
+                            .clamp(-half_angle, half_angle)
+                            .to_radians();
+                    self.world
+                        .cast(origin, a, cfg.max_range_m)
+                        .map(|h| h.range_m)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let e = self.deviate(&mut noise);
+            let jitter = n.timestamp_jitter_s * noise.normal();
+            if !nearest.is_finite() {
+                continue;
+            }
+            // The echo time is converted with the calibration temperature's speed of sound;
+            // the true echo travels at the air's: the range reads c_cal / c_air too short or long.
+            let reading = (poly(&cfg.bias, nearest) + poly(&cfg.noise, nearest) * e) / scale;
+            out.push(SonarSample {
+                t_s: (t + jitter).max(0.0),
+                range_m: quantise(reading, n.sonar_resolution_m),
+                true_range_m: None,
+            });
+        }
+        out.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        Some(out)
+    }
+
+    /// The encoders' cumulative travel.
+    pub fn odometer(&self, seed: u64) -> Option<Vec<OdometrySample>> {
+        let cfg = self.scenario.sensors.odometer.as_ref()?;
+        let n = &self.nuisances;
+        let mut noise = Stream::new(seed, "reality-odometer");
+        let gain = self
+            .concealed
+            .iter()
+            .find_map(|c| match *c {
+                Concealed::WheelSlip { gain_s } => Some(gain_s),
+                _ => None,
+            })
+            .unwrap_or(0.0);
+        let rate = cfg.rate_hz * n.rate_factor;
+        let rho = n.encoder_correlation;
+        let mut out = Vec::new();
+        let mut k = 0u64;
+        loop {
+            let t = n.sample_phase_s + k as f64 / rate;
+            k += 1;
+            if t > self.end_s {
+                break;
+            }
+            let travel = self.motion.travel(t);
+            let speed = self.motion.speed(t);
+            let (a, b) = (noise.normal(), noise.normal());
+            let e = [a, rho * a + (1.0 - rho * rho).sqrt() * b];
+            let jitter = n.timestamp_jitter_s * noise.normal();
+            let wheel = |w: usize| {
+                let v = travel[w] * (1.0 + cfg.slip) + gain * speed[w] + cfg.noise_m * e[w];
+                quantise(v, cfg.tick_m)
+            };
+            out.push(OdometrySample {
+                t_s: (t + jitter).max(0.0),
+                left_m: wheel(0),
+                right_m: wheel(1),
+            });
+        }
+        out.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        Some(out)
+    }
+
+    /// The true trajectory at the truth rate, with motion-capture noise.
+    pub fn truth(&self, seed: u64) -> Vec<TruthSample> {
+        let n = &self.nuisances;
+        let mut noise = Stream::new(seed, "reality-truth");
+        let count = (self.end_s * n.truth_hz).floor() as usize;
+        (0..=count)
+            .map(|k| {
+                let t = k as f64 / n.truth_hz;
+                let p = self.motion.pose(t);
+                let yaw = p.yaw + n.truth_noise_rad * noise.normal();
+                TruthSample {
+                    t_s: t,
+                    x_m: p.x + n.truth_noise_m * noise.normal(),
+                    y_m: p.y + n.truth_noise_m * noise.normal(),
+                    yaw_rad: yaw.sin().atan2(yaw.cos()),
+                }
+            })
+            .collect()
+    }
+}

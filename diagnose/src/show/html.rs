@@ -77,6 +77,54 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
 
 /// The named effect's fitted parameters and its held-out RMSE before and after.
 fn fix(s: &mut String, d: &Diagnosis) {
+    // Every effect named beyond the first, and what no named effect explains.
+    if d.effects.len() > 1 {
+        let _ = writeln!(
+            s,
+            "<h2>Every effect named</h2><table><tr><th>effect</th><th>where</th><th>parameters</th><th>held-out RMSE before → after</th></tr>"
+        );
+        for e in &d.effects {
+            let f = &e.fit;
+            let params: Vec<String> = f
+                .effect
+                .params()
+                .iter()
+                .zip(&f.params)
+                .map(|(spec, v)| format!("{} = {} {}", spec.name, fmt_sig(*v), spec.unit))
+                .collect();
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{} → {}</td></tr>",
+                f.effect,
+                e.located.as_ref().map_or_else(String::new, |l| format!(
+                    "{}, {}",
+                    l.sensor,
+                    escape(&l.place)
+                )),
+                escape(&params.join(", ")),
+                mm(f.rmse_before),
+                mm(f.rmse_after)
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
+    if !d.unexplained.is_empty() {
+        let _ = writeln!(
+            s,
+            "<h2>Unexplained</h2><p>Mismatches located above their sensor's floor that no named effect explains.</p><table><tr><th>sensor</th><th>where</th><th>size</th><th>evidence</th></tr>"
+        );
+        for u in &d.unexplained {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                u.sensor,
+                escape(&u.place),
+                mm(u.size_m),
+                escape(&u.detail)
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
     if let Some(f) = &d.fitted {
         let _ = writeln!(
             s,

@@ -62,13 +62,11 @@ fn dead_reckoning(
     }];
     let mut last = odometry[0];
     for o in &odometry[1..] {
-        let (dl, dr) = (o.left_m - last.left_m, o.right_m - last.right_m);
-        let forward = (dl + dr) / 2.0;
-        let turn = (dr - dl) / d.wheel_base_m;
-        let mid = pose.yaw + turn / 2.0;
-        pose.x += forward * mid.cos();
-        pose.y += forward * mid.sin();
-        pose.yaw = wrap(pose.yaw + turn);
+        pose = pose.drive(
+            o.left_m - last.left_m,
+            o.right_m - last.right_m,
+            d.wheel_base_m,
+        );
         if o.t_s > out[out.len() - 1].t_s {
             out.push(TruthSample {
                 t_s: o.t_s,

@@ -190,25 +190,18 @@ struct Scan {
 
 /// A few revolutions spread over the run, among those with the most valid readings.
 fn chosen_revolutions(view: &View<'_>) -> Vec<u64> {
-    let Some(lidar) = view.inputs.recording.lidar.as_deref() else {
+    let Some(revs) = view.revolutions.as_deref() else {
         return Vec::new();
     };
     if view.reference == "none" {
         return Vec::new();
     }
-    let mut revs: Vec<(u64, usize)> = Vec::new();
-    for s in lidar {
-        match revs.last_mut() {
-            Some((rev, n)) if *rev == s.rev => *n += usize::from(!s.invalid),
-            _ => revs.push((s.rev, usize::from(!s.invalid))),
-        }
-    }
-    let most = revs.iter().map(|r| r.1).max().unwrap_or(0);
+    let most = revs.iter().map(|r| r.valid).max().unwrap_or(0);
     // Complete revolutions only: at least half as many valid readings as the best one.
     let full: Vec<u64> = revs
         .iter()
-        .filter(|r| r.1 * 2 >= most && r.1 > 0)
-        .map(|r| r.0)
+        .filter(|r| r.valid * 2 >= most && r.valid > 0)
+        .map(|r| r.rev)
         .collect();
     if full.is_empty() {
         return Vec::new();

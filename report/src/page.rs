@@ -52,11 +52,7 @@ pub fn render_with(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
 <h1>{title}</h1>"#,
         title = escape(inputs.title)
     );
-    let revolutions = rec.lidar.as_deref().map(|l| {
-        let mut revs: Vec<u64> = l.iter().map(|s| s.rev).collect();
-        revs.dedup();
-        revs.len()
-    });
+    let revolutions = view.revolutions.as_ref().map(Vec::len);
     let mut facts = vec![format!("{} s", fmt_sig(rec.duration_s()))];
     if let (Some(l), Some(revs)) = (&rec.lidar, revolutions) {
         facts.push(format!("{} lidar readings in {revs} revolutions", l.len()));

@@ -183,25 +183,15 @@ fn distance_ahead(view: &View<'_>, t: Span) -> Option<String> {
 
 /// How many valid readings each revolution holds: dropped packets and out-of-range beams show.
 fn readings_per_revolution(view: &View<'_>, t: Span) -> Option<String> {
-    let lidar = view.inputs.recording.lidar.as_deref()?;
-    let mut revs: Vec<(u64, f64, usize, usize)> = Vec::new(); // rev, t, valid, all
-    for s in lidar {
-        match revs.last_mut() {
-            Some(r) if r.0 == s.rev => {
-                r.2 += usize::from(!s.invalid);
-                r.3 += 1;
-            }
-            _ => revs.push((s.rev, s.t_s, usize::from(!s.invalid), 1)),
-        }
-    }
+    let revs = view.revolutions.as_deref()?;
     if revs.is_empty() {
         return None;
     }
-    let valid: Vec<(f64, f64)> = revs.iter().map(|r| (r.1, r.2 as f64)).collect();
-    let all: Vec<(f64, f64)> = revs.iter().map(|r| (r.1, r.3 as f64)).collect();
+    let valid: Vec<(f64, f64)> = revs.iter().map(|r| (r.t_s, r.valid as f64)).collect();
+    let all: Vec<(f64, f64)> = revs.iter().map(|r| (r.t_s, r.readings as f64)).collect();
     let y = Span::new(
         0.0,
-        revs.iter().map(|r| r.3).max().unwrap_or(1) as f64 * 1.1,
+        revs.iter().map(|r| r.readings).max().unwrap_or(1) as f64 * 1.1,
     );
     let mut chart = Chart::new("perrev", 900.0, 220.0, t, y);
     chart.axes("Lidar readings per revolution", "time (s)", "readings");

@@ -39,6 +39,19 @@ pub struct Scored {
     pub true_m: f64,
 }
 
+/// One lidar revolution's counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Revolution {
+    /// Its number.
+    pub rev: u64,
+    /// When its first reading was taken, seconds.
+    pub t_s: f64,
+    /// Its readings.
+    pub readings: usize,
+    /// Its valid readings.
+    pub valid: usize,
+}
+
 /// The derived data of a report.
 #[derive(Debug)]
 pub struct View<'a> {
@@ -57,6 +70,9 @@ pub struct View<'a> {
     pub sonar: Vec<Scored>,
     /// Where the true distances came from, for the page.
     pub true_distance_source: &'static str,
+    /// The lidar's revolutions in order (consecutive readings of one `rev`); `None` without a
+    /// lidar.
+    pub revolutions: Option<Vec<Revolution>>,
 }
 
 impl<'a> View<'a> {
@@ -159,6 +175,7 @@ impl<'a> View<'a> {
             lidar,
             sonar,
             true_distance_source,
+            revolutions: rec.lidar.as_deref().map(revolutions),
         }
     }
 
@@ -181,6 +198,27 @@ impl<'a> View<'a> {
             .iter()
             .find_map(|c| c.sensors.get(&sensor).map(|m| (c, m.alpha.as_slice())))
     }
+}
+
+/// The revolutions of `lidar`: runs of consecutive readings with one `rev`.
+fn revolutions(lidar: &[LidarSample]) -> Vec<Revolution> {
+    let mut out: Vec<Revolution> = Vec::new();
+    for s in lidar {
+        let valid = usize::from(!s.invalid);
+        match out.last_mut() {
+            Some(r) if r.rev == s.rev => {
+                r.readings += 1;
+                r.valid += valid;
+            }
+            _ => out.push(Revolution {
+                rev: s.rev,
+                t_s: s.t_s,
+                readings: 1,
+                valid,
+            }),
+        }
+    }
+    out
 }
 
 /// The beam's direction in the lidar's frame, radians.

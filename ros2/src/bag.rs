@@ -135,6 +135,15 @@ fn listed_files(yaml: &str) -> Vec<String> {
         .collect()
 }
 
+/// Whether the file at `path` begins as MCAP's magic does (as far as it goes).
+fn starts_like_mcap(path: &Path) -> bool {
+    const MAGIC: &[u8] = b"\x89MCAP0\r\n";
+    let mut head = Vec::with_capacity(MAGIC.len());
+    let read = File::open(path)
+        .and_then(|f| std::io::Read::take(f, MAGIC.len() as u64).read_to_end(&mut head));
+    read.is_ok() && MAGIC.starts_with(&head)
+}
+
 /// One line for an MCAP error.
 fn mcap_error(path: &Path, err: McapError) -> Error {
     let message = match err {
@@ -143,6 +152,10 @@ fn mcap_error(path: &Path, err: McapError) -> Error {
             format!(
                 "a chunk compressed with `{name}`, which hilsim cannot read (zstd and lz4 only)"
             )
+        }
+        // A file shorter than MCAP's magic ends before it can be told apart: say which it is.
+        McapError::UnexpectedEof | McapError::UnexpectedEoc if !starts_like_mcap(path) => {
+            "not an MCAP file (a ROS 2 bag's storage must be MCAP)".to_string()
         }
         McapError::UnexpectedEof | McapError::UnexpectedEoc => {
             "truncated: the file ends inside a record".to_string()
@@ -350,6 +363,12 @@ mod tests {
     fn not_mcap_and_truncated_files_are_named() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.mcap");
+        std::fs::write(&path, b"hello").unwrap();
+        let err = stream(&path, |_| Ok(())).unwrap_err().to_string();
+        assert!(
+            err.contains("x.mcap: not an MCAP file"),
+            "shorter than the magic: {err}"
+        );
         std::fs::write(&path, b"hello, this is not an MCAP file at all").unwrap();
         let err = stream(&path, |_| Ok(())).unwrap_err().to_string();
         assert!(err.contains("x.mcap: not an MCAP file"), "{err}");
@@ -361,5 +380,6 @@ mod tests {
         .unwrap();
         let err = stream(&path, |_| Ok(())).unwrap_err().to_string();
         assert!(err.starts_with(&format!("{}: ", path.display())), "{err}");
+        assert!(err.contains("truncated"), "{err}");
     }
 }

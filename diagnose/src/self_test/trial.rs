@@ -77,6 +77,29 @@ pub(crate) fn real_recording(
     }
 }
 
+impl Outcome {
+    /// Trial `i` with what was drawn, before anything was diagnosed.
+    fn before_diagnosis(i: u64, drawn: &Drawn) -> Self {
+        Self {
+            index: i,
+            truth: drawn.effect,
+            second: drawn.second.map(|s| s.0),
+            outside: drawn.outside,
+            drawn: drawn.params.clone(),
+            verdict: Err(String::new()),
+            named: Vec::new(),
+            unexplained: 0,
+            param_error: None,
+            param_errors: Vec::new(),
+            improved: Vec::new(),
+            fitted: Vec::new(),
+            heldout: None,
+            strongest: (f64::NAN, f64::NAN),
+            seconds: 0.0,
+        }
+    }
+}
+
 pub(crate) fn trial(nominal: &Scenario, plan: Plan, i: u64) -> Outcome {
     let started = Instant::now();
     let (drawn, recording) = real_recording(nominal, plan, i);
@@ -84,21 +107,9 @@ pub(crate) fn trial(nominal: &Scenario, plan: Plan, i: u64) -> Outcome {
         Ok(r) => r,
         Err(err) => {
             return Outcome {
-                index: i,
-                truth: drawn.effect,
-                second: drawn.second.map(|s| s.0),
-                outside: drawn.outside,
-                drawn: drawn.params,
                 verdict: Err(err),
-                named: Vec::new(),
-                unexplained: 0,
-                param_error: None,
-                param_errors: Vec::new(),
-                improved: Vec::new(),
-                fitted: Vec::new(),
-                heldout: None,
-                strongest: (f64::NAN, f64::NAN),
                 seconds: started.elapsed().as_secs_f64(),
+                ..Outcome::before_diagnosis(i, &drawn)
             }
         }
     };
@@ -108,23 +119,7 @@ pub(crate) fn trial(nominal: &Scenario, plan: Plan, i: u64) -> Outcome {
         .and_then(|physics| {
             crate::diagnose(&physics, &recording, &Options::default()).map_err(|e| e.to_string())
         });
-    let mut outcome = Outcome {
-        index: i,
-        truth: drawn.effect,
-        second: drawn.second.map(|s| s.0),
-        outside: drawn.outside,
-        drawn: drawn.params.clone(),
-        verdict: Err(String::new()),
-        named: Vec::new(),
-        unexplained: 0,
-        param_error: None,
-        param_errors: Vec::new(),
-        improved: Vec::new(),
-        fitted: Vec::new(),
-        heldout: None,
-        strongest: (f64::NAN, f64::NAN),
-        seconds: 0.0,
-    };
+    let mut outcome = Outcome::before_diagnosis(i, &drawn);
     match result {
         Err(e) => outcome.verdict = Err(e),
         Ok(diag) => score_diagnosis(&mut outcome, &drawn, &diag),

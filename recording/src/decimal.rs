@@ -1,8 +1,96 @@
 //! Numbers as CSV text, exactly as `Display` writes them (the shortest decimal that reads back
 //! as the same `f64`, in plain notation), faster: formatting was half the time of `hilsim
-//! record` (issue 18). The shortest digits come from Żmij (`zmij`, by the author of `ryu` and
-//! `itoa`); only its notation and its rounding of exact ties are changed here, to `Display`'s,
-//! so recordings keep their bytes.
+//! record` (issue 18) and most of `hilsim import`'s (issue 17). The fixed decimals a recording
+//! mostly holds (times to the microsecond, millimetres) are written from their integer digits;
+//! other numbers' shortest digits come from Żmij (`zmij`, by the author of `ryu` and `itoa`),
+//! with its notation and its rounding of exact ties changed to `Display`'s, so recordings keep
+//! their bytes.
+
+/// Where CSV text goes: a `String` (a whole table) or a byte buffer (a streamed table's).
+pub(crate) trait Text {
+    /// Appends `s`.
+    fn push_str(&mut self, s: &str);
+    /// Appends one ASCII byte.
+    fn push_byte(&mut self, b: u8);
+    /// Appends the ASCII text `write` puts at the start of a buffer of [`SHORT_MAX`] bytes
+    /// (it returns its length).
+    fn push_short(&mut self, write: impl FnOnce(&mut [u8]) -> usize);
+}
+
+impl Text for String {
+    fn push_str(&mut self, s: &str) {
+        String::push_str(self, s);
+    }
+    fn push_byte(&mut self, b: u8) {
+        self.push(char::from(b));
+    }
+    fn push_short(&mut self, write: impl FnOnce(&mut [u8]) -> usize) {
+        let mut bytes = [0; SHORT_MAX];
+        let len = write(&mut bytes);
+        // ASCII: digits, '-' and '.'.
+        String::push_str(self, std::str::from_utf8(&bytes[..len]).unwrap_or_default());
+    }
+}
+
+impl Text for Vec<u8> {
+    fn push_str(&mut self, s: &str) {
+        self.extend_from_slice(s.as_bytes());
+    }
+    fn push_byte(&mut self, b: u8) {
+        self.push(b);
+    }
+    fn push_short(&mut self, write: impl FnOnce(&mut [u8]) -> usize) {
+        // Written in place (a copy from a stack buffer would wait for the bytes just stored
+        // there), then the unused tail cut off.
+        let start = self.len();
+        self.extend_from_slice(&[0; SHORT_MAX]);
+        let len = write(&mut self[start..]);
+        self.truncate(start + len);
+    }
+}
+
+/// The longest short text: "-999999.999999999", or a u64's 20 digits.
+const SHORT_MAX: usize = 24;
+
+/// "00" to "99": two digits at a time.
+const PAIRS: &[u8; 200] = b"\
+0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
+/// The number of decimal digits of `n` (1 for 0).
+fn digit_count(n: u64) -> usize {
+    let mut count = 1;
+    let mut power = 10u64;
+    while count < 20 && n >= power {
+        count += 1;
+        power = power.wrapping_mul(10);
+    }
+    count
+}
+
+/// Writes `n`'s last `count` digits (zero-padded) into `out[..count]`.
+fn write_digits(out: &mut [u8], mut n: u64, count: usize) {
+    let mut end = count;
+    while end >= 2 {
+        let pair = usize::try_from(n % 100).unwrap_or(0) * 2;
+        out[end - 2..end].copy_from_slice(&PAIRS[pair..pair + 2]);
+        n /= 100;
+        end -= 2;
+    }
+    if end == 1 {
+        out[0] = b'0' + u8::try_from(n % 10).unwrap_or(0);
+    }
+}
+
+/// Writes an unsigned integer as `Display` does; its length.
+fn write_unsigned(out: &mut [u8], n: u64) -> usize {
+    let count = digit_count(n);
+    write_digits(out, n, count);
+    count
+}
 
 /// At and above this magnitude, and for "NaN" and "inf", `Display` itself writes the number:
 /// a recording's values are far below (times to 86,400 s, distances to 1,000 m).
@@ -15,7 +103,11 @@ const FAST_BELOW: f64 = 2_147_483_648.0; // 2^31
 /// (Żmij rounds half to even, `Display` half up). That is common in a recording: a float that
 /// came from `f32` (rapier's positions) has a short exact decimal expansion. Such a tie is found
 /// exactly from the bits and left to `Display`.
-pub(crate) fn push_f64(out: &mut String, x: f64) {
+pub(crate) fn push_f64(out: &mut impl Text, x: f64) {
+    if let Some(n) = on_grid(x) {
+        out.push_short(|bytes| write_grid(bytes, x < 0.0, n));
+        return;
+    }
     if !x.is_finite() || x.abs() >= FAST_BELOW {
         out.push_str(&x.to_string());
         return;
@@ -53,6 +145,82 @@ pub(crate) fn push_f64(out: &mut String, x: f64) {
     }
 }
 
+/// The fixed decimals a recording mostly holds (times to the microsecond, angles to 1e-4°,
+/// ranges to the millimetre, wheel travel to the nanometre): numbers that are the `f64`
+/// closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵.
+const GRID: f64 = 1e9;
+const GRID_DIGITS: usize = 9;
+const GRID_LIMIT: f64 = 1e15;
+
+/// |n| when `x` is the `f64` closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵; `None`
+/// otherwise (and for a few within 10⁻⁶ of a tie between two `f64`, which lose nothing but
+/// this shortcut).
+fn on_grid(x: f64) -> Option<u64> {
+    let magnitude = x.abs();
+    if !(1e-9..GRID_LIMIT / GRID).contains(&magnitude) {
+        return None;
+    }
+    // The whole number nearest |x|·10⁹ (a cast, not a call to `round`; a wrong guess fails the
+    // check below). Signed: one instruction each way, where u64 takes several.
+    let n = (magnitude * GRID + 0.5) as i64;
+    // The f64 closest to n·10⁻⁹ is |x| when n lies within 10⁹ × half the step between |x| and
+    // its neighbours of |x|·10⁹ (a division would say so, slower). |x|·10⁹ exactly is
+    // high + low, |x| cut into its upper 32 bits and lower 21, each product exact (10⁹ =
+    // 1953125·2⁹ has 21 bits); n − high is exact (the two are within a factor of 2 of each
+    // other whenever it matters), so d is n − |x|·10⁹ to 2⁻⁵³ of itself.
+    let bits = magnitude.to_bits();
+    let high = f64::from_bits(bits & !((1 << 21) - 1));
+    let low = magnitude - high;
+    let d = (n as f64 - high * GRID) - low * GRID;
+    // Half a step is 2^(e−53) for |x| in [2^e, 2^(e+1)); below a power of two the step halves.
+    let exponent = bits >> 52;
+    let mut half_step = f64::from_bits((exponent - 53) << 52) * GRID;
+    if bits & ((1 << 52) - 1) == 0 && d < 0.0 {
+        half_step *= 0.5;
+    }
+    // Strictly inside, by a margin far above d's own rounding: no tie, no doubt.
+    if n == 0 || d.abs() >= half_step * (1.0 - 1e-6) {
+        return None;
+    }
+    u64::try_from(n).ok()
+}
+
+/// Writes n·10⁻⁹ (0 < n < 10¹⁵) as `Display` writes the `f64` closest to it; its length.
+///
+/// Two different decimals of at most 15 significant digits are never closest to the same normal
+/// `f64` (15 is `f64::DIGITS`), and n·10⁻⁹ has at most 15: so no other decimal as short reads
+/// back as that `f64`, and n·10⁻⁹ without its trailing zeros is the shortest, as `Display`
+/// writes it (no tie to round either).
+fn write_grid(out: &mut [u8], negative: bool, n: u64) -> usize {
+    let whole = n / 1_000_000_000;
+    let fraction = n % 1_000_000_000;
+    let sign = usize::from(negative);
+    out[0] = b'-';
+    let mut len = sign + write_unsigned(&mut out[sign..], whole);
+    if fraction != 0 {
+        out[len] = b'.';
+        let digits = &mut out[len + 1..len + 1 + GRID_DIGITS];
+        write_nine_digits(digits, fraction);
+        // The fraction's trailing zeros are not written (found in the text: no divisions).
+        let mut kept = GRID_DIGITS;
+        while digits[kept - 1] == b'0' {
+            kept -= 1;
+        }
+        len += 1 + kept;
+    }
+    len
+}
+
+/// Writes the 9 digits of `n` < 10⁹ (zero-padded) into `out[..9]`, in independent pieces of
+/// 4 digits (shorter chains of dependent divisions).
+fn write_nine_digits(out: &mut [u8], n: u64) {
+    let first = n / 100_000_000;
+    let rest = n % 100_000_000;
+    out[0] = b'0' + u8::try_from(first).unwrap_or(0);
+    write_digits(&mut out[1..5], rest / 10_000, 4);
+    write_digits(&mut out[5..9], rest % 10_000, 4);
+}
+
 /// A decimal 0.d1d2…dn × 10^point, without leading or trailing zero digits.
 struct Decimal {
     digits: Vec<u8>,
@@ -87,24 +255,28 @@ impl Decimal {
     }
 
     /// Writes the number in plain notation, as `Display` does.
-    fn push_plain(&self, out: &mut String, negative: bool) {
+    fn push_plain(&self, out: &mut impl Text, negative: bool) {
         if negative {
-            out.push('-');
+            out.push_byte(b'-');
         }
         let digits = std::str::from_utf8(&self.digits).unwrap_or_default();
         let n = i64::try_from(digits.len()).unwrap_or(i64::MAX);
-        let zeros = |count: i64| std::iter::repeat_n('0', usize::try_from(count).unwrap_or(0));
+        let zeros = |out: &mut dyn FnMut(u8), count: i64| {
+            for _ in 0..count {
+                out(b'0');
+            }
+        };
         if self.point <= 0 {
             out.push_str("0.");
-            out.extend(zeros(-self.point));
+            zeros(&mut |b| out.push_byte(b), -self.point);
             out.push_str(digits);
         } else if self.point >= n {
             out.push_str(digits);
-            out.extend(zeros(self.point - n));
+            zeros(&mut |b| out.push_byte(b), self.point - n);
         } else {
             let split = usize::try_from(self.point).unwrap_or(0);
             out.push_str(&digits[..split]);
-            out.push('.');
+            out.push_byte(b'.');
             out.push_str(&digits[split..]);
         }
     }
@@ -131,9 +303,10 @@ fn is_halfway(x: f64, n: usize, point: i64) -> bool {
     m != 0 && i64::from(m.trailing_zeros()) + e + 1 + q == 0
 }
 
-/// Appends an integer as `Display` writes it.
-pub(crate) fn push_int(out: &mut String, n: impl itoa::Integer) {
-    out.push_str(itoa::Buffer::new().format(n));
+/// Appends an unsigned integer as `Display` writes it.
+pub(crate) fn push_int(out: &mut impl Text, n: impl Into<u64>) {
+    let n = n.into();
+    out.push_short(|bytes| write_unsigned(bytes, n));
 }
 
 #[cfg(test)]
@@ -141,9 +314,13 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// As a whole table's `String` and a streamed table's bytes write it (the two must agree).
     fn shown(x: f64) -> String {
         let mut s = String::new();
         push_f64(&mut s, x);
+        let mut bytes = b"a,".to_vec();
+        push_f64(&mut bytes, x);
+        assert_eq!(bytes, format!("a,{s}").into_bytes());
         s
     }
 
@@ -163,6 +340,15 @@ mod tests {
             1.2345e21,
             5e-324,
             0.150_000_000_000_000_02,
+            1e-9,
+            -1e-9,
+            1.5e-9,
+            0.000_001,
+            123.456_789,
+            -0.002,
+            999_999.999_999_999,
+            1_000_000.000_000_001,
+            86_400.000_001,
             18.799_999_999_999_965,
             f64::MAX,
             0.696_266_174_316_406_3,
@@ -193,6 +379,17 @@ mod tests {
             prop_assert_eq!(shown(half), half.to_string());
         }
 
+        // The grid's numbers: times to the microsecond, millimetres, nanometres, near 10⁶.
+        #[test]
+        fn decimals_on_the_grid_read_as_display_writes_them(
+            n in -999_999_999_999_999i64..1_000_000_000_000_000, scale in 0u32..10,
+        ) {
+            let x = n as f64 / 10f64.powi(scale as i32);
+            prop_assert_eq!(shown(x), x.to_string());
+            let near = f64::from_bits(x.to_bits() + 1);
+            prop_assert_eq!(shown(near), near.to_string());
+        }
+
         #[test]
         fn recording_scale_numbers_read_as_display_writes_them(
             x in -1e4f64..1e4, steps in 0u32..1_000_000,
@@ -203,12 +400,57 @@ mod tests {
         }
     }
 
+    /// The shortcut takes nearly every decimal of the grid (else it would be no shortcut), and
+    /// nothing off it.
+    #[test]
+    fn the_grid_is_found() {
+        for (x, n) in [
+            (0.15, 150_000_000),
+            (1.0, 1_000_000_000),
+            (0.5, 500_000_000),
+        ] {
+            assert_eq!(on_grid(x), Some(n), "{x}");
+            assert_eq!(on_grid(-x), Some(n), "{x}");
+        }
+        assert_eq!(on_grid(2.0), Some(2_000_000_000));
+        assert_eq!(on_grid(1e-9), Some(1));
+        assert_eq!(on_grid(999_999.999_999_999), Some(999_999_999_999_999));
+        assert_eq!(on_grid(0.1 + 0.2), None);
+        assert_eq!(on_grid(1e6), None);
+        assert_eq!(on_grid(f64::NAN), None);
+        let mut found = 0;
+        let total = 1_000_000;
+        for i in 0..total {
+            // Microseconds up to 10⁵ s; millimetres.
+            let n = (i as i64) * 100_003;
+            found += usize::from(on_grid(n as f64 / 1e6).is_some());
+            found += usize::from(on_grid((i % 100_000) as f64 / 1e3).is_some_and(|m| m != 0));
+        }
+        // The margin refuses about 10⁻⁶ of them; one in ten thousand leaves room.
+        assert!(found > 2 * total - total / 10_000, "{found}");
+    }
+
     #[test]
     fn integers_read_as_display_writes_them() {
-        for n in [0u64, 7, 359, 65_535, u64::MAX] {
-            let mut s = String::new();
-            push_int(&mut s, n);
-            assert_eq!(s, n.to_string());
+        let mut n = 1u64;
+        for _ in 0..20 {
+            for m in [n - 1, n, n + 1, n.saturating_mul(7), n / 2 * 3] {
+                let mut s = String::new();
+                push_int(&mut s, m);
+                let mut bytes = Vec::new();
+                push_int(&mut bytes, m);
+                assert_eq!(s, m.to_string());
+                assert_eq!(bytes, m.to_string().into_bytes());
+            }
+            n = n.saturating_mul(10);
         }
+        for m in [65_535u16, 0, 359] {
+            let mut s = String::new();
+            push_int(&mut s, m);
+            assert_eq!(s, m.to_string());
+        }
+        let mut s = String::new();
+        push_int(&mut s, u64::MAX);
+        assert_eq!(s, u64::MAX.to_string());
     }
 }

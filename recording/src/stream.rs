@@ -5,7 +5,7 @@
 
 use std::convert::Infallible;
 use std::fs::{self, File};
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::atomic::{check_replaceable_recording, new_sibling_dir, put_in_place};
@@ -89,11 +89,17 @@ pub struct Tables {
 /// range, so it is written with the first row (or, for an empty table, at the end).
 struct TableFile {
     path: PathBuf,
-    out: BufWriter<File>,
+    file: File,
+    /// Rows not yet written to `file` (written when [`FLUSH_AT`] bytes are waiting), so that a
+    /// row is formatted straight into it.
+    text: Vec<u8>,
     /// The header, once written; `None` before the first row of a table whose header waits.
     with_truth: Option<bool>,
-    row: String,
 }
+
+/// A table's rows are written to its file in pieces of about this size (bounded memory; few
+/// system calls).
+const FLUSH_AT: usize = 1 << 18;
 
 impl TableFile {
     fn create(dir: &Path, name: &str, header: Option<&str>) -> Result<Self, Error> {
@@ -101,21 +107,25 @@ impl TableFile {
         let file = File::create(&path).map_err(|err| Error::io(&path, err))?;
         let mut table = Self {
             path,
-            out: BufWriter::with_capacity(1 << 16, file),
+            file,
+            // A row is at most a few hundred bytes (eight numbers of `Display`'s longest).
+            text: Vec::with_capacity(FLUSH_AT + 4096),
             with_truth: None,
-            row: String::with_capacity(128),
         };
         if let Some(header) = header {
             table.with_truth = Some(false);
-            table.put(header)?;
+            table.text.extend_from_slice(header.as_bytes());
         }
         Ok(table)
     }
 
-    fn put(&mut self, text: &str) -> Result<(), Error> {
-        self.out
-            .write_all(text.as_bytes())
-            .map_err(|err| Error::io(&self.path, err))
+    /// Writes the waiting rows to the file.
+    fn flush(&mut self) -> Result<(), Error> {
+        self.file
+            .write_all(&self.text)
+            .map_err(|err| Error::io(&self.path, err))?;
+        self.text.clear();
+        Ok(())
     }
 
     /// Writes one row made by `format`; `truth` says whether it carries a true range (for the
@@ -124,7 +134,7 @@ impl TableFile {
         &mut self,
         truth: Option<bool>,
         header: fn(bool) -> &'static str,
-        format: impl FnOnce(&mut String, bool),
+        format: impl FnOnce(&mut Vec<u8>, bool),
     ) -> Result<(), Error> {
         let with_truth = match (self.with_truth, truth) {
             (Some(w), Some(t)) if w != t => {
@@ -138,16 +148,15 @@ impl TableFile {
             (None, t) => {
                 let w = t.unwrap_or(false);
                 self.with_truth = Some(w);
-                self.put(header(w))?;
+                self.text.extend_from_slice(header(w).as_bytes());
                 w
             }
         };
-        let mut row = std::mem::take(&mut self.row);
-        row.clear();
-        format(&mut row, with_truth);
-        let written = self.put(&row);
-        self.row = row;
-        written
+        format(&mut self.text, with_truth);
+        if self.text.len() >= FLUSH_AT {
+            self.flush()?;
+        }
+        Ok(())
     }
 
     /// Writes a waiting header (an empty table has none of the truth column) and flushes; the
@@ -157,13 +166,10 @@ impl TableFile {
         header: Option<fn(bool) -> &'static str>,
     ) -> Result<(PathBuf, File), Error> {
         if let (None, Some(header)) = (self.with_truth, header) {
-            self.put(header(false))?;
+            self.text.extend_from_slice(header(false).as_bytes());
         }
-        let file = self
-            .out
-            .into_inner()
-            .map_err(|err| Error::io(&self.path, err.into_error()))?;
-        Ok((self.path, file))
+        self.flush()?;
+        Ok((self.path, self.file))
     }
 }
 

@@ -82,7 +82,7 @@ impl Recording {
 /// One row of each table, as the whole-table writer above and the streaming writer
 /// (`stream.rs`) both write it: floats in Rust's shortest round-trip form.
 pub(crate) mod rows {
-    use crate::decimal::{push_f64, push_int};
+    use crate::decimal::{push_f64, push_int, Text};
     use crate::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
 
     pub(crate) const COMMANDS_HEADER: &str = "t_s,left_mps,right_mps\n";
@@ -106,56 +106,58 @@ pub(crate) mod rows {
     }
 
     /// Fields joined by commas, each written as `Display` writes it.
-    fn fields(s: &mut String, numbers: &[f64]) {
+    fn fields(s: &mut impl Text, numbers: &[f64]) {
         for (i, &x) in numbers.iter().enumerate() {
             if i > 0 {
-                s.push(',');
+                s.push_byte(b',');
             }
             push_f64(s, x);
         }
     }
 
-    pub(crate) fn command(s: &mut String, c: &CommandSample) {
+    pub(crate) fn command(s: &mut impl Text, c: &CommandSample) {
         fields(s, &[c.t_s, c.left_mps, c.right_mps]);
-        s.push('\n');
+        s.push_byte(b'\n');
     }
 
-    pub(crate) fn odometry(s: &mut String, o: &OdometrySample) {
+    pub(crate) fn odometry(s: &mut impl Text, o: &OdometrySample) {
         fields(s, &[o.t_s, o.left_m, o.right_m]);
-        s.push('\n');
+        s.push_byte(b'\n');
     }
 
-    pub(crate) fn truth(s: &mut String, p: &TruthSample) {
+    pub(crate) fn truth(s: &mut impl Text, p: &TruthSample) {
         fields(s, &[p.t_s, p.x_m, p.y_m, p.yaw_rad]);
-        s.push('\n');
+        s.push_byte(b'\n');
     }
 
-    pub(crate) fn lidar(s: &mut String, r: &LidarSample, with_truth: bool) {
+    pub(crate) fn lidar(s: &mut impl Text, r: &LidarSample, with_truth: bool) {
         push_f64(s, r.t_s);
-        s.push(',');
+        s.push_byte(b',');
         push_int(s, r.rev);
-        s.push(',');
+        s.push_byte(b',');
         // A whole angle prints as the integer it is ("90"), as the XV-11's always did.
         push_f64(s, r.angle_deg);
-        s.push(',');
+        s.push_byte(b',');
         push_f64(s, r.range_m);
-        s.push(',');
+        s.push_byte(b',');
         push_int(s, r.strength);
-        s.push_str(if r.invalid { ",1" } else { ",0" });
-        s.push_str(if r.warning { ",1" } else { ",0" });
+        for flag in [r.invalid, r.warning] {
+            s.push_byte(b',');
+            s.push_byte(if flag { b'1' } else { b'0' });
+        }
         true_range(s, r.true_range_m.filter(|_| with_truth));
     }
 
-    pub(crate) fn sonar(s: &mut String, r: &SonarSample, with_truth: bool) {
+    pub(crate) fn sonar(s: &mut impl Text, r: &SonarSample, with_truth: bool) {
         fields(s, &[r.t_s, r.range_m]);
         true_range(s, r.true_range_m.filter(|_| with_truth));
     }
 
-    fn true_range(s: &mut String, t: Option<f64>) {
+    fn true_range(s: &mut impl Text, t: Option<f64>) {
         if let Some(t) = t {
-            s.push(',');
+            s.push_byte(b',');
             push_f64(s, t);
         }
-        s.push('\n');
+        s.push_byte(b'\n');
     }
 }

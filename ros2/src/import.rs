@@ -311,9 +311,8 @@ pub struct Converter {
     /// Stamp clock minus log clock, once a stamped message has said.
     clock_offset_ns: Option<i64>,
     pending_commands: Vec<(i64, Twist)>,
-    /// The latest time written into each table, and how many rows came earlier than it.
-    last_t: BTreeMap<Role, f64>,
-    reordered: BTreeMap<Role, (u64, f64)>,
+    /// Each table's time order.
+    clocks: BTreeMap<Role, TableClock>,
     rows: BTreeMap<Role, u64>,
     rev: u64,
     odometry: Option<OdometryState>,
@@ -321,6 +320,53 @@ pub struct Converter {
     odometry_start_m: (f64, f64),
     sonar_out_of_range: u64,
     sonar_fov_rad: Option<f64>,
+}
+
+/// A table's time order: the latest time written, and the rows that came earlier than it.
+#[derive(Default)]
+struct TableClock {
+    last_s: f64,
+    reordered: u64,
+    worst_s: f64,
+}
+
+impl TableClock {
+    /// `t_s`, or the latest time written when `t_s` is earlier (counted).
+    fn order(&mut self, t_s: f64) -> f64 {
+        if t_s < self.last_s {
+            self.reordered += 1;
+            self.worst_s = f64::max(self.worst_s, self.last_s - t_s);
+            return self.last_s;
+        }
+        self.last_s = t_s;
+        t_s
+    }
+}
+
+/// Seconds to the microsecond of `ns` plus `extra_ns` (the difference from t = 0 taken in
+/// integers first, as a stamp, ~1.7e18 ns, is finer than an f64 resolves).
+fn microseconds(ns_from_start: i64, extra_ns: f64) -> f64 {
+    round_half_away((ns_from_start as f64 + extra_ns) / 1e3) / 1e6
+}
+
+/// `f64::round` (half away from zero) without its call into the C library, which the
+/// baseline x86-64 target has no instruction for: it was a tenth of an import's time.
+fn round_half_away(x: f64) -> f64 {
+    // 2⁵²: from here on every f64 is whole (and NaN, ±inf pass through).
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
+        return x;
+    }
+    // |x| < 2⁵²: the cast truncates exactly, and `x - whole` is exact.
+    let whole = x as i64 as f64;
+    let fraction = x - whole;
+    if fraction >= 0.5 {
+        whole + 1.0
+    } else if fraction <= -0.5 {
+        whole - 1.0
+    } else {
+        // Keeps the sign of a zero, as `round` does.
+        whole.copysign(x)
+    }
 }
 
 /// The last pose (or wheel angles) and the wheel travel so far.
@@ -352,8 +398,7 @@ impl Converter {
             t0_ns: None,
             clock_offset_ns: None,
             pending_commands: Vec::new(),
-            last_t: BTreeMap::new(),
-            reordered: BTreeMap::new(),
+            clocks: BTreeMap::new(),
             rows: BTreeMap::new(),
             rev: 0,
             odometry: None,
@@ -393,16 +438,8 @@ impl Converter {
     /// an f64 resolves.
     fn seconds(&mut self, role: Role, ns: i64, extra_ns: f64) -> f64 {
         let t0 = *self.t0_ns.get_or_insert(ns);
-        let t = (((ns - t0) as f64 + extra_ns) / 1e3).round() / 1e6;
-        let last = self.last_t.entry(role).or_insert(0.0);
-        if t < *last {
-            let (count, worst) = self.reordered.entry(role).or_insert((0, 0.0));
-            *count += 1;
-            *worst = f64::max(*worst, *last - t);
-            return *last;
-        }
-        *last = t;
-        t
+        let t_s = microseconds(ns - t0, extra_ns);
+        self.clocks.entry(role).or_default().order(t_s)
     }
 
     fn count(&mut self, role: Role, n: u64) {
@@ -528,15 +565,18 @@ impl Converter {
         let increment = decimal_of_f32(scan.angle_increment);
         let time_increment_ns = decimal_of_f32(scan.time_increment) * 1e9;
         let (range_min, range_max) = (scan.range_min, scan.range_max);
+        let from_start_ns = ns - *self.t0_ns.get_or_insert(ns);
+        let clock = self.clocks.entry(Role::Lidar).or_default();
         for (i, &range) in scan.ranges.iter().enumerate() {
             let i_f = i as f64;
-            let t_s = self.seconds(Role::Lidar, ns, i_f * time_increment_ns);
+            let t_s = clock.order(microseconds(from_start_ns, i_f * time_increment_ns));
             let valid = range.is_finite() && range >= range_min && range <= range_max;
+            // The nearest whole strength (half away from zero, as `round`; exact in f64).
             let strength = scan
                 .intensities
                 .get(i)
                 .filter(|s| s.is_finite())
-                .map_or(0, |&s| s.round().clamp(0.0, f32::from(u16::MAX)) as u16);
+                .map_or(0, |&s| (f64::from(s.clamp(0.0, 65_535.0)) + 0.5) as u16);
             sink.lidar(&LidarSample {
                 t_s,
                 rev: self.rev,
@@ -717,11 +757,12 @@ impl Converter {
     #[must_use]
     pub fn notes(&self) -> Vec<String> {
         let mut notes = Vec::new();
-        for (role, (count, worst)) in &self.reordered {
+        for (role, clock) in self.clocks.iter().filter(|(_, c)| c.reordered > 0) {
             notes.push(format!(
-                "{count} {role} rows came before the row written ahead of them (by up to {:.3} \
-                 ms) and were put at its time",
-                worst * 1e3
+                "{} {role} rows came before the row written ahead of them (by up to {:.3} ms) \
+                 and were put at its time",
+                clock.reordered,
+                clock.worst_s * 1e3
             ));
         }
         if self.sonar_out_of_range > 0 {
@@ -742,6 +783,9 @@ pub fn decimal_of_f32(x: f32) -> f64 {
     if !x.is_finite() {
         return f64::from(x);
     }
+    if let Some(decimal) = short_decimal_of_f32(x) {
+        return decimal;
+    }
     let mut buffer = zmij::Buffer::new();
     buffer
         .format_finite(x)
@@ -749,13 +793,60 @@ pub fn decimal_of_f32(x: f32) -> f64 {
         .unwrap_or_else(|_| f64::from(x))
 }
 
+/// `x`'s decimal when it has at most 6 significant digits (millimetre ranges, `0.5`,
+/// `12.25`), found without formatting; `None` otherwise (and outside 1e-10..1e6).
+///
+/// Two different decimals of at most 6 significant digits (`f32::DIGITS`) are never read as
+/// the same normal `f32`, so one that reads as `x` is the only one as short: the shortest, the
+/// one [`decimal_of_f32`] gives. The 6-digit decimals are 10⁻ˢ apart, 10 to 100 times the
+/// float32's step, so only the one closest to `x` can read as `x`: n·10⁻ˢ for n the whole
+/// number closest to |x|·10ˢ, with s such that n has 6 digits.
+fn short_decimal_of_f32(x: f32) -> Option<f64> {
+    const POWERS: [f64; 16] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let magnitude = f64::from(x).abs();
+    if !(1e-10..1e6).contains(&magnitude) {
+        return None;
+    }
+    let power = POWERS.iter().copied().find(|p| magnitude * p >= 1e5)?;
+    let scaled = round_half_away(magnitude * power);
+    // n ≥ 10⁵ by the choice of s: n ≤ 10⁶ has at most 6 significant digits. (A power one
+    // off at a boundary makes 7 digits, or a decimal that misses `x`: `None` either way.)
+    if scaled > 1e6 {
+        return None;
+    }
+    // The f64 closest to n·10⁻ˢ (n and 10ˢ are exact: one rounding), what parsing the
+    // decimal gives.
+    let decimal = scaled / power;
+    // It reads as `x` when it lies within half a step of `x` towards either neighbour (the
+    // steps differ at a power of two); the margin of one part in 10⁶ is far above the f64
+    // rounding of `decimal` (10⁻¹⁶), so that no double rounding decides.
+    let bits = x.abs().to_bits();
+    let below = f64::from(f32::from_bits(bits - 1));
+    let above = f64::from(f32::from_bits(bits + 1));
+    let half_step = 0.5 * f64::min(magnitude - below, above - magnitude);
+    ((decimal - magnitude).abs() < half_step * (1.0 - 1e-6)).then_some(if x < 0.0 {
+        -decimal
+    } else {
+        decimal
+    })
+}
+
 /// A LaserScan angle (radians, any turn) as a recording's degrees in [0, 360), to 1e-4°: the
 /// float32 angle and increment put reading i of a 360-reading scan about 1e-5° off its nominal
 /// angle, and no lidar resolves 1e-4°.
 #[must_use]
 pub fn angle_deg(angle_rad: f64) -> f64 {
-    let deg = ((angle_rad.to_degrees() * 1e4).round() / 1e4).rem_euclid(360.0);
-    if deg >= 360.0 {
+    let deg = round_half_away(angle_rad.to_degrees() * 1e4) / 1e4;
+    // Most angles of a scan are in [0, 360) already: no `fmod` for them.
+    let deg = if (0.0..360.0).contains(&deg) {
+        deg
+    } else {
+        deg.rem_euclid(360.0)
+    };
+    // A turn rounded up to 360 is 0, and so is -0 (a tiny negative angle): written "0".
+    if deg >= 360.0 || deg == 0.0 {
         0.0
     } else {
         deg
@@ -773,13 +864,69 @@ mod tests {
         assert_eq!(decimal_of_f32(6.0), 6.0);
     }
 
+    /// The short path gives what formatting the float32's shortest decimal and reading it does,
+    /// for every float32 between 1e-11 and 1e7 in steps of a prime number of bit patterns.
+    #[test]
+    fn short_decimals_are_the_shortest() {
+        let slow = |x: f32| -> f64 { zmij::Buffer::new().format_finite(x).parse().unwrap() };
+        let (low, high) = (1e-11f32.to_bits(), 1e7f32.to_bits());
+        let mut short = 0;
+        for bits in (low..high).step_by(997) {
+            for x in [f32::from_bits(bits), -f32::from_bits(bits)] {
+                assert_eq!(decimal_of_f32(x), slow(x), "{x:e}");
+                short += usize::from(short_decimal_of_f32(x).is_some());
+            }
+        }
+        for text in [
+            "1.234", "0.001", "65.535", "12.3456", "0.000123", "1000", "0.5", "99999.9", "10",
+            "123456", "1e-9",
+        ] {
+            let x: f32 = text.parse().unwrap();
+            let expected: f64 = text.parse().unwrap();
+            assert_eq!(short_decimal_of_f32(x), Some(expected), "{text}");
+            assert_eq!(short_decimal_of_f32(-x), Some(-expected), "-{text}");
+        }
+        assert_eq!(short_decimal_of_f32(1.234_567_8), None);
+        assert!(short > 0);
+    }
+
+    #[test]
+    fn rounding_is_round() {
+        let mut x = 1e-3f64;
+        for _ in 0..2000 {
+            for v in [
+                x,
+                -x,
+                x + 0.5,
+                -x - 0.5,
+                x.floor() + 0.5,
+                -(x.floor() + 0.5),
+            ] {
+                assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+            }
+            x *= 1.037;
+        }
+        for v in [
+            0.0,
+            -0.0,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4.5e15 + 0.5,
+        ] {
+            assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+        }
+        for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300] {
+            assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+        }
+    }
+
     #[test]
     fn angles_wrap_and_round() {
         let step = (1.0f64.to_radians() as f32) as f64;
         assert_eq!(angle_deg(359.0 * step), 359.0);
         assert_eq!(angle_deg(-std::f64::consts::FRAC_PI_2), 270.0);
         assert_eq!(angle_deg(2.0 * std::f64::consts::PI), 0.0);
-        assert_eq!(angle_deg(-1e-12), 0.0);
+        assert_eq!(angle_deg(-1e-12).to_bits(), 0.0f64.to_bits());
         let half = decimal_of_f32(0.5f64.to_radians() as f32);
         for i in 0..720 {
             assert_eq!(angle_deg(f64::from(i) * half), f64::from(i) * 0.5, "{i}");

@@ -8,8 +8,10 @@
 //! | `/odom` | `nav_msgs/msg/Odometry` (the wheel travel dead-reckoned) | `odom` → `base_link` |
 //! | `/cmd_vel` | `geometry_msgs/msg/TwistStamped` | `base_link` |
 //! | `/ground_truth/pose` | `geometry_msgs/msg/PoseStamped` | `map` |
-//! | `/tf` | `tf2_msgs/msg/TFMessage`: `map` → `base_link` (truth; else `odom` → `base_link`) | |
+//! | `/tf` | `tf2_msgs/msg/TFMessage`: `odom` → `base_link` (odometry), `map` → `odom` (truth) | |
 //! | `/tf_static` | `tf2_msgs/msg/TFMessage`: `base_link` → `laser`, `base_link` → `sonar` | |
+//!
+//! The frames are one tree (REP 105): `map` → `odom` → `base_link` → `laser`, `sonar`.
 //! | `/world` | `visualization_msgs/msg/MarkerArray` (with a world) | `map` |
 //! | `/scan_calibrated` | `sensor_msgs/msg/LaserScan` (with calibrated ranges) | `laser` |
 
@@ -17,7 +19,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 
-use hilsim_recording::{AtomicFile, LidarSample, Recording};
+use hilsim_recording::{AtomicFile, LidarSample, OdometrySample, Recording};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::write::NoSeek;
 use mcap::{Compression, WriteOptions};
@@ -236,11 +238,22 @@ fn write_all<W: Write>(
         name: START_METADATA.to_string(),
         metadata,
     })?;
-    // The sensors' mounts, once.
-    let mut mounts = Vec::new();
+    let truth = rec.truth.as_deref().unwrap_or_default();
+    let odometry = rec.odometry.as_deref().unwrap_or_default();
+    let wheel_base = rec.meta.robot.wheel_base_m;
+    // The frames as REP 105 chains them, one tree that a viewer shows in `map`: map → odom
+    // (where the odometry started, from the truth) → base_link (the odometry) → laser, sonar
+    // (the mounts). Without odometry the truth places base_link in map; without truth, odom is
+    // put at map's origin; with neither, base_link is.
+    let mut fixed = Vec::new();
+    match (truth.is_empty(), odometry.is_empty()) {
+        (true, false) => fixed.push(transform(START_NS, "map", "odom", 0.0, 0.0, 0.0)),
+        (true, true) => fixed.push(transform(START_NS, "map", "base_link", 0.0, 0.0, 0.0)),
+        (false, _) => {}
+    }
     if rec.lidar.is_some() {
         let lidar = rec.meta.lidar.unwrap_or_default();
-        mounts.push(transform(
+        fixed.push(transform(
             START_NS,
             "base_link",
             "laser",
@@ -249,22 +262,28 @@ fn write_all<W: Write>(
             lidar.yaw_rad(),
         ));
     }
-    if let (Some(_), Some(sonar)) = (&rec.sonar, &rec.meta.sonar) {
-        mounts.push(transform(
+    if rec.sonar.is_some() {
+        // A sonar without a mount in meta.toml is at the robot's centre, facing forward.
+        let (x, y, yaw_deg) = rec
+            .meta
+            .sonar
+            .as_ref()
+            .map_or((0.0, 0.0, 0.0), |s| (s.x_m, s.y_m, s.yaw_deg));
+        fixed.push(transform(
             START_NS,
             "base_link",
             "sonar",
-            sonar.x_m,
-            sonar.y_m,
-            sonar.yaw_deg.to_radians(),
+            x,
+            y,
+            yaw_deg.to_radians(),
         ));
     }
-    if !mounts.is_empty() {
+    if !fixed.is_empty() {
         bag.write(
             "/tf_static",
             "tf2_msgs/msg/TFMessage",
             START_NS,
-            &TfMessage { transforms: mounts },
+            &TfMessage { transforms: fixed },
         )?;
     }
     if let Some(world) = world {
@@ -278,8 +297,6 @@ fn write_all<W: Write>(
     let events = events(rec);
     let lidar = rec.lidar.as_deref().unwrap_or_default();
     let sonar = rec.sonar.as_deref().unwrap_or_default();
-    let truth = rec.truth.as_deref().unwrap_or_default();
-    let odometry = rec.odometry.as_deref().unwrap_or_default();
     let range_max = lidar
         .iter()
         .filter(|s| !s.invalid)
@@ -294,7 +311,7 @@ fn write_all<W: Write>(
         .sonar
         .as_ref()
         .map_or(0.0, |s| (2.0 * s.half_angle_deg).to_radians() as f32);
-    let wheel_base = rec.meta.robot.wheel_base_m;
+    let odometry_path = OdometryPath::new(odometry, wheel_base);
     let mut dead_reckoning = DeadReckoning::default();
     for (t_s, event) in events {
         let t_ns = stamp_ns(t_s);
@@ -350,18 +367,16 @@ fn write_all<W: Write>(
                 message.pose.pose = pose;
                 message.twist.twist = velocity;
                 bag.write("/odom", "nav_msgs/msg/Odometry", t_ns, &message)?;
-                if truth.is_empty() {
-                    let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
-                    let tf = transform(t_ns, "odom", "base_link", x, y, yaw);
-                    bag.write(
-                        "/tf",
-                        "tf2_msgs/msg/TFMessage",
-                        t_ns,
-                        &TfMessage {
-                            transforms: vec![tf],
-                        },
-                    )?;
-                }
+                let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
+                let tf = transform(t_ns, "odom", "base_link", x, y, yaw);
+                bag.write(
+                    "/tf",
+                    "tf2_msgs/msg/TFMessage",
+                    t_ns,
+                    &TfMessage {
+                        transforms: vec![tf],
+                    },
+                )?;
             }
             Event::Truth(i) => {
                 let p = &truth[i];
@@ -375,7 +390,16 @@ fn write_all<W: Write>(
                     t_ns,
                     &pose,
                 )?;
-                let tf = transform(t_ns, "map", "base_link", p.x_m, p.y_m, p.yaw_rad);
+                // base_link is in map where the truth says: through odom when there is
+                // odometry (odom's place is the truth composed with the inverse of the
+                // odometry's pose at that time, as tf2 interpolates it).
+                let tf = match odometry_path.at(p.t_s) {
+                    Some(odom_pose) => {
+                        let [x, y, yaw] = compose([p.x_m, p.y_m, p.yaw_rad], inverse(odom_pose));
+                        transform(t_ns, "map", "odom", x, y, yaw)
+                    }
+                    None => transform(t_ns, "map", "base_link", p.x_m, p.y_m, p.yaw_rad),
+                };
                 bag.write(
                     "/tf",
                     "tf2_msgs/msg/TFMessage",
@@ -568,6 +592,63 @@ impl DeadReckoning {
     }
 }
 
+/// The odometry's poses (dead-reckoned as `/odom` sends them) at each row's time.
+struct OdometryPath {
+    times_s: Vec<f64>,
+    poses: Vec<[f64; 3]>,
+}
+
+impl OdometryPath {
+    fn new(odometry: &[OdometrySample], wheel_base: f64) -> Self {
+        let mut dead_reckoning = DeadReckoning::default();
+        let (times_s, poses) = odometry
+            .iter()
+            .map(|o| {
+                let (pose, _) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
+                let (x, y) = (pose.position.x, pose.position.y);
+                (o.t_s, [x, y, pose.orientation.yaw()])
+            })
+            .unzip();
+        Self { times_s, poses }
+    }
+
+    /// The pose at `t_s` as tf2 interpolates between two stamped transforms: the position
+    /// linearly, the yaw along the shorter way (a quaternion slerp about z); the first or last
+    /// pose outside the rows' times. `None` without odometry.
+    fn at(&self, t_s: f64) -> Option<[f64; 3]> {
+        let after = self.times_s.partition_point(|&t| t <= t_s);
+        let last = self.poses.len().checked_sub(1)?;
+        if after == 0 || after > last {
+            return Some(self.poses[after.min(last)]);
+        }
+        let (t0, t1) = (self.times_s[after - 1], self.times_s[after]);
+        let ([x0, y0, a0], [x1, y1, a1]) = (self.poses[after - 1], self.poses[after]);
+        let f = (t_s - t0) / (t1 - t0);
+        let turn = hilsim_recording::wrap_angle(a1 - a0);
+        Some([
+            x0 + f * (x1 - x0),
+            y0 + f * (y1 - y0),
+            hilsim_recording::wrap_angle(a0 + f * turn),
+        ])
+    }
+}
+
+/// `b` (a pose in `a`'s frame) in the frame `a` is given in: planar poses [x, y, yaw].
+fn compose(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    let (sin, cos) = a[2].sin_cos();
+    [
+        a[0] + cos * b[0] - sin * b[1],
+        a[1] + sin * b[0] + cos * b[1],
+        hilsim_recording::wrap_angle(a[2] + b[2]),
+    ]
+}
+
+/// The pose of the frame a planar pose is given in, in that pose's frame.
+fn inverse(a: [f64; 3]) -> [f64; 3] {
+    let (sin, cos) = a[2].sin_cos();
+    [-cos * a[0] - sin * a[1], sin * a[0] - cos * a[1], -a[2]]
+}
+
 /// The world as markers: walls and boards as thin boxes 0.3 m high, cylinders as cylinders.
 fn markers(world: &World) -> MarkerArray {
     const HEIGHT_M: f64 = 0.3;
@@ -636,4 +717,185 @@ fn markers(world: &World) -> MarkerArray {
         add("cylinders", Marker::CYLINDER, p, scale, cylinder_colour);
     }
     MarkerArray { markers }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bag::{self, Item};
+    use crate::cdr::decode;
+    use hilsim_recording::{Meta, Mount, SonarSample, TruthSample};
+
+    /// Every transform of a file (`/tf` and `/tf_static`), and its `/odom` messages.
+    fn transforms_and_odometry(path: &Path) -> (Vec<TransformStamped>, Vec<Odometry>) {
+        let mut topics = BTreeMap::new();
+        let (mut transforms, mut odometry) = (Vec::new(), Vec::new());
+        bag::stream(path, |item| {
+            match item {
+                Item::Channel(c) => {
+                    topics.insert(c.id, c.topic);
+                }
+                Item::Message {
+                    channel_id, data, ..
+                } => match topics[&channel_id].as_str() {
+                    "/tf" | "/tf_static" => {
+                        let message: TfMessage = decode(data).unwrap();
+                        transforms.extend(message.transforms);
+                    }
+                    "/odom" => odometry.push(decode(data).unwrap()),
+                    _ => {}
+                },
+                Item::Metadata(_) => {}
+            }
+            Ok(())
+        })
+        .unwrap();
+        (transforms, odometry)
+    }
+
+    /// Each frame's one parent; a frame with two is a broken tree.
+    fn parents(transforms: &[TransformStamped]) -> BTreeMap<String, String> {
+        let mut parents = BTreeMap::new();
+        for tf in transforms {
+            let parent = &tf.header.frame_id;
+            let old = parents.insert(tf.child_frame_id.clone(), parent.clone());
+            assert!(old.is_none_or(|p| &p == parent), "{tf:?}: two parents");
+        }
+        parents
+    }
+
+    fn root(frame: &str, parents: &BTreeMap<String, String>) -> String {
+        let mut frame = frame.to_string();
+        for _ in 0..10 {
+            match parents.get(&frame) {
+                Some(parent) => frame.clone_from(parent),
+                None => return frame,
+            }
+        }
+        panic!("a cycle through {frame}");
+    }
+
+    /// A robot driving an arc, its odometry drifting from the truth (a wheel 2 % long).
+    fn run(truth: bool, odometry: bool) -> Recording {
+        let mut rec = Recording::new(Meta {
+            lidar: Some(Mount::default()),
+            ..Meta::default()
+        });
+        let b = rec.meta.robot.wheel_base_m;
+        let (v, w) = (0.2, 0.3);
+        let steps = 0..=40;
+        if truth {
+            rec.truth = Some(
+                steps
+                    .clone()
+                    .map(|i| {
+                        let t_s = f64::from(i) * 0.05 + 0.013;
+                        let yaw = w * t_s;
+                        TruthSample {
+                            t_s,
+                            x_m: 1.0 + v / w * yaw.sin(),
+                            y_m: 2.0 + v / w * (1.0 - yaw.cos()),
+                            yaw_rad: yaw,
+                        }
+                    })
+                    .collect(),
+            );
+        }
+        if odometry {
+            rec.odometry = Some(
+                steps
+                    .clone()
+                    .map(|i| {
+                        let t_s = f64::from(i) * 0.1;
+                        OdometrySample {
+                            t_s,
+                            left_m: (v - 0.5 * w * b) * t_s,
+                            right_m: 1.02 * (v + 0.5 * w * b) * t_s,
+                        }
+                    })
+                    .collect(),
+            );
+        }
+        rec.lidar = Some(vec![LidarSample {
+            t_s: 0.0,
+            rev: 0,
+            angle_deg: 0.0,
+            range_m: 1.0,
+            strength: 10,
+            invalid: false,
+            warning: false,
+            true_range_m: None,
+        }]);
+        rec.sonar = Some(vec![SonarSample {
+            t_s: 0.0,
+            range_m: 1.0,
+            true_range_m: None,
+        }]);
+        rec
+    }
+
+    /// The frames are one tree rooted at `map` (REP 105: map → odom → base_link → sensors),
+    /// `/odom` names its frames as the tree does, and at each truth time the tree puts
+    /// base_link where the truth is (odom → base_link interpolated as tf2 does).
+    #[test]
+    fn the_frames_are_one_tree_that_puts_the_robot_at_the_truth() {
+        let dir = tempfile::tempdir().unwrap();
+        for (truth, odometry) in [(true, true), (true, false), (false, true), (false, false)] {
+            let rec = run(truth, odometry);
+            let path = dir.path().join("run.mcap");
+            export(&rec, None, &path).unwrap();
+            let (transforms, odometry_messages) = transforms_and_odometry(&path);
+            let parents = parents(&transforms);
+            for frame in ["laser", "sonar", "base_link"] {
+                assert_eq!(root(frame, &parents), "map", "{frame} {truth} {odometry}");
+            }
+            for message in &odometry_messages {
+                assert_eq!(message.header.frame_id, "odom");
+                assert_eq!(message.child_frame_id, "base_link");
+                assert_eq!(root("odom", &parents), "map");
+            }
+            assert_eq!(odometry_messages.len(), rec.odometry.as_ref().map_or(0, Vec::len));
+            let Some(truth) = &rec.truth else { continue };
+            let stamp = |tf: &TransformStamped| tf.header.stamp.ns();
+            let planar = |tf: &TransformStamped| {
+                let t = &tf.transform;
+                [t.translation.x, t.translation.y, t.rotation.yaw()]
+            };
+            let odom_base: Vec<_> = transforms
+                .iter()
+                .filter(|tf| tf.child_frame_id == "base_link" && tf.header.frame_id == "odom")
+                .collect();
+            for p in truth {
+                let t_ns = stamp_ns(p.t_s);
+                let at = transforms
+                    .iter()
+                    .find(|tf| tf.header.frame_id == "map" && stamp(tf) == t_ns)
+                    .unwrap();
+                let in_map = if odom_base.is_empty() {
+                    planar(at)
+                } else {
+                    // odom → base_link at t_ns, between the two stamps around it.
+                    let k = odom_base.partition_point(|tf| stamp(tf) <= t_ns);
+                    let (a, b) = (odom_base[k - 1], odom_base[k.min(odom_base.len() - 1)]);
+                    let f = if k < odom_base.len() {
+                        (t_ns - stamp(a)) as f64 / (stamp(b) - stamp(a)) as f64
+                    } else {
+                        0.0
+                    };
+                    let (pa, pb) = (planar(a), planar(b));
+                    let turn = hilsim_recording::wrap_angle(pb[2] - pa[2]);
+                    let between = [
+                        pa[0] + f * (pb[0] - pa[0]),
+                        pa[1] + f * (pb[1] - pa[1]),
+                        pa[2] + f * turn,
+                    ];
+                    compose(planar(at), between)
+                };
+                let yaw_error = hilsim_recording::wrap_angle(in_map[2] - p.yaw_rad);
+                // Rounding only: a few sums and products of numbers below 10.
+                let close = (in_map[0] - p.x_m).abs() < 1e-9 && (in_map[1] - p.y_m).abs() < 1e-9;
+                assert!(close && yaw_error.abs() < 1e-9, "{p:?}: {in_map:?}");
+            }
+        }
+    }
 }

@@ -854,7 +854,10 @@ mod tests {
                 assert_eq!(message.child_frame_id, "base_link");
                 assert_eq!(root("odom", &parents), "map");
             }
-            assert_eq!(odometry_messages.len(), rec.odometry.as_ref().map_or(0, Vec::len));
+            assert_eq!(
+                odometry_messages.len(),
+                rec.odometry.as_ref().map_or(0, Vec::len)
+            );
             let Some(truth) = &rec.truth else { continue };
             let stamp = |tf: &TransformStamped| tf.header.stamp.ns();
             let planar = |tf: &TransformStamped| {

@@ -41,6 +41,9 @@ pub struct ImportOptions {
     pub meta: Option<Meta>,
     /// The wheels' radius, for odometry from `JointState` wheel angles.
     pub wheel_radius_m: Option<f64>,
+    /// The left and right wheels' joint names in `JointState` (default: the joints named
+    /// `…left…` and `…right…`).
+    pub wheel_joints: Option<[String; 2]>,
 }
 
 /// What an import did.
@@ -112,14 +115,31 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         meta
     });
     let mut chosen = chosen;
-    if let Some((topic, Kind::JointState)) = chosen.get(&Role::Odometry) {
-        if options.wheel_radius_m.is_none() {
+    match chosen.get(&Role::Odometry) {
+        Some((topic, Kind::JointState)) if options.wheel_radius_m.is_none() => {
+            // Asked for (the topic or the joints named): an error. Found by type only (it may
+            // be an arm's): skipped, and said so.
+            if options.topics.contains_key(&Role::Odometry) || options.wheel_joints.is_some() {
+                return Err(Error::bag(
+                    bag,
+                    format!(
+                        "topic {topic} is sensor_msgs/msg/JointState: its wheel angles need \
+                         --wheel-radius-m R to become wheel travel"
+                    ),
+                ));
+            }
             notes.push(format!(
                 "{topic} (JointState) skipped: wheel angles need --wheel-radius-m to become \
                  wheel travel"
             ));
             chosen.remove(&Role::Odometry);
         }
+        Some((topic, Kind::Odometry)) if options.wheel_radius_m.is_some() => {
+            notes.push(format!(
+                "--wheel-radius-m unused: the odometry is {topic}'s Odometry, not wheel angles"
+            ));
+        }
+        _ => {}
     }
     let tables = Tables {
         odometry: chosen.contains_key(&Role::Odometry),
@@ -128,7 +148,8 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         truth: chosen.contains_key(&Role::Truth),
     };
     let mut stream = RecordingStream::create(out, meta.clone(), tables)?;
-    let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m);
+    let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m)
+        .with_wheel_joints(options.wheel_joints.clone());
     converter.t0_ns = earliest_time(&files[0], &chosen)?;
     let mut bytes = 0;
     for file in &files {
@@ -136,6 +157,22 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         read_file(file, &mut converter, &mut stream)?;
     }
     converter.finish(&mut stream)?;
+    if let Some((topic, Kind::JointState)) = chosen.get(&Role::Odometry) {
+        if !converter.rows.contains_key(&Role::Odometry) {
+            let which = match &options.wheel_joints {
+                Some([left, right]) => format!("joints {left} and {right}"),
+                None => format!(
+                    "joints named `left` and `right` (the first message's: {:?}); name the \
+                     wheels with --wheel-joints LEFT,RIGHT",
+                    converter.joints_seen
+                ),
+            };
+            return Err(Error::bag(
+                bag,
+                format!("topic {topic}: no JointState message has positions for the {which}"),
+            ));
+        }
+    }
     // What the bag says of the sensors, where meta.toml did not.
     let final_meta = stream.meta_mut();
     if tables.lidar && final_meta.lidar.is_none() {
@@ -306,6 +343,11 @@ pub struct Converter {
     chosen: Chosen,
     wheel_base_m: f64,
     wheel_radius_m: Option<f64>,
+    wheel_joints: Option<[String; 2]>,
+    /// `JointState` messages without the wheels' positions.
+    joints_missing: u64,
+    /// The joints of the first such message, for the error when no message has the wheels.
+    joints_seen: Vec<String>,
     /// The recording's t = 0 on the stamps' clock, ns.
     t0_ns: Option<i64>,
     /// Stamp clock minus log clock, once a stamped message has said.
@@ -379,10 +421,12 @@ enum OdometryState {
         right_m: f64,
     },
     Joints {
-        left: usize,
-        right: usize,
-        left0: f64,
-        right0: f64,
+        /// The wheels' joint names, and their indices in the last message (a hint: messages
+        /// may list different joints).
+        names: [String; 2],
+        at: [usize; 2],
+        /// The angles at the first message, radians.
+        start: [f64; 2],
     },
 }
 
@@ -395,6 +439,9 @@ impl Converter {
             chosen: chosen.clone(),
             wheel_base_m,
             wheel_radius_m,
+            wheel_joints: None,
+            joints_missing: 0,
+            joints_seen: Vec::new(),
             t0_ns: None,
             clock_offset_ns: None,
             pending_commands: Vec::new(),
@@ -406,6 +453,14 @@ impl Converter {
             sonar_out_of_range: 0,
             sonar_fov_rad: None,
         }
+    }
+
+    /// The left and right wheels' joints by name (else the joints named `…left…` and
+    /// `…right…`).
+    #[must_use]
+    pub fn with_wheel_joints(mut self, names: Option<[String; 2]>) -> Self {
+        self.wheel_joints = names;
+        self
     }
 
     /// The time of a stamped message on the stamps' clock (a zero stamp, which a driver that
@@ -675,59 +730,74 @@ impl Converter {
         })?)
     }
 
-    /// Wheel travel from the wheel joints' angles (the joints named `…left…` and `…right…`).
+    /// Wheel travel from the wheel joints' angles: the angle turned since the first message
+    /// times the radius. The wheels are the joints named with `--wheel-joints`, else the one
+    /// joint whose name has `left` (`right`) in it, or the one of those with `wheel` too. A
+    /// message without the wheels' positions (a driver may publish its joints in groups) is
+    /// skipped and counted.
     fn joints<S>(&mut self, ns: i64, joints: &JointState, sink: &mut S) -> Result<(), Fault>
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
         let radius = self.wheel_radius_m.unwrap_or(0.0);
         if self.odometry.is_none() {
-            let find = |side: &str| {
-                let matches: Vec<usize> = joints
-                    .name
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, n)| n.to_lowercase().contains(side))
-                    .map(|(i, _)| i)
-                    .collect();
-                match matches.as_slice() {
-                    [one] => Ok(*one),
-                    _ => Err(Fault::Message(format!(
-                        "no one joint named `{side}` among {:?}: which are the wheels?",
-                        joints.name
-                    ))),
-                }
-            };
-            let (left, right) = (find("left")?, find("right")?);
-            let (Some(&l0), Some(&r0)) = (joints.position.get(left), joints.position.get(right))
-            else {
-                return Err(Fault::Message("fewer positions than joint names".into()));
+            let names = match &self.wheel_joints {
+                Some(names) => names.clone(),
+                None => match [
+                    wheel_joint(&joints.name, "left")?,
+                    wheel_joint(&joints.name, "right")?,
+                ] {
+                    [Some(left), Some(right)] => [left, right],
+                    // Another group of joints (an arm's): the wheels may come in the next.
+                    _ => {
+                        self.joints_missing += 1;
+                        if self.joints_seen.is_empty() {
+                            self.joints_seen.clone_from(&joints.name);
+                        }
+                        return Ok(());
+                    }
+                },
             };
             self.odometry = Some(OdometryState::Joints {
-                left,
-                right,
-                left0: l0,
-                right0: r0,
+                names,
+                at: [0, 0],
+                start: [f64::NAN; 2],
             });
         }
-        let Some(OdometryState::Joints {
-            left,
-            right,
-            left0,
-            right0,
-        }) = self.odometry
-        else {
+        let Some(OdometryState::Joints { names, at, start }) = &mut self.odometry else {
             return Ok(());
         };
-        let (Some(&l), Some(&r)) = (joints.position.get(left), joints.position.get(right)) else {
-            return Err(Fault::Message("fewer positions than joint names".into()));
-        };
+        let mut angles = [0.0; 2];
+        for side in 0..2 {
+            let found = if joints.name.get(at[side]) == Some(&names[side]) {
+                Some(at[side])
+            } else {
+                joints.name.iter().position(|n| *n == names[side])
+            };
+            match found.and_then(|i| Some((i, *joints.position.get(i)?))) {
+                Some((i, angle)) if angle.is_finite() => {
+                    at[side] = i;
+                    angles[side] = angle;
+                }
+                _ => {
+                    self.joints_missing += 1;
+                    return Ok(());
+                }
+            }
+        }
+        if start[0].is_nan() {
+            *start = angles;
+        }
+        let (left_m, right_m) = (
+            (angles[0] - start[0]) * radius,
+            (angles[1] - start[1]) * radius,
+        );
         let t_s = self.seconds(Role::Odometry, ns, 0.0);
         self.count(Role::Odometry, 1);
         Ok(sink.odometry(&OdometrySample {
             t_s,
-            left_m: (l - left0) * radius,
-            right_m: (r - right0) * radius,
+            left_m,
+            right_m,
         })?)
     }
 
@@ -765,6 +835,16 @@ impl Converter {
                 clock.worst_s * 1e3
             ));
         }
+        if self.joints_missing > 0 {
+            let names = match &self.odometry {
+                Some(OdometryState::Joints { names, .. }) => names.join(" and "),
+                _ => "the wheels".to_string(),
+            };
+            notes.push(format!(
+                "{} JointState messages without a position for {names} skipped",
+                self.joints_missing
+            ));
+        }
         if self.sonar_out_of_range > 0 {
             notes.push(format!(
                 "{} sonar readings out of their min..max range (no echo) skipped",
@@ -772,6 +852,24 @@ impl Converter {
             ));
         }
         notes
+    }
+}
+
+/// The wheel joint of one `side` (`left`, `right`) among a JointState's names: the one whose
+/// name has the side in it (any case), or, of several, the one that also has `wheel`.
+/// `None` when no joint has the side in its name; an error when several do and not one of them
+/// has `wheel`.
+fn wheel_joint(names: &[String], side: &str) -> Result<Option<String>, Fault> {
+    let has = |name: &str, word: &str| name.to_lowercase().contains(word);
+    let sided: Vec<&String> = names.iter().filter(|n| has(n, side)).collect();
+    let wheels: Vec<&String> = sided.iter().copied().filter(|n| has(n, "wheel")).collect();
+    match (sided.as_slice(), wheels.as_slice()) {
+        ([], _) => Ok(None),
+        ([one], _) | (_, [one]) => Ok(Some((*one).clone())),
+        _ => Err(Fault::Message(format!(
+            "which joints are the wheels? several of the joints {names:?} are named `{side}`; \
+             name the wheels with --wheel-joints LEFT,RIGHT"
+        ))),
     }
 }
 

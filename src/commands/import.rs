@@ -1,5 +1,6 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
-//! [--truth T] [--wheel-radius-m R]`: a ROS 2 bag (MCAP) into a recording.
+//! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP) into a
+//! recording.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -40,6 +41,10 @@ pub struct ImportArgs {
     /// The wheels' radius, metres: wheel joint angles (JointState) times it are wheel travel.
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub wheel_radius_m: Option<f64>,
+    /// The left and right wheels' joints in JointState (default: the joints named `…left…` and
+    /// `…right…`).
+    #[arg(long, value_name = "LEFT,RIGHT")]
+    pub wheel_joints: Option<String>,
 }
 
 pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
@@ -49,6 +54,19 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     {
         bail!("--wheel-radius-m: expected a radius in metres, above 0 and at most 10");
     }
+    let wheel_joints = match args
+        .wheel_joints
+        .as_deref()
+        .map(|j| j.split(',').collect::<Vec<_>>())
+    {
+        None => None,
+        Some(names) => match names.as_slice() {
+            [left, right] if !left.is_empty() && !right.is_empty() && left != right => {
+                Some([(*left).to_string(), (*right).to_string()])
+            }
+            _ => bail!("--wheel-joints: expected LEFT,RIGHT, two different joint names"),
+        },
+    };
     let meta = args.meta.as_deref().map(Meta::read).transpose()?;
     let mut topics = BTreeMap::new();
     for (role, topic) in [
@@ -66,6 +84,7 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
         topics,
         meta,
         wheel_radius_m: args.wheel_radius_m,
+        wheel_joints,
     };
     hilsim_recording::tidy_after_killed_writers(&args.out)?;
     let report = hilsim_ros2::import(&args.bag, &args.out, &options)?;

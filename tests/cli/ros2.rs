@@ -238,3 +238,16 @@ fn bad_bags_are_one_line_errors_naming_the_file() {
     assert!(assert_bad_input(&out).contains("nowhere"));
     assert!(!tmp.path().join("x.mcap").exists());
 }
+
+#[test]
+fn wheel_joints_are_two_names() {
+    let tmp = tempfile::tempdir().unwrap();
+    for joints in ["left_wheel", "a,b,c", ",right", "w,w"] {
+        let args = ["import", "x.mcap", "--out", "r", "--wheel-joints", joints];
+        let err = assert_bad_input(&hilsim(tmp.path(), &args));
+        assert!(
+            err.contains("--wheel-joints: expected LEFT,RIGHT, two different joint names"),
+            "{joints}: {err}"
+        );
+    }
+}

@@ -30,6 +30,14 @@ for compression in zstd lz4; do
     "$venv/bin/python" "$check" imported "$tmp/$compression.mcap" "$tmp/$compression"
 done
 
+# Another robot's bag: namespaced topics, a clockwise scan without intensities, NaN and inf,
+# wheel joints, split in two files (the second big-endian, ros2idl schemas).
+"$venv/bin/python" "$check" write-foreign "$tmp/foreign"
+"$hilsim" import "$tmp/foreign" --out "$tmp/foreign-rec" --meta "$tmp/meta.toml"
+"$hilsim" import "$tmp/foreign" --out "$tmp/foreign-joints" --meta "$tmp/meta.toml" \
+    --odom /joint_states --wheel-radius-m 0.033
+"$venv/bin/python" "$check" foreign-imported "$tmp/foreign-rec" "$tmp/foreign-joints"
+
 # hilsim record --mcap → rosbags and mcap-ros2-support.
 scenario=scenarios/straight-board.toml
 "$hilsim" record "$scenario" --out "$tmp/rec" --mcap "$tmp/run.mcap"

@@ -5,6 +5,10 @@
                                              writer, chunks compressed with C (zstd, lz4)
     rosbags_check.py imported BAGDIR RECDIR  check hilsim's import of that bag
     rosbags_check.py exported MCAP RECDIR    read hilsim's export with rosbags and mcap-ros2
+                                             (messages, and the TF tree: connected, base_link at
+                                             the truth)
+    rosbags_check.py write-foreign BAGDIR    a split bag of another robot's ways (see below)
+    rosbags_check.py foreign-imported REC JOINTS_REC   check its imports (Odometry, JointState)
 
 Each check compares message contents with the recording's CSV files and exits non-zero with a
 line saying what differs.
@@ -129,6 +133,169 @@ def write(bagdir):
             events.append((ns, cmd_c, twist, "geometry_msgs/msg/Twist"))
         for ns, conn, msg, kind in sorted(events, key=lambda e: e[0]):
             writer.write(conn, ns, store.serialize_cdr(msg, kind))
+
+
+# The foreign bag: a robot under a namespace, its lidar mounted upside down (clockwise from
+# +90 degrees: a negative increment), no time increment and no intensities; a sonar that
+# reports NaN and inf; Odometry of base_footprint; wheel joints with an arm's joints published
+# in messages of their own. Split in two files, the second big-endian CDR with ros2idl schemas.
+FOREIGN_SCANS = 10
+FOREIGN_READINGS = 181
+WHEEL_RADIUS = 0.033
+
+
+def foreign_ranges(k):
+    out = [1.0 + 0.001 * (i + k) for i in range(FOREIGN_READINGS)]
+    out[0:5] = [float("nan"), float("inf"), float("-inf"), 0.05, 9.0]
+    return np.array(out, dtype=np.float32)
+
+
+def wheel_angles(k):
+    return 0.5 + 0.1 * k, -0.25 + 0.3 * k
+
+
+def write_foreign(bagdir):
+    import shutil
+    import tempfile
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    t = store.types
+    Time = t["builtin_interfaces/msg/Time"]
+    Header = t["std_msgs/msg/Header"]
+
+    def header(ns, frame):
+        return Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=frame)
+
+    bagdir = Path(bagdir)
+    bagdir.mkdir()
+    half = FOREIGN_SCANS // 2
+    with tempfile.TemporaryDirectory() as tmp:
+        for part in (0, 1):
+            little = part == 0
+            with Writer(Path(tmp) / f"part{part}", version=8, storage_plugin=StoragePlugin.MCAP) as w:
+                scan_c = w.add_connection("/robot1/scan", "sensor_msgs/msg/LaserScan", typestore=store)
+                range_c = w.add_connection("/robot1/range", "sensor_msgs/msg/Range", typestore=store)
+                odom_c = w.add_connection("/robot1/odom", "nav_msgs/msg/Odometry", typestore=store)
+                joints_c = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=store)
+
+                def put(conn, ns, msg, kind):
+                    w.write(conn, ns, store.serialize_cdr(msg, kind, little_endian=little))
+
+                for k in range(part * half, (part + 1) * half):
+                    ns = T0_NS + k * 100_000_000
+                    put(scan_c, ns, t["sensor_msgs/msg/LaserScan"](
+                        header=header(ns, "base_scan"),
+                        angle_min=math.radians(90.0),
+                        angle_max=math.radians(-90.0),
+                        angle_increment=-math.radians(1.0),
+                        time_increment=0.0,
+                        scan_time=0.1,
+                        range_min=0.12,
+                        range_max=3.5,
+                        ranges=foreign_ranges(k),
+                        intensities=np.array([], dtype=np.float32),
+                    ), "sensor_msgs/msg/LaserScan")
+                    put(range_c, ns + 10_000_000, t["sensor_msgs/msg/Range"](
+                        header=header(ns + 10_000_000, "sonar_link"),
+                        radiation_type=0,
+                        field_of_view=0.5,
+                        min_range=0.02,
+                        max_range=4.0,
+                        range=[float("nan"), float("inf"), 1.5][k % 3],
+                    ), "sensor_msgs/msg/Range")
+                    cov = np.zeros(36, dtype=np.float64)
+                    odom = t["nav_msgs/msg/Odometry"](
+                        header=header(ns + 20_000_000, "odom"),
+                        child_frame_id="base_footprint",
+                        pose=t["geometry_msgs/msg/PoseWithCovariance"](
+                            pose=t["geometry_msgs/msg/Pose"](
+                                position=t["geometry_msgs/msg/Point"](x=0.01 * k, y=0.0, z=0.0),
+                                orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                            ),
+                            covariance=cov,
+                        ),
+                        twist=t["geometry_msgs/msg/TwistWithCovariance"](
+                            twist=t["geometry_msgs/msg/Twist"](
+                                linear=t["geometry_msgs/msg/Vector3"](x=0.1, y=0.0, z=0.0),
+                                angular=t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
+                            ),
+                            covariance=cov,
+                        ),
+                    )
+                    put(odom_c, ns + 20_000_000, odom, "nav_msgs/msg/Odometry")
+                    left, right = wheel_angles(k)
+                    for names, positions in (
+                        (["caster_joint", "wheel_left_joint", "wheel_right_joint"], [1.5, left, right]),
+                        (["shoulder", "elbow"], [0.1, 0.2]),
+                    ):
+                        put(joints_c, ns + 30_000_000, t["sensor_msgs/msg/JointState"](
+                            header=header(ns + 30_000_000, ""),
+                            name=names,
+                            position=np.array(positions, dtype=np.float64),
+                            velocity=np.array([], dtype=np.float64),
+                            effort=np.array([], dtype=np.float64),
+                        ), "sensor_msgs/msg/JointState")
+            shutil.copy(Path(tmp) / f"part{part}" / f"part{part}.mcap", bagdir / f"foreign_{part}.mcap")
+        yaml = (Path(tmp) / "part0" / "metadata.yaml").read_text()
+        yaml = yaml.replace("  relative_file_paths:\n  - part0.mcap\n",
+                            "  relative_file_paths:\n  - foreign_0.mcap\n  - foreign_1.mcap\n")
+        if "foreign_1.mcap" not in yaml:
+            fail("rosbags' metadata.yaml has no relative_file_paths list to split")
+        (bagdir / "metadata.yaml").write_text(yaml)
+    # The second file's schemas as ros2idl (hilsim reads only a schema's name).
+    from mcap.reader import make_reader
+    from mcap.writer import Writer as McapWriter
+
+    second = bagdir / "foreign_1.mcap"
+    with open(second, "rb") as f:
+        records = list(make_reader(f).iter_messages())
+    with open(second, "wb") as f:
+        writer = McapWriter(f)
+        writer.start(profile="ros2", library="rosbags_check")
+        schemas, channels = {}, {}
+        for schema, channel, message in records:
+            if schema.name not in schemas:
+                schemas[schema.name] = writer.register_schema(schema.name, "ros2idl", schema.data)
+            if channel.topic not in channels:
+                channels[channel.topic] = writer.register_channel(channel.topic, "cdr", schemas[schema.name])
+            writer.add_message(channels[channel.topic], log_time=message.log_time,
+                               data=message.data, publish_time=message.publish_time)
+        writer.finish()
+
+
+def foreign_imported(rec, joints_rec):
+    rec, joints_rec = Path(rec), Path(joints_rec)
+    lidar = table(rec / "lidar.csv")
+    if len(lidar) != FOREIGN_SCANS * FOREIGN_READINGS:
+        fail(f"foreign lidar.csv has {len(lidar)} rows")
+    for n, row in enumerate(lidar):
+        k, i = divmod(n, FOREIGN_READINGS)
+        r = float(foreign_ranges(k)[i])
+        valid = math.isfinite(r) and 0.12 <= r <= 3.5
+        if float(row["angle_deg"]) != (90 - i) % 360 or int(row["rev"]) != k:
+            fail(f"foreign lidar row {k},{i}: angle {row['angle_deg']} rev {row['rev']}")
+        close(float(row["t_s"]), 0.1 * k, 1e-9, f"foreign lidar row {k},{i} t_s")
+        if int(row["invalid"]) != (0 if valid else 1) or int(row["strength"]) != 0:
+            fail(f"foreign lidar row {k},{i}: {row}")
+        close(float(row["range_m"]), r if valid else 0.0, 1e-6, f"foreign lidar row {k},{i}")
+    sonar = table(rec / "sonar.csv")
+    if [float(s["range_m"]) for s in sonar] != [1.5] * sum(1 for k in range(FOREIGN_SCANS) if k % 3 == 2):
+        fail(f"foreign sonar rows {sonar}")
+    odometry = table(rec / "odometry.csv")
+    if len(odometry) != FOREIGN_SCANS:
+        fail(f"foreign odometry.csv has {len(odometry)} rows")
+    close(float(odometry[-1]["left_m"]), 0.01 * (FOREIGN_SCANS - 1), 1e-9, "foreign odometry")
+    wheels = table(joints_rec / "odometry.csv")
+    if len(wheels) != FOREIGN_SCANS:
+        fail(f"JointState odometry.csv has {len(wheels)} rows")
+    l0, r0 = wheel_angles(0)
+    for k, row in enumerate(wheels):
+        left, right = wheel_angles(k)
+        close(float(row["t_s"]), 0.1 * k + 0.03, 1e-9, f"JointState row {k} t_s")
+        close(float(row["left_m"]), (left - l0) * WHEEL_RADIUS, 1e-12, f"JointState row {k} left")
+        close(float(row["right_m"]), (right - r0) * WHEEL_RADIUS, 1e-12, f"JointState row {k} right")
+    print(f"rosbags_check: hilsim imported the foreign split bag: {len(lidar)} lidar readings, "
+          f"{len(sonar)} sonar, {len(odometry)} odometry and {len(wheels)} wheel-joint rows agree")
 
 
 def table(path):
@@ -401,6 +568,10 @@ if __name__ == "__main__":
         rewrite(Path(sys.argv[2]), sys.argv[3], sys.argv[4])
     elif mode == "imported":
         imported(sys.argv[2], sys.argv[3])
+    elif mode == "write-foreign":
+        write_foreign(sys.argv[2])
+    elif mode == "foreign-imported":
+        foreign_imported(sys.argv[2], sys.argv[3])
     elif mode == "exported":
         exported(sys.argv[2], sys.argv[3])
     else:

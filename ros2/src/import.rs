@@ -150,7 +150,7 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     let mut stream = RecordingStream::create(out, meta.clone(), tables)?;
     let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m)
         .with_wheel_joints(options.wheel_joints.clone());
-    converter.t0_ns = earliest_time(&files[0], &chosen)?;
+    (converter.t0_ns, converter.clock_offset_ns) = earliest_time(&files[0], &chosen)?;
     let mut bytes = 0;
     for file in &files {
         bytes += std::fs::metadata(file).map_or(0, |m| m.len());
@@ -261,14 +261,20 @@ const EARLIEST_WITHIN_NS: u64 = 10_000_000_000;
 /// stamp, or the log time of an unstamped one on the same clock. `None` when none is found
 /// (the first message converted then sets it).
 ///
+/// With it, the stamps' clock minus the log clock, as the first stamped message says (see
+/// [`Converter::stamped`]): known before the first message is converted, a message stamped zero
+/// at a simulator's start (time 0, or no stamp at all) is put on the stamps' clock too, not at
+/// its wall-clock log time.
+///
 /// # Errors
 /// As [`bag::stream`].
-fn earliest_time(file: &Path, chosen: &Chosen) -> Result<Option<i64>, Error> {
+fn earliest_time(file: &Path, chosen: &Chosen) -> Result<(Option<i64>, Option<i64>), Error> {
     let mut roles: HashMap<u16, Kind> = HashMap::new();
     let mut stamped: Option<i64> = None;
     let mut unstamped: Option<i64> = None;
     let mut start = None;
     let mut first_log = None;
+    let mut offset = None;
     bag::stream_while(file, |item| {
         match item {
             Item::Channel(c) => {
@@ -304,6 +310,7 @@ fn earliest_time(file: &Path, chosen: &Chosen) -> Result<Option<i64>, Error> {
                             if !header.stamp.is_zero() {
                                 let ns = header.stamp.ns();
                                 stamped = Some(stamped.map_or(ns, |t| t.min(ns)));
+                                offset.get_or_insert(clock_offset(ns, log_ns));
                             }
                         }
                     }
@@ -314,14 +321,26 @@ fn earliest_time(file: &Path, chosen: &Chosen) -> Result<Option<i64>, Error> {
         Ok(true)
     })?;
     if start.is_some() {
-        return Ok(start);
+        return Ok((start, None));
     }
-    Ok(match (stamped, unstamped) {
+    let t0 = match (stamped, unstamped) {
         // Unstamped messages count when they are on the stamps' clock.
         (Some(s), Some(u)) if (s - u).abs() <= OTHER_CLOCK_NS => Some(s.min(u)),
         (Some(s), _) => Some(s),
         (None, u) => u,
-    })
+    };
+    Ok((t0, offset))
+}
+
+/// The stamps' clock minus the log clock from a message's stamp and log time: the difference
+/// when it says the two are different clocks, else 0 (transport delay is left alone).
+fn clock_offset(stamp_ns: i64, log_ns: i64) -> i64 {
+    let offset = stamp_ns - log_ns;
+    if offset.abs() > OTHER_CLOCK_NS {
+        offset
+    } else {
+        0
+    }
 }
 
 /// Why a message could not be converted.
@@ -471,12 +490,7 @@ impl Converter {
         }
         let ns = stamp.ns();
         if self.clock_offset_ns.is_none() {
-            let offset = ns - log_ns;
-            let offset = if offset.abs() > OTHER_CLOCK_NS {
-                offset
-            } else {
-                0
-            };
+            let offset = clock_offset(ns, log_ns);
             self.clock_offset_ns = Some(offset);
             let first_pending = self.pending_commands.first().map(|(log, _)| log + offset);
             if self.t0_ns.is_none() {

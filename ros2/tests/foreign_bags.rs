@@ -352,3 +352,61 @@ fn foreign_scans_ranges_frames_and_split_bags_import() {
     assert!((odometry[9].left_m - 0.09).abs() < 1e-9, "{odometry:?}");
     assert_eq!(report.chosen[&Role::Lidar].0, "/robot1/scan");
 }
+
+/// A simulator's bag: stamps on simulated time from 0 (the first odometry stamped exactly 0,
+/// which also means "no stamp"), logged on the recorder's wall clock. Every row is on the
+/// simulated clock, the first odometry at 0, not at its wall-clock log time.
+#[test]
+fn a_simulators_first_stamp_at_zero_is_on_the_simulated_clock() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("sim.mcap");
+    let sim_header = |t_ns: i64, frame: &str| Header {
+        stamp: Time::from_ns(t_ns),
+        frame_id: frame.to_string(),
+    };
+    let mut messages = Vec::new();
+    for k in 0..10 {
+        let t_ns = k * 50_000_000;
+        let mut odometry = Odometry {
+            header: sim_header(t_ns, "odom"),
+            child_frame_id: "base_link".into(),
+            ..Odometry::default()
+        };
+        odometry.pose.pose.position.x = 0.01 * k as f64;
+        messages.push(Message {
+            topic: "/odom",
+            type_name: "nav_msgs/msg/Odometry",
+            t_ns,
+            data: cdr(&odometry),
+        });
+        let mut scan_message = scan(0, 0.0, 1f64.to_radians() as f32, vec![1.0; 360]);
+        scan_message.header = sim_header(t_ns + 10_000_000, "laser");
+        messages.push(Message {
+            topic: "/scan",
+            type_name: "sensor_msgs/msg/LaserScan",
+            t_ns: t_ns + 10_000_000,
+            data: cdr(&scan_message),
+        });
+    }
+    write_mcap(&bag, "ros2msg", &messages);
+    let out = dir.path().join("rec");
+    let report = import(&bag, &out, &ImportOptions::default()).unwrap();
+    let rec = Recording::read_dir(&out).unwrap();
+    let times: Vec<f64> = rec.odometry.unwrap().iter().map(|o| o.t_s).collect();
+    // t = 0 is the earliest non-zero stamp, the first scan's (0.01 s): the odometry stamped
+    // 0 comes before it and is put at 0, said so.
+    assert_eq!(
+        times[1..],
+        [0.04, 0.09, 0.14, 0.19, 0.24, 0.29, 0.34, 0.39, 0.44]
+    );
+    assert_eq!(times[0], 0.0);
+    assert_eq!(rec.lidar.unwrap()[0].t_s, 0.0);
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.starts_with("1 odometry rows came before")),
+        "{:?}",
+        report.notes
+    );
+}

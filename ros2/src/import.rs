@@ -564,6 +564,7 @@ impl Converter {
                 self.sonar_fov_rad
                     .get_or_insert(f64::from(range.field_of_view));
                 let valid = range.range.is_finite()
+                    && range.range > 0.0
                     && range.range >= range.min_range
                     && range.range <= range.max_range;
                 if !valid {
@@ -639,7 +640,9 @@ impl Converter {
         for (i, &range) in scan.ranges.iter().enumerate() {
             let i_f = i as f64;
             let t_s = clock.order(microseconds(from_start_ns, i_f * time_increment_ns));
-            let valid = range.is_finite() && range >= range_min && range <= range_max;
+            // 0 is no echo too (drivers that leave range_min 0 send it for none).
+            let valid =
+                range.is_finite() && range > 0.0 && range >= range_min && range <= range_max;
             // The nearest whole strength (half away from zero, as `round`; exact in f64).
             let strength = scan
                 .intensities

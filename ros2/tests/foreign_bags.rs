@@ -410,3 +410,39 @@ fn a_simulators_first_stamp_at_zero_is_on_the_simulated_clock() {
         report.notes
     );
 }
+
+/// A driver that leaves `range_min` 0 and sends 0 for no echo: a range of 0 is no reading.
+#[test]
+fn a_range_of_zero_is_no_echo() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("zero.mcap");
+    let mut scan_message = scan(0, 0.0, 1f64.to_radians() as f32, vec![0.0, 1.25, 0.0]);
+    scan_message.range_min = 0.0;
+    let range = Range {
+        header: header(0, "sonar"),
+        max_range: 4.0,
+        range: 0.0,
+        ..Range::default()
+    };
+    let messages = [
+        Message {
+            topic: "/scan",
+            type_name: "sensor_msgs/msg/LaserScan",
+            t_ns: 0,
+            data: cdr(&scan_message),
+        },
+        Message {
+            topic: "/sonar",
+            type_name: "sensor_msgs/msg/Range",
+            t_ns: 0,
+            data: cdr(&range),
+        },
+    ];
+    write_mcap(&bag, "ros2msg", &messages);
+    let out = dir.path().join("rec");
+    import(&bag, &out, &ImportOptions::default()).unwrap();
+    let rec = Recording::read_dir(&out).unwrap();
+    let invalid: Vec<bool> = rec.lidar.unwrap().iter().map(|r| r.invalid).collect();
+    assert_eq!(invalid, [true, false, true]);
+    assert!(rec.sonar.unwrap().is_empty());
+}

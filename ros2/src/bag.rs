@@ -254,6 +254,47 @@ pub fn count_messages(path: &Path) -> Result<u64, Error> {
     Ok(count)
 }
 
+/// A zstd frame's first bytes. A CDR message starts with its representation (0x00 0x00 or
+/// 0x00 0x01), an MCAP file with 0x89: either starting so was compressed by rosbag2's
+/// `message` or `file` compression mode.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+
+/// An MCAP file's bytes: the file, or its decompression when rosbag2 compressed the whole file
+/// (`compression_mode: file`, `name.mcap.zstd`).
+fn open(path: &Path) -> Result<Box<dyn Read>, Error> {
+    let fail = |err: std::io::Error| Error::bag(path, err.to_string());
+    let mut file = File::open(path).map_err(fail)?;
+    let mut head = [0; 4];
+    let starts_zstd = file.read_exact(&mut head).is_ok() && head == ZSTD_MAGIC;
+    file.rewind().map_err(fail)?;
+    if starts_zstd {
+        return Ok(Box::new(
+            zstd::stream::read::Decoder::new(file).map_err(fail)?,
+        ));
+    }
+    Ok(Box::new(file))
+}
+
+/// A message that rosbag2 compressed on its own (`compression_mode: message`), into `out`; at
+/// most [`RECORD_LENGTH_LIMIT`] bytes, as any record.
+fn decompress_message(path: &Path, data: &[u8], out: &mut Vec<u8>) -> Result<(), Error> {
+    out.clear();
+    let decoder = zstd::stream::read::Decoder::new(data)
+        .map_err(|err| Error::bag(path, format!("a zstd-compressed message: {err}")))?;
+    let limit = RECORD_LENGTH_LIMIT as u64;
+    decoder
+        .take(limit + 1)
+        .read_to_end(out)
+        .map_err(|err| Error::bag(path, format!("a zstd-compressed message: {err}")))?;
+    if out.len() as u64 > limit {
+        return Err(Error::bag(
+            path,
+            format!("a zstd-compressed message of more than {limit} bytes"),
+        ));
+    }
+    Ok(())
+}
+
 /// Reads an MCAP file from start to end, handing each channel, message and metadata record to
 /// `visit` in file order; `visit`'s error ends the read.
 ///
@@ -275,7 +316,8 @@ pub(crate) fn stream_while(
     path: &Path,
     mut visit: impl FnMut(Item<'_>) -> Result<bool, Error>,
 ) -> Result<(), Error> {
-    let mut file = File::open(path).map_err(|err| Error::bag(path, err.to_string()))?;
+    let mut file = open(path)?;
+    let mut message = Vec::new();
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_validate_chunk_crcs(true)
@@ -305,11 +347,19 @@ pub(crate) fn stream_while(
                             type_name: schemas.get(&c.schema_id).cloned().unwrap_or_default(),
                             message_encoding: c.message_encoding,
                         }))?,
-                        Record::Message { header, data } => visit(Item::Message {
-                            channel_id: header.channel_id,
-                            log_time: header.log_time,
-                            data: &data,
-                        })?,
+                        Record::Message { header, data } => {
+                            let data = if data.starts_with(&ZSTD_MAGIC) {
+                                decompress_message(path, &data, &mut message)?;
+                                &message[..]
+                            } else {
+                                &data[..]
+                            };
+                            visit(Item::Message {
+                                channel_id: header.channel_id,
+                                log_time: header.log_time,
+                                data,
+                            })?
+                        }
                         Record::Metadata(m) => visit(Item::Metadata(m))?,
                         _ => true,
                     };

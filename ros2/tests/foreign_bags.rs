@@ -446,3 +446,66 @@ fn a_range_of_zero_is_no_echo() {
     assert_eq!(invalid, [true, false, true]);
     assert!(rec.sonar.unwrap().is_empty());
 }
+
+/// rosbag2's own compression modes: a whole file as one zstd stream (`name.mcap.zstd`), and each
+/// message's bytes compressed apart; a cut-off compressed file is a one-line error.
+#[test]
+fn rosbag2_file_and_message_compression_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let scans = |compress: bool| -> Vec<Message> {
+        (0..3)
+            .map(|k| {
+                let message = scan(
+                    k * 100_000_000,
+                    0.0,
+                    0.5f64.to_radians() as f32,
+                    vec![1.5; 720],
+                );
+                let data = cdr(&message);
+                Message {
+                    topic: "/scan",
+                    type_name: "sensor_msgs/msg/LaserScan",
+                    t_ns: k * 100_000_000,
+                    data: if compress {
+                        zstd::encode_all(&data[..], 3).unwrap()
+                    } else {
+                        data
+                    },
+                }
+            })
+            .collect()
+    };
+    let plain = dir.path().join("plain.mcap");
+    write_mcap(&plain, "ros2msg", &scans(false));
+    let whole = dir.path().join("run.mcap.zstd");
+    fs::write(
+        &whole,
+        zstd::encode_all(&fs::read(&plain).unwrap()[..], 3).unwrap(),
+    )
+    .unwrap();
+    let each = dir.path().join("each.mcap");
+    write_mcap(&each, "ros2msg", &scans(true));
+    let expected = {
+        import(&plain, &dir.path().join("p"), &ImportOptions::default()).unwrap();
+        fs::read(dir.path().join("p/lidar.csv")).unwrap()
+    };
+    assert_eq!(
+        expected.iter().filter(|&&b| b == b'\n').count(),
+        1 + 3 * 720
+    );
+    for (bag, name) in [(&whole, "w"), (&each, "e")] {
+        import(bag, &dir.path().join(name), &ImportOptions::default()).unwrap();
+        let csv = fs::read(dir.path().join(name).join("lidar.csv")).unwrap();
+        assert!(csv == expected, "{name}");
+    }
+    let cut = dir.path().join("cut.mcap.zstd");
+    let bytes = fs::read(&whole).unwrap();
+    fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let err = import(&cut, &dir.path().join("c"), &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(&format!("{}: ", cut.display())) && !err.contains('\n'),
+        "{err}"
+    );
+}

@@ -30,6 +30,13 @@ for compression in zstd lz4; do
     "$venv/bin/python" "$check" imported "$tmp/$compression.mcap" "$tmp/$compression"
 done
 
+# rosbag2's own compression modes: each file one zstd stream (`file`), each message (`message`).
+for mode in file message; do
+    "$venv/bin/python" "$check" write "$tmp/bag-$mode" "$mode"
+    "$hilsim" import "$tmp/bag-$mode" --out "$tmp/rec-$mode" --meta "$tmp/meta.toml"
+    "$venv/bin/python" "$check" imported "$tmp/bag-$mode" "$tmp/rec-$mode"
+done
+
 # Another robot's bag: namespaced topics, a clockwise scan without intensities, NaN and inf,
 # wheel joints, split in two files (the second big-endian, ros2idl schemas).
 "$venv/bin/python" "$check" write-foreign "$tmp/foreign"

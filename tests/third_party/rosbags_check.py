@@ -1,6 +1,7 @@
 """Third-party ROS 2 libraries against `hilsim import` and `hilsim export` (issue 17).
 
-    rosbags_check.py write BAGDIR            write a ROS 2 bag with rosbags (MCAP storage)
+    rosbags_check.py write BAGDIR [MODE]     write a ROS 2 bag with rosbags (MCAP storage;
+                                             MODE: rosbag2 compression, file or message)
     rosbags_check.py rewrite BAGDIR OUT C    the same messages through the mcap library's
                                              writer, chunks compressed with C (zstd, lz4)
     rosbags_check.py imported BAGDIR RECDIR  check hilsim's import of that bag
@@ -60,7 +61,10 @@ def odom_pose(j):
     return 0.2 * t * math.cos(0.2 * t), 0.2 * t * math.sin(0.2 * t), yaw
 
 
-def write(bagdir):
+def write(bagdir, compression="none"):
+    """`compression`: rosbag2's mode, `none`, `file` (each file one zstd stream) or `message`."""
+    from rosbags.rosbag2.writer import CompressionFormat, CompressionMode
+
     store = get_typestore(Stores.ROS2_HUMBLE)
     t = store.types
     Time = t["builtin_interfaces/msg/Time"]
@@ -75,7 +79,10 @@ def write(bagdir):
     Pose = t["geometry_msgs/msg/Pose"]
     Twist = t["geometry_msgs/msg/Twist"]
     cov = np.zeros(36, dtype=np.float64)
-    with Writer(bagdir, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+    writer = Writer(bagdir, version=8, storage_plugin=StoragePlugin.MCAP)
+    if compression != "none":
+        writer.set_compression(CompressionMode[compression.upper()], CompressionFormat.ZSTD)
+    with writer:
         scan_c = writer.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
         odom_c = writer.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=store)
         cmd_c = writer.add_connection("/cmd_vel", "geometry_msgs/msg/Twist", typestore=store)
@@ -563,7 +570,7 @@ def rewrite(bagdir, out, compression):
 if __name__ == "__main__":
     mode = sys.argv[1]
     if mode == "write":
-        write(Path(sys.argv[2]))
+        write(Path(sys.argv[2]), *sys.argv[3:4])
     elif mode == "rewrite":
         rewrite(Path(sys.argv[2]), sys.argv[3], sys.argv[4])
     elif mode == "imported":

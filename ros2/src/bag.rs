@@ -62,11 +62,11 @@ pub fn bag_files(bag: &Path) -> Result<Vec<PathBuf>, Error> {
     let yaml_path = bag.join("metadata.yaml");
     let yaml = read_small(&yaml_path)?;
     if let Some(storage) = yaml_value(&yaml, "storage_identifier") {
-        if storage != "mcap" {
+        if storage != "mcap" && storage != "sqlite3" {
             return Err(Error::bag(
                 &yaml_path,
                 format!(
-                    "storage `{storage}`, not MCAP: convert it first (`ros2 bag convert` to \
+                    "storage `{storage}`, neither MCAP nor SQLite3: convert it first (`ros2 bag convert` to \
                      storage mcap)"
                 ),
             ));
@@ -84,7 +84,7 @@ pub fn bag_files(bag: &Path) -> Result<Vec<PathBuf>, Error> {
             let path = entry
                 .map_err(|err| Error::bag(bag, err.to_string()))?
                 .path();
-            if path.extension().is_some_and(|e| e == "mcap") {
+            if path.extension().is_some_and(|e| e == "mcap" || e == "db3") {
                 files.push(path);
             }
         }
@@ -100,7 +100,10 @@ pub fn bag_files(bag: &Path) -> Result<Vec<PathBuf>, Error> {
         });
     }
     if files.is_empty() {
-        return Err(Error::bag(bag, "a bag directory without an .mcap file"));
+        return Err(Error::bag(
+            bag,
+            "a bag directory without an .mcap or .db3 file",
+        ));
     }
     Ok(files)
 }
@@ -144,10 +147,13 @@ fn starts_like_mcap(path: &Path) -> bool {
     read.is_ok() && MAGIC.starts_with(&head)
 }
 
+/// What a file that is no bag is.
+const NOT_A_BAG: &str = "not an MCAP file (a ROS 2 bag's storage must be MCAP or SQLite3)";
+
 /// One line for an MCAP error.
 fn mcap_error(path: &Path, err: McapError) -> Error {
     let message = match err {
-        McapError::BadMagic => "not an MCAP file (a ROS 2 bag's storage must be MCAP)".to_string(),
+        McapError::BadMagic => NOT_A_BAG.to_string(),
         McapError::UnsupportedCompression(name) => {
             format!(
                 "a chunk compressed with `{name}`, which hilsim cannot read (zstd and lz4 only)"
@@ -155,7 +161,7 @@ fn mcap_error(path: &Path, err: McapError) -> Error {
         }
         // A file shorter than MCAP's magic ends before it can be told apart: say which it is.
         McapError::UnexpectedEof | McapError::UnexpectedEoc if !starts_like_mcap(path) => {
-            "not an MCAP file (a ROS 2 bag's storage must be MCAP)".to_string()
+            NOT_A_BAG.to_string()
         }
         McapError::UnexpectedEof | McapError::UnexpectedEoc => {
             "truncated: the file ends inside a record".to_string()
@@ -172,6 +178,9 @@ fn mcap_error(path: &Path, err: McapError) -> Error {
 /// # Errors
 /// The file cannot be read, or is not MCAP.
 pub fn channels(path: &Path) -> Result<Vec<Channel>, Error> {
+    if is_sqlite(path) {
+        return sqlite_channels(path);
+    }
     if let Some(found) = summary_channels(path)? {
         if !found.is_empty() {
             return Ok(found);
@@ -316,6 +325,9 @@ pub(crate) fn stream_while(
     path: &Path,
     mut visit: impl FnMut(Item<'_>) -> Result<bool, Error>,
 ) -> Result<(), Error> {
+    if is_sqlite(path) {
+        return sqlite_stream_while(path, visit);
+    }
     let mut file = open(path)?;
     let mut message = Vec::new();
     let mut reader = LinearReader::new_with_options(
@@ -372,6 +384,101 @@ pub(crate) fn stream_while(
     Ok(())
 }
 
+/// Whether the file is an SQLite database (rosbag2's `sqlite3` storage, `.db3`).
+fn is_sqlite(path: &Path) -> bool {
+    let mut head = [0; 16];
+    File::open(path).is_ok_and(|mut f| f.read_exact(&mut head).is_ok())
+        && &head == b"SQLite format 3\0"
+}
+
+/// One line for an SQLite error (a database that is not a rosbag2 bag, or a damaged one).
+fn sqlite_error(path: &Path, err: &rusqlite::Error) -> Error {
+    Error::bag(path, format!("not a readable SQLite3 bag ({err})"))
+}
+
+fn open_sqlite(path: &Path) -> Result<rusqlite::Connection, Error> {
+    use rusqlite::OpenFlags;
+    let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+    rusqlite::Connection::open_with_flags(path, flags).map_err(|err| sqlite_error(path, &err))
+}
+
+/// An SQLite3 bag's topics, from its `topics` table (rosbag2's schema; ids as channel ids).
+fn sqlite_channels(path: &Path) -> Result<Vec<Channel>, Error> {
+    let db = open_sqlite(path)?;
+    let fail = |err: rusqlite::Error| sqlite_error(path, &err);
+    let mut query = db
+        .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
+        .map_err(fail)?;
+    let rows = query
+        .query_map([], |row| {
+            Ok((row.get::<_, i64>(0)?, row.get(1)?, row.get(2)?, row.get(3)?))
+        })
+        .map_err(fail)?;
+    let mut found = Vec::new();
+    for row in rows {
+        let (id, topic, type_name, message_encoding) = row.map_err(fail)?;
+        let id = u16::try_from(id)
+            .map_err(|_| Error::bag(path, format!("topic {topic}: id {id} beyond 65535")))?;
+        found.push(Channel {
+            id,
+            topic,
+            type_name,
+            message_encoding,
+        });
+    }
+    Ok(found)
+}
+
+/// As [`stream_while`] for an SQLite3 bag: its topics, then its messages in time order, one
+/// row at a time (SQLite walks rosbag2's timestamp index; memory stays flat).
+fn sqlite_stream_while(
+    path: &Path,
+    mut visit: impl FnMut(Item<'_>) -> Result<bool, Error>,
+) -> Result<(), Error> {
+    for channel in sqlite_channels(path)? {
+        if !visit(Item::Channel(channel))? {
+            return Ok(());
+        }
+    }
+    let db = open_sqlite(path)?;
+    let fail = |err: rusqlite::Error| sqlite_error(path, &err);
+    let mut query = db
+        .prepare("SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp, id")
+        .map_err(fail)?;
+    let mut rows = query.query([]).map_err(fail)?;
+    let mut message = Vec::new();
+    while let Some(row) = rows.next().map_err(fail)? {
+        let topic_id: i64 = row.get(0).map_err(fail)?;
+        let timestamp: i64 = row.get(1).map_err(fail)?;
+        let data = row
+            .get_ref(2)
+            .and_then(|v| Ok(v.as_blob()?))
+            .map_err(fail)?;
+        if data.len() > RECORD_LENGTH_LIMIT {
+            return Err(Error::bag(
+                path,
+                format!("a message of {} bytes, beyond any scan's", data.len()),
+            ));
+        }
+        let data = if data.starts_with(&ZSTD_MAGIC) {
+            decompress_message(path, data, &mut message)?;
+            &message[..]
+        } else {
+            data
+        };
+        let go_on = visit(Item::Message {
+            // A topic id beyond u16 was refused with the topics.
+            channel_id: u16::try_from(topic_id).unwrap_or(u16::MAX),
+            log_time: u64::try_from(timestamp).unwrap_or(0),
+            data,
+        })?;
+        if !go_on {
+            break;
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -386,7 +493,7 @@ mod tests {
     }
 
     #[test]
-    fn a_sqlite_bag_and_a_missing_one_are_one_line_errors() {
+    fn a_foreign_storage_and_a_missing_bag_are_one_line_errors() {
         let dir = tempfile::tempdir().unwrap();
         let err = bag_files(dir.path()).unwrap_err().to_string();
         assert!(err.contains("metadata.yaml"), "{err}");
@@ -395,8 +502,22 @@ mod tests {
             "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n",
         )
         .unwrap();
+        // SQLite3 storage is read; this directory has no file of it.
         let err = bag_files(dir.path()).unwrap_err().to_string();
-        assert!(err.contains("storage `sqlite3`, not MCAP"), "{err}");
+        assert!(
+            err.contains("a bag directory without an .mcap or .db3 file"),
+            "{err}"
+        );
+        std::fs::write(
+            dir.path().join("metadata.yaml"),
+            "rosbag2_bagfile_information:\n  storage_identifier: rosbag_v2\n",
+        )
+        .unwrap();
+        let err = bag_files(dir.path()).unwrap_err().to_string();
+        assert!(
+            err.contains("storage `rosbag_v2`, neither MCAP nor SQLite3"),
+            "{err}"
+        );
         std::fs::write(dir.path().join("metadata.yaml"), "x: 1\n").unwrap();
         for name in ["b_10.mcap", "b_2.mcap", "b_0.mcap"] {
             std::fs::write(dir.path().join(name), b"").unwrap();

@@ -509,3 +509,74 @@ fn rosbag2_file_and_message_compression_read() {
         "{err}"
     );
 }
+
+/// rosbag2's SQLite3 storage (`.db3`, the default before Iron): its `topics` and `messages`
+/// tables, read as an MCAP file's channels and messages; another SQLite database is a one-line
+/// error.
+#[test]
+fn a_sqlite3_bag_reads_as_its_mcap_twin() {
+    let dir = tempfile::tempdir().unwrap();
+    let messages: Vec<Message> = (0..3)
+        .map(|k| Message {
+            topic: "/scan",
+            type_name: "sensor_msgs/msg/LaserScan",
+            t_ns: k * 100_000_000,
+            data: cdr(&scan(
+                k * 100_000_000,
+                0.0,
+                1f64.to_radians() as f32,
+                vec![2.5; 360],
+            )),
+        })
+        .collect();
+    let mcap = dir.path().join("twin.mcap");
+    write_mcap(&mcap, "ros2msg", &messages);
+    let bag = dir.path().join("bag");
+    fs::create_dir(&bag).unwrap();
+    let db = rusqlite::Connection::open(bag.join("bag_0.db3")).unwrap();
+    db.execute_batch(
+        "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, \
+         serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL); \
+         CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, \
+         timestamp INTEGER NOT NULL, data BLOB NOT NULL); \
+         CREATE INDEX timestamp_idx ON messages (timestamp ASC); \
+         INSERT INTO topics VALUES (1, '/scan', 'sensor_msgs/msg/LaserScan', 'cdr', '');",
+    )
+    .unwrap();
+    // Inserted out of time order: read in time order.
+    for m in messages.iter().rev() {
+        db.execute(
+            "INSERT INTO messages (topic_id, timestamp, data) VALUES (1, ?1, ?2)",
+            rusqlite::params![T0_NS + m.t_ns, m.data],
+        )
+        .unwrap();
+    }
+    drop(db);
+    fs::write(
+        bag.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths:\n  \
+         - bag_0.db3\n",
+    )
+    .unwrap();
+    import(&mcap, &dir.path().join("m"), &ImportOptions::default()).unwrap();
+    import(&bag, &dir.path().join("s"), &ImportOptions::default()).unwrap();
+    let csv = |name: &str| fs::read(dir.path().join(name).join("lidar.csv")).unwrap();
+    assert_eq!(csv("m").len(), csv("s").len());
+    assert!(csv("m") == csv("s"));
+
+    let other = dir.path().join("other.db3");
+    rusqlite::Connection::open(&other)
+        .unwrap()
+        .execute_batch("CREATE TABLE t(x); INSERT INTO t VALUES (1);")
+        .unwrap();
+    let err = import(&other, &dir.path().join("o"), &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(&format!(
+            "{}: not a readable SQLite3 bag (",
+            other.display()
+        )) && !err.contains('\n'),
+        "{err}"
+    );
+}

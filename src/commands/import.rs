@@ -1,6 +1,6 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
-//! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP) into a
-//! recording.
+//! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP or SQLite3)
+//! into a recording.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -12,7 +12,7 @@ use hilsim_ros2::{ImportOptions, Role};
 
 #[derive(Debug, clap::Args)]
 pub struct ImportArgs {
-    /// A ROS 2 bag: an `.mcap` file, or a bag directory (`metadata.yaml` and its MCAP files).
+    /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files).
     pub bag: PathBuf,
     /// The recording directory to write (replaced atomically when complete).
     #[arg(long)]

@@ -30,8 +30,9 @@ for compression in zstd lz4; do
     "$venv/bin/python" "$check" imported "$tmp/$compression.mcap" "$tmp/$compression"
 done
 
-# rosbag2's own compression modes: each file one zstd stream (`file`), each message (`message`).
-for mode in file message; do
+# rosbag2's own compression modes: each file one zstd stream (`file`), each message (`message`);
+# and its other storage, SQLite3 (rosbags' and Humble's default).
+for mode in file message sqlite3; do
     "$venv/bin/python" "$check" write "$tmp/bag-$mode" "$mode"
     "$hilsim" import "$tmp/bag-$mode" --out "$tmp/rec-$mode" --meta "$tmp/meta.toml"
     "$venv/bin/python" "$check" imported "$tmp/bag-$mode" "$tmp/rec-$mode"

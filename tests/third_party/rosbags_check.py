@@ -1,7 +1,8 @@
 """Third-party ROS 2 libraries against `hilsim import` and `hilsim export` (issue 17).
 
-    rosbags_check.py write BAGDIR [MODE]     write a ROS 2 bag with rosbags (MCAP storage;
-                                             MODE: rosbag2 compression, file or message)
+    rosbags_check.py write BAGDIR [VARIANT]  write a ROS 2 bag with rosbags (MCAP storage;
+                                             VARIANT: rosbag2 compression, file or message,
+                                             or sqlite3 storage)
     rosbags_check.py rewrite BAGDIR OUT C    the same messages through the mcap library's
                                              writer, chunks compressed with C (zstd, lz4)
     rosbags_check.py imported BAGDIR RECDIR  check hilsim's import of that bag
@@ -61,8 +62,9 @@ def odom_pose(j):
     return 0.2 * t * math.cos(0.2 * t), 0.2 * t * math.sin(0.2 * t), yaw
 
 
-def write(bagdir, compression="none"):
-    """`compression`: rosbag2's mode, `none`, `file` (each file one zstd stream) or `message`."""
+def write(bagdir, variant="none"):
+    """`variant`: rosbag2's compression mode, `none`, `file` (each file one zstd stream) or
+    `message`; or `sqlite3`, rosbag2's other storage (rosbags' default), uncompressed."""
     from rosbags.rosbag2.writer import CompressionFormat, CompressionMode
 
     store = get_typestore(Stores.ROS2_HUMBLE)
@@ -79,9 +81,10 @@ def write(bagdir, compression="none"):
     Pose = t["geometry_msgs/msg/Pose"]
     Twist = t["geometry_msgs/msg/Twist"]
     cov = np.zeros(36, dtype=np.float64)
-    writer = Writer(bagdir, version=8, storage_plugin=StoragePlugin.MCAP)
-    if compression != "none":
-        writer.set_compression(CompressionMode[compression.upper()], CompressionFormat.ZSTD)
+    storage = StoragePlugin.SQLITE3 if variant == "sqlite3" else StoragePlugin.MCAP
+    writer = Writer(bagdir, version=8, storage_plugin=storage)
+    if variant in ("file", "message"):
+        writer.set_compression(CompressionMode[variant.upper()], CompressionFormat.ZSTD)
     with writer:
         scan_c = writer.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
         odom_c = writer.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=store)

@@ -46,6 +46,16 @@ done
     --odom /joint_states --wheel-radius-m 0.033
 "$venv/bin/python" "$check" foreign-imported "$tmp/foreign-rec" "$tmp/foreign-joints"
 
+# A run calibrated through another library's bag: the landmarks run, every message serialized
+# again by rosbags (big-endian, SQLite3 storage, topics under /robot), imports and calibrates
+# as the recording itself does.
+"$hilsim" record scenarios/landmarks-5.toml --out "$tmp/lm" --mcap "$tmp/lm.mcap" > /dev/null
+"$venv/bin/python" "$check" resave "$tmp/lm.mcap" "$tmp/lm-resaved"
+"$hilsim" import "$tmp/lm-resaved" --out "$tmp/lm-imported" --meta "$tmp/lm/meta.toml"
+"$hilsim" calibrate "$tmp/lm" --method landmarks --json > "$tmp/lm.json"
+"$hilsim" calibrate "$tmp/lm-imported" --method landmarks --json > "$tmp/lm-imported.json"
+"$venv/bin/python" "$check" same-calibration "$tmp/lm.json" "$tmp/lm-imported.json"
+
 # hilsim record --mcap → rosbags and mcap-ros2-support.
 scenario=scenarios/straight-board.toml
 "$hilsim" record "$scenario" --out "$tmp/rec" --mcap "$tmp/run.mcap"

@@ -11,6 +11,9 @@
                                              the truth)
     rosbags_check.py write-foreign BAGDIR    a split bag of another robot's ways (see below)
     rosbags_check.py foreign-imported REC JOINTS_REC   check its imports (Odometry, JointState)
+    rosbags_check.py resave MCAP BAGDIR      hilsim's export re-serialized by rosbags (SQLite3,
+                                             big-endian, namespaced)
+    rosbags_check.py same-calibration A B    two `calibrate --json` outputs agree
 
 Each check compares message contents with the recording's CSV files and exits non-zero with a
 line saying what differs.
@@ -308,6 +311,33 @@ def foreign_imported(rec, joints_rec):
           f"{len(sonar)} sonar, {len(odometry)} odometry and {len(wheels)} wheel-joint rows agree")
 
 
+def resave(mcap_path, bagdir):
+    """hilsim's export as another library's bag: every message deserialized and serialized
+    again by rosbags, big-endian, into SQLite3 storage, topics under /robot (TF and markers
+    left out)."""
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    with AnyReader([Path(mcap_path)], default_typestore=store) as reader, \
+            Writer(Path(bagdir), version=8, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connections = {}
+        for c in reader.connections:
+            if not c.msgtype.startswith(("visualization_msgs", "tf2_msgs")):
+                connections[c.id] = writer.add_connection("/robot" + c.topic, c.msgtype, typestore=store)
+        for c, ts, raw in reader.messages():
+            if c.id in connections:
+                msg = reader.deserialize(raw, c.msgtype)
+                writer.write(connections[c.id], ts, store.serialize_cdr(msg, c.msgtype, little_endian=False))
+
+
+def same_calibration(a, b):
+    import json
+
+    a, b = (json.loads(Path(p).read_text()) for p in (a, b))
+    for key in ("sensors", "landmarks", "order", "converged"):
+        if a.get(key) != b.get(key):
+            fail(f"calibration {key} differs: {a.get(key)} != {b.get(key)}")
+    print("rosbags_check: the calibration of the rosbags-resaved bag is the recording's, digit for digit")
+
+
 def table(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -578,6 +608,10 @@ if __name__ == "__main__":
         rewrite(Path(sys.argv[2]), sys.argv[3], sys.argv[4])
     elif mode == "imported":
         imported(sys.argv[2], sys.argv[3])
+    elif mode == "resave":
+        resave(sys.argv[2], sys.argv[3])
+    elif mode == "same-calibration":
+        same_calibration(sys.argv[2], sys.argv[3])
     elif mode == "write-foreign":
         write_foreign(sys.argv[2])
     elif mode == "foreign-imported":

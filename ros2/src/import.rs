@@ -363,6 +363,8 @@ pub struct Converter {
     wheel_base_m: f64,
     wheel_radius_m: Option<f64>,
     wheel_joints: Option<[String; 2]>,
+    /// Messages skipped for a value that is not finite, by table.
+    not_finite: BTreeMap<Role, u64>,
     /// `JointState` messages without the wheels' positions.
     joints_missing: u64,
     /// The joints of the first such message, for the error when no message has the wheels.
@@ -459,6 +461,7 @@ impl Converter {
             wheel_base_m,
             wheel_radius_m,
             wheel_joints: None,
+            not_finite: BTreeMap::new(),
             joints_missing: 0,
             joints_seen: Vec::new(),
             t0_ns: None,
@@ -509,6 +512,11 @@ impl Converter {
         let t0 = *self.t0_ns.get_or_insert(ns);
         let t_s = microseconds(ns - t0, extra_ns);
         self.clocks.entry(role).or_default().order(t_s)
+    }
+
+    /// Counts a message skipped for a NaN or infinite value (a driver's "unknown").
+    fn not_finite(&mut self, role: Role) {
+        *self.not_finite.entry(role).or_insert(0) += 1;
     }
 
     fn count(&mut self, role: Role, n: u64) {
@@ -670,8 +678,12 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
-        let t_s = self.seconds(Role::Commands, ns, 0.0);
         let (v, w) = (twist.linear.x, twist.angular.z);
+        if !(v.is_finite() && w.is_finite()) {
+            self.not_finite(Role::Commands);
+            return Ok(());
+        }
+        let t_s = self.seconds(Role::Commands, ns, 0.0);
         let half = 0.5 * self.wheel_base_m * w;
         self.count(Role::Commands, 1);
         Ok(sink.command(&CommandSample {
@@ -685,13 +697,18 @@ impl Converter {
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
+        let (x_m, y_m, yaw_rad) = (pose.position.x, pose.position.y, pose.orientation.yaw());
+        if ![x_m, y_m, yaw_rad].iter().all(|v| v.is_finite()) {
+            self.not_finite(Role::Truth);
+            return Ok(());
+        }
         let t_s = self.seconds(Role::Truth, ns, 0.0);
         self.count(Role::Truth, 1);
         Ok(sink.truth(&TruthSample {
             t_s,
-            x_m: pose.position.x,
-            y_m: pose.position.y,
-            yaw_rad: pose.orientation.yaw(),
+            x_m,
+            y_m,
+            yaw_rad,
         })?)
     }
 
@@ -705,7 +722,8 @@ impl Converter {
         let pose = &odometry.pose.pose;
         let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
         if ![x, y, yaw].iter().all(|v| v.is_finite()) {
-            return Err(Fault::Message("a pose that is not finite".into()));
+            self.not_finite(Role::Odometry);
+            return Ok(());
         }
         let (left_m, right_m) = match &mut self.odometry {
             Some(OdometryState::Pose {
@@ -850,6 +868,11 @@ impl Converter {
                  and were put at its time",
                 clock.reordered,
                 clock.worst_s * 1e3
+            ));
+        }
+        for (role, count) in &self.not_finite {
+            notes.push(format!(
+                "{count} {role} messages with a value that is not finite (NaN, inf) skipped"
             ));
         }
         if self.joints_missing > 0 {

@@ -580,3 +580,61 @@ fn a_sqlite3_bag_reads_as_its_mcap_twin() {
         "{err}"
     );
 }
+
+/// Drivers that send NaN for "unknown": an Odometry, a truth pose and a command with a NaN are
+/// skipped and counted, not written (a recording's numbers are finite), and the rest imports.
+#[test]
+fn messages_with_nan_are_skipped_and_counted() {
+    use hilsim_ros2::msgs::{PoseStamped, Twist, TwistStamped};
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("nan.mcap");
+    let mut messages = Vec::new();
+    for k in 0..4 {
+        let t_ns = k * 100_000_000;
+        let bad = if k == 2 { f64::NAN } else { 0.0 };
+        let mut odometry = Odometry {
+            header: header(t_ns, "odom"),
+            ..Odometry::default()
+        };
+        odometry.pose.pose.position.x = 0.1 * k as f64 + bad;
+        let mut pose = PoseStamped {
+            header: header(t_ns, "map"),
+            ..PoseStamped::default()
+        };
+        pose.pose.position.y = bad;
+        let mut twist = TwistStamped {
+            header: header(t_ns, "base_link"),
+            twist: Twist::default(),
+        };
+        twist.twist.angular.z = bad;
+        messages.push(Message {
+            topic: "/odom",
+            type_name: "nav_msgs/msg/Odometry",
+            t_ns,
+            data: cdr(&odometry),
+        });
+        messages.push(Message {
+            topic: "/pose",
+            type_name: "geometry_msgs/msg/PoseStamped",
+            t_ns,
+            data: cdr(&pose),
+        });
+        messages.push(Message {
+            topic: "/cmd",
+            type_name: "geometry_msgs/msg/TwistStamped",
+            t_ns,
+            data: cdr(&twist),
+        });
+    }
+    write_mcap(&bag, "ros2msg", &messages);
+    let out = dir.path().join("rec");
+    let report = import(&bag, &out, &ImportOptions::default()).unwrap();
+    let rec = Recording::read_dir(&out).unwrap();
+    assert_eq!(rec.odometry.unwrap().len(), 3);
+    assert_eq!(rec.truth.unwrap().len(), 3);
+    assert_eq!(rec.commands.len(), 3);
+    for role in ["odometry", "commands", "truth"] {
+        let note = format!("1 {role} messages with a value that is not finite (NaN, inf) skipped");
+        assert!(report.notes.contains(&note), "{note}: {:?}", report.notes);
+    }
+}

@@ -395,8 +395,11 @@ fn write_all<W: Write>(
                 // odometry's pose at that time, as tf2 interpolates it).
                 let tf = match odometry_path.at(p.t_s) {
                     Some(odom_pose) => {
-                        let [x, y, yaw] = compose([p.x_m, p.y_m, p.yaw_rad], inverse(odom_pose));
-                        transform(t_ns, "map", "odom", x, y, yaw)
+                        // odom's origin in base_link, then in map through the truth.
+                        let origin = hilsim_recording::Pose::default().relative_to(&odom_pose);
+                        let odom = hilsim_recording::Pose::new(p.x_m, p.y_m, p.yaw_rad)
+                            .compose(origin.x, origin.y, origin.yaw);
+                        transform(t_ns, "map", "odom", odom.x, odom.y, odom.yaw)
                     }
                     None => transform(t_ns, "map", "base_link", p.x_m, p.y_m, p.yaw_rad),
                 };
@@ -595,7 +598,7 @@ impl DeadReckoning {
 /// The odometry's poses (dead-reckoned as `/odom` sends them) at each row's time.
 struct OdometryPath {
     times_s: Vec<f64>,
-    poses: Vec<[f64; 3]>,
+    poses: Vec<hilsim_recording::Pose>,
 }
 
 impl OdometryPath {
@@ -606,47 +609,29 @@ impl OdometryPath {
             .map(|o| {
                 let (pose, _) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
                 let (x, y) = (pose.position.x, pose.position.y);
-                (o.t_s, [x, y, pose.orientation.yaw()])
+                (
+                    o.t_s,
+                    hilsim_recording::Pose::new(x, y, pose.orientation.yaw()),
+                )
             })
             .unzip();
         Self { times_s, poses }
     }
 
     /// The pose at `t_s` as tf2 interpolates between two stamped transforms: the position
-    /// linearly, the yaw along the shorter way (a quaternion slerp about z); the first or last
-    /// pose outside the rows' times. `None` without odometry.
-    fn at(&self, t_s: f64) -> Option<[f64; 3]> {
+    /// linearly, the yaw along the shorter way (a quaternion slerp about z), which is
+    /// [`hilsim_recording::Pose::lerp`]; the first or last pose outside the rows' times. `None`
+    /// without odometry.
+    fn at(&self, t_s: f64) -> Option<hilsim_recording::Pose> {
         let after = self.times_s.partition_point(|&t| t <= t_s);
         let last = self.poses.len().checked_sub(1)?;
         if after == 0 || after > last {
             return Some(self.poses[after.min(last)]);
         }
         let (t0, t1) = (self.times_s[after - 1], self.times_s[after]);
-        let ([x0, y0, a0], [x1, y1, a1]) = (self.poses[after - 1], self.poses[after]);
         let f = (t_s - t0) / (t1 - t0);
-        let turn = hilsim_recording::wrap_angle(a1 - a0);
-        Some([
-            x0 + f * (x1 - x0),
-            y0 + f * (y1 - y0),
-            hilsim_recording::wrap_angle(a0 + f * turn),
-        ])
+        Some(self.poses[after - 1].lerp(&self.poses[after], f))
     }
-}
-
-/// `b` (a pose in `a`'s frame) in the frame `a` is given in: planar poses [x, y, yaw].
-fn compose(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    let (sin, cos) = a[2].sin_cos();
-    [
-        a[0] + cos * b[0] - sin * b[1],
-        a[1] + sin * b[0] + cos * b[1],
-        hilsim_recording::wrap_angle(a[2] + b[2]),
-    ]
-}
-
-/// The pose of the frame a planar pose is given in, in that pose's frame.
-fn inverse(a: [f64; 3]) -> [f64; 3] {
-    let (sin, cos) = a[2].sin_cos();
-    [-cos * a[0] - sin * a[1], sin * a[0] - cos * a[1], -a[2]]
 }
 
 /// The world as markers: walls and boards as thin boxes 0.3 m high, cylinders as cylinders.
@@ -862,7 +847,7 @@ mod tests {
             let stamp = |tf: &TransformStamped| tf.header.stamp.ns();
             let planar = |tf: &TransformStamped| {
                 let t = &tf.transform;
-                [t.translation.x, t.translation.y, t.rotation.yaw()]
+                hilsim_recording::Pose::new(t.translation.x, t.translation.y, t.rotation.yaw())
             };
             let odom_base: Vec<_> = transforms
                 .iter()
@@ -885,18 +870,12 @@ mod tests {
                     } else {
                         0.0
                     };
-                    let (pa, pb) = (planar(a), planar(b));
-                    let turn = hilsim_recording::wrap_angle(pb[2] - pa[2]);
-                    let between = [
-                        pa[0] + f * (pb[0] - pa[0]),
-                        pa[1] + f * (pb[1] - pa[1]),
-                        pa[2] + f * turn,
-                    ];
-                    compose(planar(at), between)
+                    let between = planar(a).lerp(&planar(b), f);
+                    planar(at).compose(between.x, between.y, between.yaw)
                 };
-                let yaw_error = hilsim_recording::wrap_angle(in_map[2] - p.yaw_rad);
+                let yaw_error = hilsim_recording::wrap_angle(in_map.yaw - p.yaw_rad);
                 // Rounding only: a few sums and products of numbers below 10.
-                let close = (in_map[0] - p.x_m).abs() < 1e-9 && (in_map[1] - p.y_m).abs() < 1e-9;
+                let close = (in_map.x - p.x_m).abs() < 1e-9 && (in_map.y - p.y_m).abs() < 1e-9;
                 assert!(close && yaw_error.abs() < 1e-9, "{p:?}: {in_map:?}");
             }
         }

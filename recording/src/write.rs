@@ -37,43 +37,49 @@ impl Recording {
     /// Each present table as (file name, CSV text).
     #[must_use]
     pub fn tables(&self) -> Vec<(&'static str, String)> {
+        // Written as bytes (the streamed tables' fast path), then checked as UTF-8 once: every
+        // byte is ASCII.
+        let text = |bytes: Vec<u8>| {
+            String::from_utf8(bytes)
+                .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into())
+        };
         let mut out = Vec::new();
-        let mut s = String::from(rows::COMMANDS_HEADER);
+        let mut s = rows::COMMANDS_HEADER.as_bytes().to_vec();
         for c in &self.commands {
             rows::command(&mut s, c);
         }
-        out.push(("commands.csv", s));
+        out.push(("commands.csv", text(s)));
         if let Some(odometry) = &self.odometry {
-            let mut s = String::from(rows::ODOMETRY_HEADER);
+            let mut s = rows::ODOMETRY_HEADER.as_bytes().to_vec();
             for o in odometry {
                 rows::odometry(&mut s, o);
             }
-            out.push(("odometry.csv", s));
+            out.push(("odometry.csv", text(s)));
         }
         if let Some(lidar) = &self.lidar {
             // The truth column is all-or-nothing: a simulator knows every true range.
             let with_truth = lidar.iter().all(|r| r.true_range_m.is_some()) && !lidar.is_empty();
-            let mut s = String::with_capacity(lidar.len() * 48);
-            s.push_str(rows::lidar_header(with_truth));
+            let mut s = Vec::with_capacity(lidar.len() * 48);
+            s.extend_from_slice(rows::lidar_header(with_truth).as_bytes());
             for r in lidar {
                 rows::lidar(&mut s, r, with_truth);
             }
-            out.push(("lidar.csv", s));
+            out.push(("lidar.csv", text(s)));
         }
         if let Some(sonar) = &self.sonar {
             let with_truth = sonar.iter().all(|r| r.true_range_m.is_some()) && !sonar.is_empty();
-            let mut s = String::from(rows::sonar_header(with_truth));
+            let mut s = rows::sonar_header(with_truth).as_bytes().to_vec();
             for r in sonar {
                 rows::sonar(&mut s, r, with_truth);
             }
-            out.push(("sonar.csv", s));
+            out.push(("sonar.csv", text(s)));
         }
         if let Some(truth) = &self.truth {
-            let mut s = String::from(rows::TRUTH_HEADER);
+            let mut s = rows::TRUTH_HEADER.as_bytes().to_vec();
             for p in truth {
                 rows::truth(&mut s, p);
             }
-            out.push(("truth.csv", s));
+            out.push(("truth.csv", text(s)));
         }
         out
     }

@@ -15,7 +15,7 @@ mod nuisance;
 mod sensors;
 mod world;
 
-pub use concealed::Concealed;
+pub use concealed::{Concealed, Stamped};
 pub use noise::Stream;
 pub use nuisance::Nuisances;
 
@@ -53,15 +53,33 @@ pub fn record(
         y: scenario.robot.start.y,
         yaw: scenario.robot.start.yaw_deg.to_radians(),
     };
+    let radius_scale = concealed
+        .iter()
+        .find_map(|c| match *c {
+            Concealed::WheelRadius {
+                left_scale,
+                right_scale,
+            } => Some([left_scale, right_scale]),
+            _ => None,
+        })
+        .unwrap_or([1.0; 2]);
+    let base_scale = concealed
+        .iter()
+        .find_map(|c| match *c {
+            Concealed::WheelBase { scale } => Some(scale),
+            _ => None,
+        })
+        .unwrap_or(1.0);
     let mut drive_noise = Stream::new(seed, "reality-drive");
     let motion = motion::integrate(
         &spans,
         start,
-        scenario.robot.wheel_base_m,
+        scenario.robot.wheel_base_m * base_scale,
         end_s,
         Drive {
             lag_s,
             speed_noise: nuisances.speed_noise,
+            radius_scale,
         },
         &mut drive_noise,
     );
@@ -72,6 +90,7 @@ pub fn record(
         end_s,
         concealed,
         nuisances,
+        radius_scale,
     };
     let s = &scenario.sensors;
     Recording {

@@ -247,7 +247,12 @@ impl Effect {
             23,
             R::uniform(15.0, 30.0).signed().around(20.0, -50.0, 60.0),
         )];
-        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (-0.5, 0.5), 11, R::uniform(0.03, 0.1))];
+        // Slip's gain is searched at g ≥ 0 only (the same 0.1 s grid as before on that side):
+        // a driven wheel's surface outruns the ground as it accelerates (the traction force
+        // needs a positive slip ratio: Wong, *Theory of Ground Vehicles*, ch. 1), so the
+        // encoders lead. Encoders that lag the travel by `L v` are a late stamp, the
+        // odometer's `sensor_latency`, which is otherwise a slip with g = −L.
+        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1))];
         const LAG: [ParamSpec; 1] = [log(
             "time_constant_s",
             "s",

@@ -92,7 +92,20 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
             }
         }
     } else {
-        let (u, v) = nelder_mead(&mut eval, &best_u, &cell, simplex_evals(specs.len()));
+        let (mut u, mut v, mut converged) =
+            nelder_mead(&mut eval, &best_u, &cell, simplex_evals(specs.len()));
+        // A likelihood far sharper than the grid (a wheel's radius to 1e-5 from a cell of
+        // 0.05) can use up the simplex's budget before it shrinks that far: restart from
+        // where it got with steps a tenth as large, at most three times. A converged search
+        // (every fit before the wheels' radius) is left as it was.
+        let mut step = cell.clone();
+        for _ in 0..3 {
+            if converged {
+                break;
+            }
+            step.iter_mut().for_each(|s| *s /= 10.0);
+            (u, v, converged) = nelder_mead(&mut eval, &u, &step, simplex_evals(specs.len()));
+        }
         if v > best_v {
             best_v = v;
             best_u = u;
@@ -142,7 +155,7 @@ pub(crate) fn refine(
         .iter()
         .map(|s| 0.5 / (s.grid.max(2) - 1) as f64)
         .collect();
-    let (u, v) = nelder_mead(&mut eval, &u0, &step, max_evals);
+    let (u, v, _) = nelder_mead(&mut eval, &u0, &step, max_evals);
     let x = specs
         .iter()
         .zip(&u)
@@ -151,13 +164,14 @@ pub(crate) fn refine(
     (x, v)
 }
 
-/// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`.
+/// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`: the best
+/// point, its value, and whether the simplex converged (else the budget ran out).
 fn nelder_mead(
     f: &mut dyn FnMut(&[f64]) -> f64,
     start: &[f64],
     step: &[f64],
     max_evals: usize,
-) -> (Vec<f64>, f64) {
+) -> (Vec<f64>, f64, bool) {
     let n = start.len();
     let clamp = |x: Vec<f64>| x.into_iter().map(|v| v.clamp(0.0, 1.0)).collect::<Vec<_>>();
     let mut simplex: Vec<(Vec<f64>, f64)> = Vec::with_capacity(n + 1);
@@ -174,6 +188,7 @@ fn nelder_mead(
         simplex.push((x, v));
     }
     let mut evals = n + 1;
+    let mut converged = false;
     while evals < max_evals {
         simplex.sort_by(|a, b| b.1.total_cmp(&a.1));
         // Converged when the simplex spans less than 0.01 nats or 1e-4 of the box.
@@ -187,6 +202,7 @@ fn nelder_mead(
             })
             .fold(0.0, f64::max);
         if spread.abs() < 1e-2 || size < 1e-4 {
+            converged = true;
             break;
         }
         let centroid: Vec<f64> = (0..n)
@@ -236,7 +252,8 @@ fn nelder_mead(
         }
     }
     simplex.sort_by(|a, b| b.1.total_cmp(&a.1));
-    simplex.swap_remove(0)
+    let (x, v) = simplex.swap_remove(0);
+    (x, v, converged)
 }
 
 /// Standard errors of the maximiser `x` of the log-likelihood `f`: the square roots of the

@@ -1,7 +1,7 @@
 //! Issue 15: each of the catalogue's mount, timing and wheel-geometry entries, concealed in a
 //! recording `hilsim` makes with truth, is named with its parameters.
 //!
-//! A short run (about 16 s: starts, stops, two turns and a reverse in a 4 m × 3 m room with a
+//! A short run (17 s: starts, stops, two turns and a reverse in a 4 m × 3 m room with a
 //! cylinder and a board) keeps the fits quick; each recording has its own fixed seed. Each
 //! diagnosis tries the effects of the concealed one's sensor (the competitors it must beat
 //! there, and the rest of the catalogue is the self-test's to exercise; this keeps a debug
@@ -130,7 +130,7 @@ fn each_sensor_stamped_late_is_named_with_its_own_delay() {
         // ~20,000 readings, the encoders' travel by 15 mm against 2 mm of noise: within 10 %.
         (Sensor::Lidar, 0.05, 0.005),
         (Sensor::Odometer, 0.05, 0.005),
-        // The sonar's ~160 pings see only the motion along its axis (8 mm noise): within 30 %.
+        // The sonar's ~170 pings (10 Hz) see only the motion along its axis (8 mm noise): within 30 %.
         (Sensor::Sonar, 0.08, 0.024),
     ] {
         let effect = Effect::SensorLatency(sensor);

@@ -4,7 +4,10 @@
 //! are then refitted jointly and each must still earn its place against the others.
 //!
 //! An effect earns its place when it improves the held-out log-likelihood by more than
-//! [`Options::min_gain`], its BIC gain on the training half is positive, its fitted parameter
+//! [`Options::min_gain`], its BIC gain on the training half is positive, it does not raise its
+//! sensor's held-out RMSE (a likelihood gained on a few readings while the rest fit worse is
+//! not the effect: a lidar mount offset shifted a few millimetres gains tens of nats against a
+//! periodic range error outside the catalogue while the RMSE rises), its fitted parameter
 //! departs from the effect's absence by more than the sensors resolve (`Effect::departs`),
 //! and it changes the predicted readings by more than the sensor's practical floor
 //! ([`crate::locate::Floors`]): a small difference between the recording and the simulation
@@ -37,6 +40,7 @@ pub(crate) struct Selection {
 pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Options) -> bool {
     c.heldout_gain > options.min_gain
         && c.bic_gain > 0.0
+        && c.rmse_after.partial_cmp(&c.rmse_before) != Some(std::cmp::Ordering::Greater)
         && c.effect.departs(&c.params, declared_cone)
         && c.size_m > options.floors.floor_m(c.effect.sensor(), c.size_noise_m)
 }

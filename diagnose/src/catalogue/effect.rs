@@ -93,7 +93,8 @@ impl Effect {
     /// ```
     /// use hilsim_diagnose::Effect;
     /// for e in Effect::ALL {
-    ///     assert_eq!(Effect::from_name(e.name()), Some(e));
+    ///     assert!(Effect::named(e.name()).contains(&e));
+    ///     assert_eq!(Effect::from_name(e.name()).map(Effect::name), Some(e.name()));
     /// }
     /// ```
     #[must_use]

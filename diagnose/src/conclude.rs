@@ -124,7 +124,7 @@ pub(crate) fn conclude(
         .collect();
     let mut unexplained: Vec<Evidence> = Vec::new();
     for l in left {
-        let explained = effects.iter().any(|e| e.fit.effect.sensor() == l.sensor);
+        let explained = effects.iter().any(|e| e.fit.effect.shows_in(l.sensor));
         // Most readings far from every prediction and no effect of the sensor named: the
         // recording is not a run of this scenario (or its trajectory is wrong).
         if let Some(m) = nominal

@@ -109,7 +109,7 @@ pub fn diagnose_with_progress(
     let named = explaining_their_sensor(&nominal, &left, named, options);
     // A sensor whose effects were all dropped is left with its nominal structure.
     for l in &mut left {
-        if !named.iter().any(|c| c.effect.sensor() == l.sensor) {
+        if !named.iter().any(|c| c.effect.shows_in(l.sensor)) {
             l.evidence = nominal
                 .evidence
                 .iter()
@@ -211,7 +211,7 @@ fn structure_left(
         .map(|d| {
             let mine: Vec<CandidateFit> = named
                 .iter()
-                .filter(|c| c.effect.sensor() == d.sensor)
+                .filter(|c| c.effect.shows_in(d.sensor))
                 .cloned()
                 .collect();
             let evidence = if mine.is_empty() {

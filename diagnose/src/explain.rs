@@ -161,13 +161,15 @@ pub(crate) fn fit_candidate(
     score(ctx, data, base, effect, params, &train)
 }
 
-/// Refits the effects of one sensor `chosen` (each fitted in turn on top of those before it)
-/// jointly: every parameter at once, from where the turns left them. Each is then scored
-/// against the others: its gain is what it adds to them.
+/// Refits the effects of one sensor `chosen` (each fitted in turn on top of those before it
+/// and of `base`, the effects named in other sensors that show in this one) jointly: every
+/// parameter of `chosen` at once, from where the turns left them, `base` held. Each is then
+/// scored against the others and `base`: its gain is what it adds to them.
 pub(crate) fn refit_jointly(
     ctx: &Context<'_>,
     data: &SensorData,
     chosen: &[CandidateFit],
+    base: &Hypothesis,
     max_fit_rows: usize,
 ) -> Vec<CandidateFit> {
     if chosen.len() < 2 {
@@ -179,32 +181,31 @@ pub(crate) fn refit_jointly(
         .flat_map(|c| c.effect.params().iter().copied())
         .collect();
     let start: Vec<f64> = chosen.iter().flat_map(|c| c.params.clone()).collect();
-    let split = |x: &[f64]| -> Hypothesis {
-        let mut h = Hypothesis::nominal();
+    let split = |x: &[f64]| -> Vec<(Effect, Vec<f64>)> {
         let mut at = 0;
-        for c in chosen {
-            let k = c.effect.params().len();
-            h = h.and(c.effect, x[at..at + k].to_vec());
-            at += k;
-        }
-        h
+        chosen
+            .iter()
+            .map(|c| {
+                let k = c.effect.params().len();
+                at += k;
+                (c.effect, x[at - k..at].to_vec())
+            })
+            .collect()
     };
-    let mut objective = |x: &[f64]| total_ll(ctx, data, &split(x), &train);
+    let with = |effects: &[(Effect, Vec<f64>)]| -> Hypothesis {
+        effects
+            .iter()
+            .fold(base.clone(), |h, (e, p)| h.and(*e, p.clone()))
+    };
+    let mut objective = |x: &[f64]| total_ll(ctx, data, &with(&split(x)), &train);
     let (x, _) = refine(&specs, &start, 30 * specs.len(), &mut objective);
     let joint = split(&x);
     joint
-        .effects
         .iter()
         .map(|(effect, params)| {
-            let others = Hypothesis {
-                effects: joint
-                    .effects
-                    .iter()
-                    .filter(|(e, _)| e != effect)
-                    .cloned()
-                    .collect(),
-            };
-            score(ctx, data, &others, *effect, params.clone(), &train)
+            let others: Vec<(Effect, Vec<f64>)> =
+                joint.iter().filter(|(e, _)| e != effect).cloned().collect();
+            score(ctx, data, &with(&others), *effect, params.clone(), &train)
         })
         .collect()
 }

@@ -1,8 +1,9 @@
-//! Maximising a likelihood over an effect's one or two parameters: a coarse grid over the
-//! searched range (the likelihood need not be concave there: a time constant, a beam width),
-//! then a golden-section search (one parameter) or Nelder–Mead (two) from the best grid point,
-//! in the parameter's own scale (logarithmic for ranges spanning decades). The uncertainty is
-//! the curvature at the maximum: the inverse observed information.
+//! Maximising a likelihood over an effect's parameters (one, two, or the mount's three): a
+//! coarse grid over the searched box (the likelihood need not be concave there: a time
+//! constant, a beam width), then a golden-section search (one parameter) or Nelder–Mead (n)
+//! from the best grid point, in each parameter's own scale (logarithmic for ranges spanning
+//! decades), clamped to the box. The uncertainty is the curvature at the maximum: the inverse
+//! observed information.
 
 use crate::catalogue::ParamSpec;
 
@@ -15,8 +16,14 @@ fn from_unit(spec: &ParamSpec, u: f64) -> f64 {
     }
 }
 
+/// Nelder–Mead's evaluations after the grid: 60 for two parameters (what the one- and
+/// two-parameter fits have always had), 30 more for each further one.
+fn simplex_evals(n: usize) -> usize {
+    60 + 30 * n.saturating_sub(2)
+}
+
 /// The maximum of `f` over the box of `specs`, with the value there, after at most about
-/// `grid + 40` evaluations.
+/// the grid's points (the product of each parameter's) and [`simplex_evals`] evaluations.
 pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) -> (Vec<f64>, f64) {
     let mut eval = |u: &[f64]| -> f64 {
         let x: Vec<f64> = specs.iter().zip(u).map(|(s, &u)| from_unit(s, u)).collect();
@@ -85,7 +92,20 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
             }
         }
     } else {
-        let (u, v) = nelder_mead(&mut eval, &best_u, &cell, 60);
+        let (mut u, mut v, mut converged) =
+            nelder_mead(&mut eval, &best_u, &cell, simplex_evals(specs.len()));
+        // A likelihood far sharper than the grid (a wheel's radius to 1e-5 from a cell of
+        // 0.05) can use up the simplex's budget before it shrinks that far: restart from
+        // where it got with steps a tenth as large, at most three times. A converged search
+        // (every fit before the wheels' radius) is left as it was.
+        let mut step = cell.clone();
+        for _ in 0..3 {
+            if converged {
+                break;
+            }
+            step.iter_mut().for_each(|s| *s /= 10.0);
+            (u, v, converged) = nelder_mead(&mut eval, &u, &step, simplex_evals(specs.len()));
+        }
         if v > best_v {
             best_v = v;
             best_u = u;
@@ -135,7 +155,7 @@ pub(crate) fn refine(
         .iter()
         .map(|s| 0.5 / (s.grid.max(2) - 1) as f64)
         .collect();
-    let (u, v) = nelder_mead(&mut eval, &u0, &step, max_evals);
+    let (u, v, _) = nelder_mead(&mut eval, &u0, &step, max_evals);
     let x = specs
         .iter()
         .zip(&u)
@@ -144,13 +164,14 @@ pub(crate) fn refine(
     (x, v)
 }
 
-/// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`.
+/// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`: the best
+/// point, its value, and whether the simplex converged (else the budget ran out).
 fn nelder_mead(
     f: &mut dyn FnMut(&[f64]) -> f64,
     start: &[f64],
     step: &[f64],
     max_evals: usize,
-) -> (Vec<f64>, f64) {
+) -> (Vec<f64>, f64, bool) {
     let n = start.len();
     let clamp = |x: Vec<f64>| x.into_iter().map(|v| v.clamp(0.0, 1.0)).collect::<Vec<_>>();
     let mut simplex: Vec<(Vec<f64>, f64)> = Vec::with_capacity(n + 1);
@@ -167,6 +188,7 @@ fn nelder_mead(
         simplex.push((x, v));
     }
     let mut evals = n + 1;
+    let mut converged = false;
     while evals < max_evals {
         simplex.sort_by(|a, b| b.1.total_cmp(&a.1));
         // Converged when the simplex spans less than 0.01 nats or 1e-4 of the box.
@@ -180,6 +202,7 @@ fn nelder_mead(
             })
             .fold(0.0, f64::max);
         if spread.abs() < 1e-2 || size < 1e-4 {
+            converged = true;
             break;
         }
         let centroid: Vec<f64> = (0..n)
@@ -229,7 +252,8 @@ fn nelder_mead(
         }
     }
     simplex.sort_by(|a, b| b.1.total_cmp(&a.1));
-    simplex.swap_remove(0)
+    let (x, v) = simplex.swap_remove(0);
+    (x, v, converged)
 }
 
 /// Standard errors of the maximiser `x` of the log-likelihood `f`: the square roots of the
@@ -277,7 +301,7 @@ pub(crate) fn standard_errors(
             hess[j][i] = v;
         }
     }
-    // Invert −H (1×1 or 2×2).
+    // Invert −H (1×1 and 2×2 in closed form, as they always were; larger by Cholesky).
     match n {
         1 => {
             let a = -hess[0][0];
@@ -292,8 +316,26 @@ pub(crate) fn standard_errors(
                 vec![f64::NAN; 2]
             }
         }
-        _ => vec![f64::NAN; n],
+        _ => {
+            let minus: Vec<Vec<f64>> = hess
+                .iter()
+                .map(|row| row.iter().map(|v| -v).collect())
+                .collect();
+            inverse_diagonal(&minus).map_or_else(
+                || vec![f64::NAN; n],
+                |d| d.into_iter().map(f64::sqrt).collect(),
+            )
+        }
     }
+}
+
+/// The diagonal of the inverse of the symmetric matrix `a`, `None` unless it is positive
+/// definite (Cholesky).
+fn inverse_diagonal(a: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let n = a.len();
+    let m = nalgebra::DMatrix::from_fn(n, n, |i, j| a[i][j]);
+    let inverse = m.cholesky()?.inverse();
+    Some((0..n).map(|i| inverse[(i, i)]).collect())
 }
 
 #[cfg(test)]
@@ -323,6 +365,45 @@ mod tests {
         // A quadratic's curvature is the same everywhere: exact from any point.
         let se = standard_errors(&specs, &x, v, &mut f, 1e-3);
         assert!((se[0] - 0.05).abs() < 1e-6, "{se:?}");
+    }
+
+    #[test]
+    fn three_parameters_and_their_correlated_errors() {
+        let specs = [
+            spec(-8.0, 8.0, false),
+            spec(-0.1, 0.1, false),
+            spec(-0.1, 0.1, false),
+        ];
+        // ln L = −½ (x − m)ᵀ A (x − m) with A correlating the first two: the maximiser m,
+        // the standard errors the square roots of diag(A⁻¹).
+        let m = [1.7, -0.02, 0.03];
+        let a = [
+            [4.0, 100.0, 0.0],
+            [100.0, 10_000.0, 0.0],
+            [0.0, 0.0, 40_000.0],
+        ];
+        let mut f = |x: &[f64]| {
+            let d: Vec<f64> = x.iter().zip(&m).map(|(x, m)| x - m).collect();
+            let mut q = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    q += d[i] * a[i][j] * d[j];
+                }
+            }
+            -0.5 * q
+        };
+        let (x, v) = maximize(&specs, &mut f);
+        // Within a tenth of each one's standard error (0.707, 0.0141, 0.005).
+        assert!((x[0] - m[0]).abs() < 0.07, "{x:?}");
+        assert!((x[1] - m[1]).abs() < 0.0015, "{x:?}");
+        assert!((x[2] - m[2]).abs() < 0.0005, "{x:?}");
+        let se = standard_errors(&specs, &m, 0.0, &mut f, 1e-3);
+        // A⁻¹'s diagonal: det of the 2×2 block is 30,000: 10,000/30,000 and 4/30,000.
+        let want = [(1.0f64 / 3.0).sqrt(), (4.0f64 / 30_000.0).sqrt(), 0.005];
+        for (s, w) in se.iter().zip(want) {
+            assert!((s / w - 1.0).abs() < 1e-4, "{se:?}");
+        }
+        let _ = v;
     }
 
     #[test]

@@ -223,8 +223,8 @@ pub trait Physics: Sync {
     }
 
     /// The robot's trajectory from t = 0 to `end_s` when its wheels are commanded by `commands`
-    /// (the recording's `commands.csv`), under `hypothesis` (motor lag; any other effect leaves
-    /// the drive nominal). The declared actuation error is left out: it is noise to the
+    /// (the recording's `commands.csv`), under `hypothesis` (motor lag, the wheels' radii and
+    /// base; any other effect leaves the drive nominal). The declared actuation error is left out: it is noise to the
     /// diagnosis, not a prediction.
     fn drive(
         &self,

@@ -4,7 +4,10 @@
 //! are then refitted jointly and each must still earn its place against the others.
 //!
 //! An effect earns its place when it improves the held-out log-likelihood by more than
-//! [`Options::min_gain`], its BIC gain on the training half is positive, its fitted parameter
+//! [`Options::min_gain`], its BIC gain on the training half is positive, it does not raise its
+//! sensor's held-out RMSE (a likelihood gained on a few readings while the rest fit worse is
+//! not the effect: a lidar mount offset shifted a few millimetres gains tens of nats against a
+//! periodic range error outside the catalogue while the RMSE rises), its fitted parameter
 //! departs from the effect's absence by more than the sensors resolve (`Effect::departs`),
 //! and it changes the predicted readings by more than the sensor's practical floor
 //! ([`crate::locate::Floors`]): a small difference between the recording and the simulation
@@ -37,15 +40,28 @@ pub(crate) struct Selection {
 pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Options) -> bool {
     c.heldout_gain > options.min_gain
         && c.bic_gain > 0.0
+        && c.rmse_after.partial_cmp(&c.rmse_before) != Some(std::cmp::Ordering::Greater)
         && c.effect.departs(&c.params, declared_cone)
         && c.size_m > options.floors.floor_m(c.effect.sensor(), c.size_noise_m)
 }
 
 /// The hypothesis of the effects `fits` with their parameters.
 pub(crate) fn hypothesis_of(fits: &[CandidateFit]) -> Hypothesis {
-    fits.iter().fold(Hypothesis::nominal(), |h, c| {
-        h.and(c.effect, c.params.clone())
-    })
+    on_top_of(&Hypothesis::nominal(), fits)
+}
+
+/// `base` with the effects `fits` switched on as well.
+fn on_top_of(base: &Hypothesis, fits: &[CandidateFit]) -> Hypothesis {
+    fits.iter()
+        .fold(base.clone(), |h, c| h.and(c.effect, c.params.clone()))
+}
+
+/// The effects named in other sensors than `sensor` that show in it too (the wheels' radius
+/// and base, named in the odometer, move the drive): its effects are fitted on top of them.
+fn carried_into(named: &[CandidateFit], sensor: Sensor) -> impl Iterator<Item = &CandidateFit> {
+    named
+        .iter()
+        .filter(move |c| c.effect.sensor() != sensor && c.effect.shows_in(sensor))
 }
 
 /// Every applicable effect fitted on its own (in parallel: each is independent), best held-out
@@ -67,12 +83,14 @@ fn first_round(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Vec
     candidates
 }
 
-/// Forward selection in one sensor's `data`, starting from `pool` (its effects fitted on
-/// their own), then the joint refit.
+/// Forward selection in one sensor's `data` on top of `base` (the effects named elsewhere that
+/// show here), starting from `pool` (its effects fitted on their own on `base`), then the
+/// joint refit.
 fn select_in(
     ctx: &Context<'_>,
     data: &SensorData,
     mut pool: Vec<CandidateFit>,
+    base: &Hypothesis,
     options: &Options,
 ) -> Vec<CandidateFit> {
     let cone = declared_cone(ctx);
@@ -96,15 +114,15 @@ fn select_in(
         if pool.is_empty() || chosen.len() == MAX_PER_SENSOR {
             break;
         }
-        let base = hypothesis_of(&chosen);
+        let under = on_top_of(base, &chosen);
         pool = pool
             .par_iter()
-            .map(|c| explain::fit_candidate(ctx, data, &base, c.effect, options.max_fit_rows))
+            .map(|c| explain::fit_candidate(ctx, data, &under, c.effect, options.max_fit_rows))
             .collect();
     }
     // Jointly; an effect the others make redundant is dropped and the rest refitted.
     while chosen.len() >= 2 {
-        let joint = explain::refit_jointly(ctx, data, &chosen, options.max_fit_rows);
+        let joint = explain::refit_jointly(ctx, data, &chosen, base, options.max_fit_rows);
         let kept: Vec<CandidateFit> = joint
             .iter()
             .filter(|c| earns_place(c, cone, options))
@@ -114,14 +132,9 @@ fn select_in(
             return joint;
         }
         if kept.len() == 1 {
-            // Alone again: scored against the nominal model, as in the first round.
-            let alone = explain::fit_candidate(
-                ctx,
-                data,
-                &Hypothesis::nominal(),
-                kept[0].effect,
-                options.max_fit_rows,
-            );
+            // Alone again: scored against the base, as in the first round.
+            let alone =
+                explain::fit_candidate(ctx, data, base, kept[0].effect, options.max_fit_rows);
             return if earns_place(&alone, cone, options) {
                 vec![alone]
             } else {
@@ -137,13 +150,23 @@ fn select_in(
 pub(crate) fn select(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Selection {
     let candidates = first_round(ctx, data, options);
     let mut named: Vec<CandidateFit> = Vec::new();
+    // In the data's order (lidar, sonar, odometer, drive): an effect named in the odometer
+    // that moves the drive too is in place before the drive's are fitted.
     for d in data {
-        let pool: Vec<CandidateFit> = candidates
+        let carried: Vec<CandidateFit> = carried_into(&named, d.sensor).cloned().collect();
+        let base = hypothesis_of(&carried);
+        let mut pool: Vec<CandidateFit> = candidates
             .iter()
             .filter(|c| c.effect.sensor() == d.sensor)
             .cloned()
             .collect();
-        named.extend(select_in(ctx, d, pool, options));
+        if !base.is_nominal() {
+            pool = pool
+                .par_iter()
+                .map(|c| explain::fit_candidate(ctx, d, &base, c.effect, options.max_fit_rows))
+                .collect();
+        }
+        named.extend(select_in(ctx, d, pool, &base, options));
     }
     named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
     Selection { named, candidates }

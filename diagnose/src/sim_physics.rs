@@ -7,12 +7,12 @@ use crate::{
     Declared, DeclaredActuation, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
     LidarQuery, MismatchError, OdometryPrediction, Physics, SonarPrediction, Trajectory,
 };
-use hilsim_lidar_emulator::effects::LidarEffects;
+use hilsim_lidar_emulator::effects::{real_mount, LidarEffects};
 use hilsim_lidar_emulator::prediction::{
     BeamNodes, LidarPredictor, OdometerPredictor, SonarPredictor,
 };
 use hilsim_recording::{CommandSample, TruthSample};
-use hilsim_sim::scenario::{Effects, LidarTiming};
+use hilsim_sim::scenario::{self, Effects, LidarTiming};
 use hilsim_sim::{replay, Obstacle, Pose, Scenario, World};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -169,6 +169,19 @@ impl SimPhysics {
         }) as u32
     }
 
+    /// The lidar as the hypothesis has it mounted (`[effects.lidar_mount_offset]`: the
+    /// simulator's own [`real_mount`]).
+    fn lidar_config(&self, effects: &Effects) -> Option<scenario::Lidar> {
+        let mut config = self.scenario.sensors.lidar.clone()?;
+        let m = real_mount(config.mount.into(), effects.lidar_mount_offset);
+        config.mount = scenario::Mount {
+            x_m: m.x_m,
+            y_m: m.y_m,
+            yaw_deg: m.yaw_deg,
+        };
+        Some(config)
+    }
+
     /// The scenario's effects with the hypothesis's switched on over them.
     fn effects(&self, h: &Hypothesis) -> Effects {
         let mut e = self.scenario.effects.clone();
@@ -214,14 +227,15 @@ impl Physics for SimPhysics {
         queries: &[LidarQuery],
         hypothesis: &Hypothesis,
     ) -> Vec<LidarPrediction> {
-        let Some(config) = &self.scenario.sensors.lidar else {
+        let all_effects = self.effects(hypothesis);
+        let Some(config) = self.lidar_config(&all_effects) else {
             return queries.iter().map(|_| empty_lidar()).collect();
         };
-        let effects = LidarEffects::from_scenario(&self.effects(hypothesis));
+        let effects = LidarEffects::from_scenario(&all_effects);
         let (Ok(predictor), Ok(geometry)) = (
-            LidarPredictor::new(config, effects),
+            LidarPredictor::new(&config, effects),
             LidarPredictor::new(
-                config,
+                &config,
                 LidarEffects {
                     mixed_half_width_rad: None,
                     ..effects
@@ -237,11 +251,18 @@ impl Physics for SimPhysics {
         let cacheable = span > 2.0;
         let snapshot = self.declared.lidar.is_some_and(|l| l.snapshot);
         let skew = hypothesis.param_of(Effect::LidarMotionSkew, 0);
+        // `[effects.sensor_latency]`: each reading was taken this long before its stamp.
+        let latency_s = all_effects.sensor_latency.map_or(0.0, |l| l.lidar_s);
+        // The beams' caches hold the declared mount's rays at the stamps' poses.
+        let moved = latency_s != 0.0 || all_effects.lidar_mount_offset.is_some();
         // When each reading's geometry is taken.
-        let instant = |q: &LidarQuery| match (snapshot, skew) {
-            (true, Some(revolution_s)) => q.rev_start_s + q.angle_deg / 360.0 * revolution_s,
-            (true, None) => q.rev_start_s,
-            (false, _) => q.t_s,
+        let instant = |q: &LidarQuery| {
+            let stamped = match (snapshot, skew) {
+                (true, Some(revolution_s)) => q.rev_start_s + q.angle_deg / 360.0 * revolution_s,
+                (true, None) => q.rev_start_s,
+                (false, _) => q.t_s,
+            };
+            stamped - latency_s
         };
         queries
             .par_chunks(CHUNK)
@@ -249,7 +270,7 @@ impl Physics for SimPhysics {
                 chunk.iter().map(|q| {
                     let p = trajectory.pose_at(instant(q));
                     let robot = pose(p);
-                    let e = if skew.is_some() || !cacheable {
+                    let e = if skew.is_some() || moved || !cacheable {
                         // Another pose for every reading: nothing to reuse.
                         predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
                     } else {
@@ -298,10 +319,12 @@ impl Physics for SimPhysics {
             Effect::SonarBeamWidth.apply(&[30.0], &mut e);
             SonarPredictor::new(config, &e)
         });
+        // `[effects.sensor_latency]`: each ping was taken this long before its stamp.
+        let latency_s = effects.sensor_latency.map_or(0.0, |l| l.sonar_s);
         times
             .par_iter()
             .map(|&t| {
-                let robot = pose(trajectory.pose_at(t));
+                let robot = pose(trajectory.pose_at(t - latency_s));
                 let p = predictor.predict(&self.world, &robot);
                 SonarPrediction {
                     reading: p.map(|p| p.reading),
@@ -332,7 +355,19 @@ impl Physics for SimPhysics {
                 })
                 .collect();
         };
-        let predictor = OdometerPredictor::new(config, &self.effects(hypothesis));
+        let effects = self.effects(hypothesis);
+        let predictor = OdometerPredictor::new(config, &effects);
+        // `[effects.drive_wheel_base]`: the wheels' contact points are this far apart, so
+        // the body's turn comes from their travel over the effective base.
+        let wheel_base_m =
+            self.scenario.robot.wheel_base_m * effects.drive_wheel_base.map_or(1.0, |b| b.scale);
+        // `[effects.odometer_wheel_radius]`: the encoders count turns of the real radius and
+        // report them at the nominal one: the true travel over each wheel's scale.
+        let radius_scale = effects
+            .odometer_wheel_radius
+            .map_or([1.0; 2], |r| [r.left_scale, r.right_scale]);
+        // `[effects.sensor_latency]`: each reading was taken this long before its stamp.
+        let latency_s = effects.sensor_latency.map_or(0.0, |l| l.odometer_s);
         // The wheels' true travel along the trajectory, as the simulator defines it.
         let (ts, ps) = (trajectory.times(), trajectory.poses());
         let mut travel = Vec::with_capacity(ts.len());
@@ -343,12 +378,13 @@ impl Physics for SimPhysics {
                 prev,
                 &pose(ps[k - 1]),
                 &pose(ps[k]),
-                self.scenario.robot.wheel_base_m,
+                wheel_base_m,
             ));
         }
         times
             .iter()
             .map(|&t| {
+                let t = t - latency_s;
                 let at = trajectory.interpolate(&travel, t);
                 let k = trajectory.interval(t);
                 let speed = match ts.get(k + 1) {
@@ -357,8 +393,11 @@ impl Physics for SimPhysics {
                     }
                     _ => [0.0; 2],
                 };
+                // The slip acts on the ground's travel, before the encoders' scale (as in
+                // the emulator); the slip being linear in speed, dividing both is the same.
+                let scaled = [0, 1].map(|w| speed[w] / radius_scale[w]);
                 OdometryPrediction {
-                    wheels: [0, 1].map(|w| predictor.predict(at[w], speed[w])),
+                    wheels: [0, 1].map(|w| predictor.predict(at[w] / radius_scale[w], scaled[w])),
                     speed_mps: speed,
                 }
             })

@@ -31,6 +31,16 @@ pub enum Concealed {
     WheelSlip { gain_s: f64 },
     /// Each wheel's speed follows its command with a first-order lag.
     MotorLag { time_constant_s: f64 },
+    /// The lidar sits turned by `yaw_deg` (counter-clockwise) and moved `x_m` forward, `y_m`
+    /// left of where the scenario mounts it.
+    LidarMountOffset { yaw_deg: f64, x_m: f64, y_m: f64 },
+    /// One sensor's readings are stamped `delay_s` after they were taken.
+    SensorLatency { sensor: Stamped, delay_s: f64 },
+    /// Each wheel's radius over nominal: the ground moves `scale` times the commanded wheel
+    /// speed, the encoders report the ground's travel over `scale`.
+    WheelRadius { left_scale: f64, right_scale: f64 },
+    /// The wheels' effective contact points are `scale` times the nominal base apart.
+    WheelBase { scale: f64 },
     /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
     /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
     /// the sensor, which moves with 1/d; over a room's ranges it reads as a ripple in d).
@@ -51,9 +61,33 @@ impl Concealed {
             Self::SonarSpeedOfSound { .. } => "sonar_speed_of_sound",
             Self::WheelSlip { .. } => "odometer_wheel_slip",
             Self::MotorLag { .. } => "drive_motor_lag",
+            Self::LidarMountOffset { .. } => "lidar_mount_offset",
+            Self::SensorLatency { .. } => "sensor_latency",
+            Self::WheelRadius { .. } => "odometer_wheel_radius",
+            Self::WheelBase { .. } => "drive_wheel_base",
             Self::LidarPeriodicRange { .. } => "lidar_periodic_range",
         }
     }
+}
+
+/// A sensor whose driver stamps its readings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stamped {
+    Lidar,
+    Sonar,
+    Odometer,
+}
+
+/// How late `sensor`'s readings are stamped under `concealed`, seconds (0: on time).
+#[must_use]
+pub fn delay_s(concealed: &[Concealed], sensor: Stamped) -> f64 {
+    concealed
+        .iter()
+        .map(|c| match *c {
+            Concealed::SensorLatency { sensor: s, delay_s } if s == sensor => delay_s,
+            _ => 0.0,
+        })
+        .sum()
 }
 
 /// Speed of sound in air at `t_c` °C, m/s (ideal gas: `331.3 √(1 + T/273.15)`).

@@ -15,7 +15,7 @@ mod nuisance;
 mod sensors;
 mod world;
 
-pub use concealed::Concealed;
+pub use concealed::{Concealed, Stamped};
 pub use noise::Stream;
 pub use nuisance::Nuisances;
 
@@ -53,15 +53,33 @@ pub fn record(
         y: scenario.robot.start.y,
         yaw: scenario.robot.start.yaw_deg.to_radians(),
     };
+    let radius_scale = concealed
+        .iter()
+        .find_map(|c| match *c {
+            Concealed::WheelRadius {
+                left_scale,
+                right_scale,
+            } => Some([left_scale, right_scale]),
+            _ => None,
+        })
+        .unwrap_or([1.0; 2]);
+    let base_scale = concealed
+        .iter()
+        .find_map(|c| match *c {
+            Concealed::WheelBase { scale } => Some(scale),
+            _ => None,
+        })
+        .unwrap_or(1.0);
     let mut drive_noise = Stream::new(seed, "reality-drive");
     let motion = motion::integrate(
         &spans,
         start,
-        scenario.robot.wheel_base_m,
+        scenario.robot.wheel_base_m * base_scale,
         end_s,
         Drive {
             lag_s,
             speed_noise: nuisances.speed_noise,
+            radius_scale,
         },
         &mut drive_noise,
     );
@@ -72,6 +90,7 @@ pub fn record(
         end_s,
         concealed,
         nuisances,
+        radius_scale,
     };
     let s = &scenario.sensors;
     Recording {
@@ -166,6 +185,114 @@ noise_m = 0.002
         assert!((mean(&hot) - 2.0 * 0.9686).abs() < 0.004, "{}", mean(&hot));
         // The same seed, the same recording.
         assert_eq!(record(&s, &[], Nuisances::default(), 7), r);
+    }
+
+    #[test]
+    fn a_lidar_mounted_forward_reads_short_and_late_stamps_come_late() {
+        let s = facing_a_wall();
+        let ahead = |r: &Recording| {
+            mean(
+                &r.lidar
+                    .as_ref()
+                    .unwrap()
+                    .iter()
+                    .filter(|l| l.angle_deg == 0.0 && !l.invalid)
+                    .map(|l| l.range_m)
+                    .collect::<Vec<_>>(),
+            )
+        };
+        let moved = record(
+            &s,
+            &[Concealed::LidarMountOffset {
+                yaw_deg: 0.0,
+                x_m: 0.1,
+                y_m: 0.0,
+            }],
+            Nuisances::default(),
+            7,
+        );
+        // 10 cm nearer the wall; the same noise draws, so the difference is exact to rounding.
+        let nominal = record(&s, &[], Nuisances::default(), 7);
+        assert!((ahead(&nominal) - ahead(&moved) - 0.1).abs() < 0.001);
+        // A yaw of 30° turns bearing 0° onto the wall at 30°: 2 / cos 30° = 2.309 m.
+        let turned = record(
+            &s,
+            &[Concealed::LidarMountOffset {
+                yaw_deg: 30.0,
+                x_m: 0.0,
+                y_m: 0.0,
+            }],
+            Nuisances::default(),
+            7,
+        );
+        assert!((ahead(&turned) - 2.0 / 30f64.to_radians().cos()).abs() < 0.006);
+        let late = record(
+            &s,
+            &[Concealed::SensorLatency {
+                sensor: Stamped::Sonar,
+                delay_s: 0.05,
+            }],
+            Nuisances::default(),
+            7,
+        );
+        let (a, b) = (nominal.sonar.unwrap(), late.sonar.unwrap());
+        assert_eq!(a.len(), b.len());
+        for (a, b) in a.iter().zip(&b) {
+            assert!((b.t_s - a.t_s - 0.05).abs() < 1e-9);
+            assert_eq!(a.range_m, b.range_m);
+        }
+        // Only the sonar's stamps: the lidar's are the nominal ones.
+        assert_eq!(late.lidar, nominal.lidar);
+    }
+
+    #[test]
+    fn wider_wheels_move_the_robot_more_than_the_encoders_say_and_a_wider_base_turns_less() {
+        let s = Scenario::from_toml(
+            r#"name = "drive"
+[world]
+walls = [{ from = [5.0, -5.0], to = [5.0, 5.0] }]
+[robot]
+start = { x = 0.0, y = 0.0, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+turn_rate_deg_s = 45.0
+[[drive]]
+speed_mps = 0.2
+distance_m = 1.0
+[[drive]]
+turn_deg = 90.0
+[sensors.odometer]
+noise_m = 0.0
+"#,
+            std::path::Path::new("drive.toml"),
+        )
+        .unwrap();
+        let end = |r: &Recording| *r.truth.as_ref().unwrap().last().unwrap();
+        let odo = |r: &Recording| *r.odometry.as_ref().unwrap().last().unwrap();
+        let nominal = record(&s, &[], Nuisances::default(), 3);
+        let wide = record(
+            &s,
+            &[Concealed::WheelRadius {
+                left_scale: 1.05,
+                right_scale: 1.05,
+            }],
+            Nuisances::default(),
+            3,
+        );
+        // Both wheels 5 % larger: 5 % farther and a 5 % larger turn, the encoders unchanged
+        // (to their 1 mm ticks).
+        let (n, w) = (end(&nominal), end(&wide));
+        assert!((w.x_m.hypot(w.y_m) / n.x_m.hypot(n.y_m) - 1.05).abs() < 0.01);
+        assert!((w.yaw_rad / n.yaw_rad - 1.05).abs() < 0.001);
+        assert!((odo(&wide).left_m - odo(&nominal).left_m).abs() <= 0.0011);
+        let base = record(
+            &s,
+            &[Concealed::WheelBase { scale: 1.1 }],
+            Nuisances::default(),
+            3,
+        );
+        // The turn comes out 1/1.1 as large; the straight run and the encoders are the same.
+        assert!((end(&base).yaw_rad / n.yaw_rad - 1.0 / 1.1).abs() < 0.001);
+        assert!((odo(&base).right_m - odo(&nominal).right_m).abs() <= 0.0011);
     }
 
     #[test]

@@ -101,12 +101,25 @@ pub struct Motion {
 }
 
 /// How the wheels follow their commands.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Drive {
     /// First-order lag of each wheel's speed, seconds (`None`: at once).
     pub lag_s: Option<f64>,
     /// Relative standard deviation of white noise on each wheel's speed, held 10 ms.
     pub speed_noise: f64,
+    /// Each wheel's radius over nominal: the motor turns it at the command over the nominal
+    /// radius, so the ground moves this many times the command.
+    pub radius_scale: [f64; 2],
+}
+
+impl Default for Drive {
+    fn default() -> Self {
+        Self {
+            lag_s: None,
+            speed_noise: 0.0,
+            radius_scale: [1.0; 2],
+        }
+    }
 }
 
 /// Integrates the commands of `spans` from `start` to `end_s`.
@@ -142,7 +155,7 @@ pub fn integrate(
             ];
         }
         for w in 0..2 {
-            let target = u[w] * (1.0 + jitter[w]);
+            let target = u[w] * drive.radius_scale[w] * (1.0 + jitter[w]);
             v[w] = match drive.lag_s {
                 // τ v̇ + v = u, exactly over one step.
                 Some(tau) => target + (v[w] - target) * (-STEP_S / tau).exp(),

@@ -5,7 +5,7 @@
 use hilsim_recording::{LidarSample, OdometrySample, Pose, SonarSample, TruthSample};
 use hilsim_sim::scenario::{LidarTiming, Scenario};
 
-use crate::concealed::{speed_of_sound, Concealed};
+use crate::concealed::{delay_s, speed_of_sound, Concealed, Stamped};
 use crate::motion::Motion;
 use crate::noise::Stream;
 use crate::nuisance::Nuisances;
@@ -49,6 +49,8 @@ pub struct Run<'a> {
     pub end_s: f64,
     pub concealed: &'a [Concealed],
     pub nuisances: Nuisances,
+    /// Each wheel's radius over nominal (the encoders report the ground's travel over it).
+    pub radius_scale: [f64; 2],
 }
 
 impl Run<'_> {
@@ -76,6 +78,16 @@ impl Run<'_> {
         let snapshot = cfg.timing == LidarTiming::PerRevolution
             && !self.has(|c| matches!(c, Concealed::LidarMotionSkew));
         let max_range = cfg.max_range_m * n.max_range_factor;
+        // Where the unit really sits: the scenario's mount moved in the robot's frame.
+        let (dx, dy, dyaw) = self
+            .concealed
+            .iter()
+            .find_map(|c| match *c {
+                Concealed::LidarMountOffset { yaw_deg, x_m, y_m } => Some((x_m, y_m, yaw_deg)),
+                _ => None,
+            })
+            .unwrap_or((0.0, 0.0, 0.0));
+        let late_s = delay_s(self.concealed, Stamped::Lidar);
         let mut out = Vec::new();
         let revolutions = (self.end_s / period).floor() as u64;
         for rev in 0..revolutions {
@@ -96,9 +108,9 @@ impl Run<'_> {
                 };
                 let (origin, heading) = at_mount(
                     self.motion.pose(t_geometry),
-                    cfg.mount.x_m,
-                    cfg.mount.y_m,
-                    cfg.mount.yaw_deg,
+                    cfg.mount.x_m + dx,
+                    cfg.mount.y_m + dy,
+                    cfg.mount.yaw_deg + dyaw,
                 );
                 let direction = heading
                     + f64::from(i).to_radians()
@@ -125,7 +137,7 @@ impl Run<'_> {
                 let valid = range > 0.0 && valid_by >= cfg.min_range_m && valid_by <= max_range;
                 let strength = (strength * n.intensity_scale).clamp(0.0, f64::from(u16::MAX));
                 out.push(LidarSample {
-                    t_s: (t + jitter).max(0.0),
+                    t_s: (t + late_s + jitter).max(0.0),
                     rev,
                     angle_deg: f64::from(i),
                     range_m: if valid { range } else { 0.0 },
@@ -226,6 +238,7 @@ impl Run<'_> {
             })
             .unwrap_or(1.0);
         let rate = cfg.rate_hz * n.rate_factor;
+        let late_s = delay_s(self.concealed, Stamped::Sonar);
         let mut out = Vec::new();
         let mut k = 0u64;
         loop {
@@ -262,7 +275,7 @@ impl Run<'_> {
             // the true echo travels at the air's: the range reads c_cal / c_air too short or long.
             let reading = (poly(&cfg.bias, nearest) + poly(&cfg.noise, nearest) * e) / scale;
             out.push(SonarSample {
-                t_s: (t + jitter).max(0.0),
+                t_s: (t + late_s + jitter).max(0.0),
                 range_m: quantise(reading, n.sonar_resolution_m),
                 true_range_m: None,
             });
@@ -286,6 +299,7 @@ impl Run<'_> {
             .unwrap_or(0.0);
         let rate = cfg.rate_hz * n.rate_factor;
         let rho = n.encoder_correlation;
+        let late_s = delay_s(self.concealed, Stamped::Odometer);
         let mut out = Vec::new();
         let mut k = 0u64;
         loop {
@@ -300,11 +314,13 @@ impl Run<'_> {
             let e = [a, rho * a + (1.0 - rho * rho).sqrt() * b];
             let jitter = n.timestamp_jitter_s * noise.normal();
             let wheel = |w: usize| {
-                let v = travel[w] * (1.0 + cfg.slip) + gain * speed[w] + cfg.noise_m * e[w];
+                // The encoders count the wheel's turns and report them at the nominal radius.
+                let ground = (travel[w] + gain * speed[w]) / self.radius_scale[w];
+                let v = ground * (1.0 + cfg.slip) + cfg.noise_m * e[w];
                 quantise(v, cfg.tick_m)
             };
             out.push(OdometrySample {
-                t_s: (t + jitter).max(0.0),
+                t_s: (t + late_s + jitter).max(0.0),
                 left_m: wheel(0),
                 right_m: wheel(1),
             });

@@ -138,10 +138,10 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             None => None,
             Some("none") => Some(0),
             Some(name) if name == self_test::OUTSIDE && reality == Reality::Independent => {
-                Some(1 + Effect::ALL.len())
+                Some(1 + Effect::entries().len())
             }
-            Some(name) => match Effect::from_name(name) {
-                Some(e) => Some(1 + Effect::ALL.iter().position(|x| *x == e).unwrap_or(0)),
+            Some(name) => match Effect::entries().iter().position(|x| *x == name) {
+                Some(k) => Some(1 + k),
                 None => bail!("--only: expected `none` or a catalogued effect, found `{name}`"),
             },
         };

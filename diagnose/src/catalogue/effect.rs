@@ -27,11 +27,22 @@ pub enum Effect {
     OdometerWheelSlip,
     /// `drive_motor_lag`.
     DriveMotorLag,
+    /// `lidar_mount_offset`.
+    LidarMountOffset,
+    /// `sensor_latency` of one sensor (the lidar, the sonar or the odometer): one catalogue
+    /// entry, fitted in each sensor where a mismatch is located and reporting that sensor's
+    /// delay only, since each sensor's driver stamps its own readings.
+    SensorLatency(Sensor),
+    /// `odometer_wheel_radius`.
+    OdometerWheelRadius,
+    /// `drive_wheel_base`.
+    DriveWheelBase,
 }
 
 impl Effect {
-    /// The whole catalogue, in `interfaces.md` order.
-    pub const ALL: [Effect; 9] = [
+    /// The whole catalogue, in `interfaces.md` order (`sensor_latency` once per sensor it
+    /// concerns).
+    pub const ALL: [Effect; 15] = [
         Effect::LidarIncidenceAngle,
         Effect::LidarReflectivity,
         Effect::LidarMixedPixels,
@@ -41,14 +52,49 @@ impl Effect {
         Effect::SonarSpeedOfSound,
         Effect::OdometerWheelSlip,
         Effect::DriveMotorLag,
+        Effect::LidarMountOffset,
+        Effect::SensorLatency(Sensor::Lidar),
+        Effect::SensorLatency(Sensor::Sonar),
+        Effect::SensorLatency(Sensor::Odometer),
+        Effect::OdometerWheelRadius,
+        Effect::DriveWheelBase,
     ];
+
+    /// The catalogue's entries (its names, each once), in `interfaces.md` order.
+    ///
+    /// ```
+    /// use hilsim_diagnose::Effect;
+    /// assert_eq!(Effect::entries().len(), 13);
+    /// assert_eq!(Effect::entries()[10], "sensor_latency");
+    /// ```
+    #[must_use]
+    pub fn entries() -> Vec<&'static str> {
+        let mut names: Vec<&'static str> = Vec::new();
+        for e in Self::ALL {
+            if !names.contains(&e.name()) {
+                names.push(e.name());
+            }
+        }
+        names
+    }
+
+    /// The name with the sensor where one entry is fitted in several (`sensor_latency
+    /// (lidar)`), for reports that list the effects one by one.
+    #[must_use]
+    pub fn label(self) -> String {
+        match self {
+            Effect::SensorLatency(s) => format!("{} ({s})", self.name()),
+            _ => self.name().to_string(),
+        }
+    }
 
     /// The catalogue name.
     ///
     /// ```
     /// use hilsim_diagnose::Effect;
     /// for e in Effect::ALL {
-    ///     assert_eq!(Effect::from_name(e.name()), Some(e));
+    ///     assert!(Effect::named(e.name()).contains(&e));
+    ///     assert_eq!(Effect::from_name(e.name()).map(Effect::name), Some(e.name()));
     /// }
     /// ```
     #[must_use]
@@ -63,19 +109,45 @@ impl Effect {
             Effect::SonarSpeedOfSound => "sonar_speed_of_sound",
             Effect::OdometerWheelSlip => "odometer_wheel_slip",
             Effect::DriveMotorLag => "drive_motor_lag",
+            Effect::LidarMountOffset => "lidar_mount_offset",
+            Effect::SensorLatency(_) => "sensor_latency",
+            Effect::OdometerWheelRadius => "odometer_wheel_radius",
+            Effect::DriveWheelBase => "drive_wheel_base",
         }
     }
 
-    /// The effect of a catalogue name.
+    /// The effect of a catalogue name (`sensor_latency`: the lidar's; see [`Effect::named`]).
     #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|e| e.name() == name)
     }
 
-    /// The sensor it shows in.
+    /// Every effect of a catalogue name (`sensor_latency`: one per sensor).
+    #[must_use]
+    pub fn named(name: &str) -> Vec<Self> {
+        Self::ALL.into_iter().filter(|e| e.name() == name).collect()
+    }
+
+    /// The sensor it is fitted and named in.
+    ///
+    /// Where an effect shows in two, the one whose data tell it apart from its neighbours:
+    /// - `odometer_wheel_radius` moves the robot `scale` times the command (the drive) and
+    ///   makes the encoders disagree with the world (the odometer). It is the odometer's: the
+    ///   encoders' disagreement is per wheel and everywhere (straight runs and turns), a
+    ///   millimetre sensor against the truth, while in the drive an equal scale on both
+    ///   wheels is what the declared actuation scale error already allows.
+    /// - `drive_wheel_base` turns the robot `1/scale` times the command (the drive) while the
+    ///   encoders agree with the command, so they disagree with the world's turn (the
+    ///   odometer). It is the odometer's too: fitted beside the wheel radius on the same
+    ///   data, the forward selection tells the two apart (the radius moves straight travel
+    ///   as well, the base only turns) instead of each being named in its own sensor for
+    ///   the other's mismatch. See [`Effect::shows_in`] for the drive.
     #[must_use]
     pub fn sensor(self) -> Sensor {
         match self {
+            Effect::LidarMountOffset => Sensor::Lidar,
+            Effect::SensorLatency(s) => s,
+            Effect::OdometerWheelRadius | Effect::DriveWheelBase => Sensor::Odometer,
             Effect::LidarIncidenceAngle
             | Effect::LidarReflectivity
             | Effect::LidarMixedPixels
@@ -87,6 +159,22 @@ impl Effect {
         }
     }
 
+    /// Whether it changes what `sensor` reads (or where the drive goes): its own sensor and,
+    /// for the wheels' radius and base, the drive too. The drive's data are diagnosed on top
+    /// of the effects named elsewhere that show in it, so that their mismatch there is
+    /// theirs, not another effect's.
+    #[must_use]
+    pub fn shows_in(self, sensor: Sensor) -> bool {
+        self.sensor() == sensor
+            || matches!(
+                (self, sensor),
+                (
+                    Effect::OdometerWheelRadius | Effect::DriveWheelBase,
+                    Sensor::Drive
+                )
+            )
+    }
+
     /// Its parameters, in the order a [`super::Hypothesis`] holds them.
     ///
     /// The fit's ranges are wide enough for any plausible unit (several times the self-test's
@@ -96,7 +184,9 @@ impl Effect {
     /// (at most 5°); motion skew the head's own period; warm-up k ±[0.004, 0.01] /m with τ in
     /// [5, 20] s (unscaled); sonar cone [8, 20]° (at most 60°); air temperature 20 °C ±
     /// [15, 30] °C (within [−50, 60] °C, scored as the departure from 20 °C); slip gain
-    /// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s (at most 10 s).
+    /// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
+    /// position ±[0.01, 0.03] m; latency [0.02, 0.08] s; each wheel's radius scale 1 ±
+    /// [0.01, 0.03]; wheel-base scale 1 ± [0.03, 0.1].
     #[must_use]
     pub const fn params(self) -> &'static [ParamSpec] {
         use super::params::SelfTestRange as R;
@@ -158,7 +248,12 @@ impl Effect {
             23,
             R::uniform(15.0, 30.0).signed().around(20.0, -50.0, 60.0),
         )];
-        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (-0.5, 0.5), 11, R::uniform(0.03, 0.1))];
+        // Slip's gain is searched at g ≥ 0 only (the same 0.1 s grid as before on that side):
+        // a driven wheel's surface outruns the ground as it accelerates (the traction force
+        // needs a positive slip ratio: Wong, *Theory of Ground Vehicles*, ch. 1), so the
+        // encoders lead. Encoders that lag the travel by `L v` are a late stamp, the
+        // odometer's `sensor_latency`, which is otherwise a slip with g = −L.
+        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1))];
         const LAG: [ParamSpec; 1] = [log(
             "time_constant_s",
             "s",
@@ -166,7 +261,68 @@ impl Effect {
             13,
             R::uniform(0.1, 0.4).at_most(10.0),
         )];
+        // The mount's yaw is searched over ±8° (a unit bolted visibly crooked is past it) on
+        // a 2° grid: a wall seen 2° off moves by 3.5 % of its range, which the likelihood
+        // follows smoothly; its position over ±0.1 m on a coarse grid, Nelder–Mead refining
+        // all three.
+        const MOUNT: [ParamSpec; 3] = [
+            lin(
+                "yaw_deg",
+                "deg",
+                (-8.0, 8.0),
+                9,
+                R::uniform(1.0, 3.0).signed(),
+            ),
+            lin("x_m", "m", (-0.1, 0.1), 3, R::uniform(0.01, 0.03).signed()),
+            lin("y_m", "m", (-0.1, 0.1), 3, R::uniform(0.01, 0.03).signed()),
+        ];
+        // A delay of up to 0.3 s (a driver buffering a whole revolution of a 5 Hz lidar is
+        // 0.2 s) on a 0.02 s grid.
+        const LIDAR_LATENCY: [ParamSpec; 1] =
+            [lin("lidar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08))];
+        const SONAR_LATENCY: [ParamSpec; 1] =
+            [lin("sonar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08))];
+        const ODOMETER_LATENCY: [ParamSpec; 1] = [lin(
+            "odometer_s",
+            "s",
+            (0.0, 0.3),
+            16,
+            R::uniform(0.02, 0.08),
+        )];
+        // Radius and base scales within ±20 % / ±30 % of nominal (a worn or soft tyre is a
+        // few per cent; the scenario allows ±50 %).
+        const RADIUS: [ParamSpec; 2] = [
+            lin(
+                "left_scale",
+                "",
+                (0.8, 1.2),
+                9,
+                R::uniform(0.01, 0.03).signed().around(1.0, 0.5, 1.5),
+            ),
+            lin(
+                "right_scale",
+                "",
+                (0.8, 1.2),
+                9,
+                R::uniform(0.01, 0.03).signed().around(1.0, 0.5, 1.5),
+            ),
+        ];
+        const BASE: [ParamSpec; 1] = [lin(
+            "scale",
+            "",
+            (0.7, 1.3),
+            13,
+            R::uniform(0.03, 0.1).signed().around(1.0, 0.5, 1.5),
+        )];
         match self {
+            Effect::LidarMountOffset => &MOUNT,
+            Effect::SensorLatency(Sensor::Lidar) => &LIDAR_LATENCY,
+            Effect::SensorLatency(Sensor::Sonar) => &SONAR_LATENCY,
+            Effect::SensorLatency(Sensor::Odometer) => &ODOMETER_LATENCY,
+            // The drive's commands are stamped when issued: no latency of its own.
+            Effect::SensorLatency(Sensor::Drive) => &[],
+            Effect::OdometerWheelRadius => &RADIUS,
+            Effect::DriveWheelBase => &BASE,
             Effect::LidarIncidenceAngle => &INCIDENCE,
             Effect::LidarReflectivity => &REFLECTIVITY,
             Effect::LidarMixedPixels => &MIXED,
@@ -189,6 +345,9 @@ impl Effect {
             Effect::LidarWarmupDrift => vec![0.0, 10.0],
             Effect::SonarBeamWidth => vec![declared_half_angle_deg],
             Effect::SonarSpeedOfSound => vec![20.0],
+            Effect::LidarMountOffset => vec![0.0; 3],
+            Effect::OdometerWheelRadius => vec![1.0, 1.0],
+            Effect::DriveWheelBase => vec![1.0],
             _ => vec![0.0],
         }
     }
@@ -205,13 +364,33 @@ impl Effect {
     /// - sonar cone: 1°, four of the emulator's 0.25° rays;
     /// - speed of sound: 0.6 °C, 0.1 % of range (1 mm at 1 m);
     /// - wheel slip g: 0.005 s, 1 mm of travel at 0.2 m/s;
-    /// - motor lag τ: 0.02 s, two physics steps (the drive's resolution is 0.01 s).
+    /// - motor lag τ: 0.02 s, two physics steps (the drive's resolution is 0.01 s);
+    /// - mount yaw: 0.05°, 1.7 mm at 2 m; its position 2 mm, the lidar's rounding twice;
+    /// - latency: 5 ms, 1.5 mm of motion at 0.3 m/s;
+    /// - wheel radius: a scale of 0.0005, 1 mm in 2 m of travel; wheel base likewise 0.0005.
+    ///
+    /// An effect of several parameters that all describe its size (the mount, the two
+    /// wheels) departs when any of them does.
     #[must_use]
     pub fn departs(self, params: &[f64], declared_half_angle_deg: f64) -> bool {
         let Some(&value) = params.first() else {
             return false;
         };
-        let absent = self.absent(declared_half_angle_deg)[0];
+        let absent = self.absent(declared_half_angle_deg);
+        let beyond = |i: usize, least: f64| {
+            params
+                .get(i)
+                .zip(absent.get(i))
+                .is_some_and(|(v, a)| (v - a).abs() >= least)
+        };
+        match self {
+            Effect::LidarMountOffset => {
+                return beyond(0, 0.05) || beyond(1, 0.002) || beyond(2, 0.002);
+            }
+            Effect::OdometerWheelRadius => return beyond(0, 0.000_5) || beyond(1, 0.000_5),
+            _ => {}
+        }
+        let absent = absent[0];
         let least = match self {
             Effect::LidarIncidenceAngle => 0.001,
             Effect::LidarReflectivity => 0.001,
@@ -222,6 +401,10 @@ impl Effect {
             Effect::SonarSpeedOfSound => 0.6,
             Effect::OdometerWheelSlip => 0.005,
             Effect::DriveMotorLag => 0.02,
+            Effect::SensorLatency(_) => 0.005,
+            Effect::DriveWheelBase => 0.000_5,
+            // Returned above.
+            Effect::LidarMountOffset | Effect::OdometerWheelRadius => 0.0,
         };
         (value - absent).abs() >= least
     }
@@ -252,5 +435,27 @@ mod tests {
         for e in Effect::ALL {
             assert!(!e.departs(&e.absent(10.0), 10.0), "{e:?}");
         }
+        // Either wheel, any part of the mount.
+        assert!(Effect::OdometerWheelRadius.departs(&[1.0, 1.02], 0.0));
+        assert!(!Effect::OdometerWheelRadius.departs(&[1.0001, 0.9999], 0.0));
+        assert!(Effect::LidarMountOffset.departs(&[0.0, 0.0, 0.01], 0.0));
+        assert!(!Effect::LidarMountOffset.departs(&[0.01, 0.001, 0.0], 0.0));
+    }
+
+    #[test]
+    fn latency_is_one_entry_fitted_per_sensor() {
+        use super::Sensor;
+        let all = Effect::named("sensor_latency");
+        assert_eq!(all.len(), 3);
+        for (e, s) in all
+            .iter()
+            .zip([Sensor::Lidar, Sensor::Sonar, Sensor::Odometer])
+        {
+            assert_eq!(e.sensor(), s);
+            assert_eq!(e.params().len(), 1);
+            assert_eq!(e.params()[0].name, format!("{}_s", s.name()));
+        }
+        assert!(Effect::DriveWheelBase.shows_in(Sensor::Drive));
+        assert!(!Effect::OdometerWheelSlip.shows_in(Sensor::Drive));
     }
 }

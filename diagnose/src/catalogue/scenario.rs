@@ -3,7 +3,7 @@
 
 use hilsim_sim::scenario::{self, Effects};
 
-use super::Effect;
+use super::{Effect, Sensor};
 
 /// The reference reflectivity of `[effects.lidar_reflectivity]` (the catalogue's coefficient is
 /// the range walk on a surface of half of it).
@@ -16,6 +16,8 @@ impl Effect {
     /// missing one is 0), replacing its table if the scenario already has one. A parameter at
     /// which the scenario's table cannot exist (a mixed-pixel footprint or a motor lag of 0)
     /// leaves the effect off.
+    ///
+    /// `sensor_latency` sets its sensor's delay only, keeping the others' in the table.
     ///
     /// Motion skew's table has no parameter: the revolution's duration is the lidar's `rpm` in
     /// a scenario, and the diagnosis's physics fits it as the timing of each reading
@@ -71,6 +73,37 @@ impl Effect {
             Effect::DriveMotorLag => {
                 e.drive_motor_lag = (p(0) > 0.0).then_some(scenario::DriveMotorLag {
                     time_constant_s: p(0),
+                });
+            }
+            Effect::LidarMountOffset => {
+                e.lidar_mount_offset = Some(scenario::LidarMountOffset {
+                    yaw_deg: p(0),
+                    x_m: p(1),
+                    y_m: p(2),
+                });
+            }
+            Effect::SensorLatency(sensor) => {
+                // A delay is never negative: the fit's range starts at 0.
+                let delay = p(0).max(0.0);
+                let mut l = e.sensor_latency.unwrap_or_default();
+                match sensor {
+                    Sensor::Lidar => l.lidar_s = delay,
+                    Sensor::Sonar => l.sonar_s = delay,
+                    Sensor::Odometer => l.odometer_s = delay,
+                    Sensor::Drive => {}
+                }
+                e.sensor_latency = Some(l);
+            }
+            Effect::OdometerWheelRadius => {
+                let scale = |i: usize| params.get(i).copied().unwrap_or(1.0);
+                e.odometer_wheel_radius = Some(scenario::OdometerWheelRadius {
+                    left_scale: scale(0),
+                    right_scale: scale(1),
+                });
+            }
+            Effect::DriveWheelBase => {
+                e.drive_wheel_base = Some(scenario::DriveWheelBase {
+                    scale: params.first().copied().unwrap_or(1.0),
                 });
             }
         }

@@ -60,6 +60,31 @@ impl Effect {
                  with a first-order lag of {:.2} s.",
                 p(0)
             ),
+            Effect::LidarMountOffset => format!(
+                "The simulated lidar sits where the scenario says; the real one is turned \
+                 {:+.2}° and moved {:+.1} mm forward, {:+.1} mm left of that.",
+                p(0),
+                p(1) * 1000.0,
+                p(2) * 1000.0
+            ),
+            Effect::SensorLatency(sensor) => format!(
+                "The simulated {sensor} is stamped when it measures; the real one's timestamps \
+                 come {:.0} ms later.",
+                p(0) * 1000.0
+            ),
+            Effect::OdometerWheelRadius => format!(
+                "The simulated wheels have their nominal radius; the real left one is {:.1} % \
+                 and the right one {:.1} % of it, so the robot moves that much of its command \
+                 while the encoders report the command.",
+                p(0) * 100.0,
+                p(1) * 100.0
+            ),
+            Effect::DriveWheelBase => format!(
+                "The simulated wheels turn the robot about the nominal wheel base; the real \
+                 effective base is {:.1} % of it, so every turn comes out {:.1} % as large.",
+                p(0) * 100.0,
+                100.0 / p(0)
+            ),
         }
     }
 }

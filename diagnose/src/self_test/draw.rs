@@ -7,7 +7,7 @@ use rand_xoshiro::SplitMix64;
 
 use hilsim_reality::{Concealed, Nuisances, Stream};
 
-use crate::catalogue::{DrawSource, SelfTestRange, REFERENCE_REFLECTIVITY};
+use crate::catalogue::{DrawSource, SelfTestRange, Sensor, REFERENCE_REFLECTIVITY};
 use crate::Effect;
 
 /// The trial's draws, from (S, i) alone: SplitMix64 started from a mix of the two.
@@ -118,29 +118,72 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
         Effect::DriveMotorLag => Concealed::MotorLag {
             time_constant_s: p(0),
         },
+        Effect::LidarMountOffset => Concealed::LidarMountOffset {
+            yaw_deg: p(0),
+            x_m: p(1),
+            y_m: p(2),
+        },
+        Effect::SensorLatency(sensor) => Concealed::SensorLatency {
+            sensor: match sensor {
+                Sensor::Lidar => hilsim_reality::Stamped::Lidar,
+                Sensor::Sonar => hilsim_reality::Stamped::Sonar,
+                Sensor::Odometer | Sensor::Drive => hilsim_reality::Stamped::Odometer,
+            },
+            delay_s: p(0),
+        },
+        Effect::OdometerWheelRadius => Concealed::WheelRadius {
+            left_scale: p(0),
+            right_scale: p(1),
+        },
+        Effect::DriveWheelBase => Concealed::WheelBase { scale: p(0) },
     }
 }
 
+/// The effect of catalogue entry `k` (0-based, [`Effect::entries`] order): `sensor_latency`
+/// on one of the sensors the scenario has, drawn uniformly (a draw is taken only then).
+fn entry_effect(k: usize, d: &mut Draws, nominal: &Scenario) -> Option<Effect> {
+    let name = *Effect::entries().get(k)?;
+    let s = &nominal.sensors;
+    let has = |e: &Effect| match e.sensor() {
+        Sensor::Lidar => s.lidar.is_some(),
+        Sensor::Sonar => s.sonar.is_some(),
+        Sensor::Odometer => s.odometer.is_some(),
+        Sensor::Drive => true,
+    };
+    let mut effects = Effect::named(name);
+    if effects.len() > 1 {
+        effects.retain(has);
+        let i = (d.unit() * effects.len() as f64).floor() as usize;
+        return effects.get(i.min(effects.len().saturating_sub(1))).copied();
+    }
+    effects.first().copied()
+}
+
 /// Trial `i`'s concealment in the independent reality: with probability 1/5 two different
-/// catalogued effects, else one of eleven classes (none, the nine effects, a periodic range
-/// error outside the catalogue: amplitude ±[1, 4] cm × strength, period [0.3, 1] m), or the
-/// `only` one (0 none, 1..=9 the catalogue, 10 outside); and the run's nuisances.
+/// catalogued entries, else one of fifteen classes (none, the thirteen entries, a periodic
+/// range error outside the catalogue: amplitude ±[1, 4] cm × strength, period [0.3, 1] m), or
+/// the `only` one (0 none, 1..=13 the catalogue's entries, 14 outside); and the run's
+/// nuisances.
 pub(crate) fn draw_independent(
     d: &mut Draws,
     strength: f64,
     nominal: &Scenario,
     only: Option<usize>,
 ) -> (Drawn, Nuisances) {
+    let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
-    let class = only.unwrap_or_else(|| (d.unit() * 11.0).floor() as usize);
+    let class = only.unwrap_or_else(|| (d.unit() * (entries + 2) as f64).floor() as usize);
     let mut effects: Vec<Effect> = Vec::new();
     if two {
-        let a = (d.unit() * 9.0).floor() as usize;
-        let b = (a + 1 + (d.unit() * 8.0).floor() as usize) % 9;
-        effects.push(Effect::ALL[a.min(8)]);
-        effects.push(Effect::ALL[b.min(8)]);
-    } else if let Some(e) = class.checked_sub(1).and_then(|k| Effect::ALL.get(k)) {
-        effects.push(*e);
+        let a = ((d.unit() * entries as f64).floor() as usize).min(entries - 1);
+        let b = (a + 1 + (d.unit() * (entries - 1) as f64).floor() as usize) % entries;
+        effects.extend(entry_effect(a, d, nominal));
+        effects.extend(entry_effect(b, d, nominal));
+    } else if let Some(e) = class
+        .checked_sub(1)
+        .and_then(|k| entry_effect(k, d, nominal))
+    {
+        effects.push(e);
     }
     let mut drawn = Drawn {
         effect: None,
@@ -148,7 +191,7 @@ pub(crate) fn draw_independent(
         truth: None,
         params: Vec::new(),
         second: None,
-        outside: !two && class == 10,
+        outside: !two && class == entries + 1,
         concealed: Vec::new(),
     };
     for (k, e) in effects.iter().enumerate() {
@@ -187,14 +230,15 @@ pub(crate) fn draw_independent(
     (drawn, Nuisances::draw(&mut nuisance_draws))
 }
 
-/// Draws trial `i`'s effect: none, or one of the catalogue (each with probability 1/10, or the
-/// `only` one: 0 none, 1..=9 the catalogue in order), and its parameters from their
-/// [`SelfTestRange`]s (the documented moderate ranges × `strength`; [`Effect::params`]).
+/// Draws trial `i`'s effect: none, or one of the catalogue's entries (each with probability
+/// 1/14, or the `only` one: 0 none, 1..=13 the entries in order; `sensor_latency` on a sensor
+/// drawn among the scenario's), and its parameters from their [`SelfTestRange`]s (the
+/// documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {
-    let drawn_class = (d.unit() * 10.0).floor() as usize;
+    let drawn_class = (d.unit() * (Effect::entries().len() + 1) as f64).floor() as usize;
     let k = only.unwrap_or(drawn_class);
     let mut effects = nominal.effects.clone();
-    let effect = k.checked_sub(1).and_then(|i| Effect::ALL.get(i).copied());
+    let effect = k.checked_sub(1).and_then(|i| entry_effect(i, d, nominal));
     let Some(effect) = effect else {
         return Drawn {
             effect: None,

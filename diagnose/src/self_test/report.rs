@@ -257,8 +257,8 @@ impl SelfTest {
             let m = median(&mut errs);
             writeln!(
                 out,
-                "  {:<22} median {:>7}, worst {:>7} over {}",
-                e.name(),
+                "  {:<26} median {:>7}, worst {:>7} over {}",
+                e.label(),
                 pct(m),
                 pct(worst),
                 errs.len()

@@ -83,11 +83,11 @@ impl Score {
         // Confusion matrix of the trials with one concealed class: rows the truth, columns the
         // verdict.
         let classes: Vec<&'static str> = std::iter::once("none")
-            .chain(Effect::ALL.iter().map(|e| e.name()))
+            .chain(Effect::entries())
             .chain((reality == Reality::Independent).then_some(OUTSIDE))
             .collect();
         let columns: Vec<&'static str> = std::iter::once("none")
-            .chain(Effect::ALL.iter().map(|e| e.name()))
+            .chain(Effect::entries())
             .chain(["unexplained", "refused"])
             .collect();
         let mut matrix = vec![vec![0usize; columns.len()]; classes.len()];

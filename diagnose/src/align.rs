@@ -5,8 +5,9 @@
 
 use hilsim_recording::Recording;
 
+use crate::catalogue::Sensor;
 use crate::error::MismatchError;
-use crate::estimate::estimate_trajectory;
+use crate::estimate::{estimate_trajectory, DeadReckoning};
 use crate::physics::{Hypothesis, Physics};
 use crate::trajectory::{wrap, Trajectory};
 
@@ -52,6 +53,10 @@ pub(crate) struct Aligned {
     pub position_sd_m: f64,
     /// The standard deviation of its headings, radians (0 for `truth.csv`).
     pub yaw_sd_rad: f64,
+    /// What an estimate followed between the lidar's corrections (`None` for `truth.csv`).
+    pub reckoned: Option<DeadReckoning>,
+    /// The drive effects an estimate's commands were replayed under (nominal at first).
+    pub replayed: Hypothesis,
     /// What the user should know (sensors missing on one side).
     pub notes: Vec<String>,
 }
@@ -102,12 +107,13 @@ pub(crate) fn align(
                 .into(),
         ));
     }
-    let (trajectory, alignment, position_sd_m, yaw_sd_rad) = match &recording.truth {
+    let (trajectory, alignment, position_sd_m, yaw_sd_rad, reckoned) = match &recording.truth {
         Some(truth) if !truth.is_empty() => (
             Trajectory::new(truth)?,
             Alignment::Truth,
             TRUTH_POSITION_SD_M,
             0.0,
+            None,
         ),
         _ => {
             if declared.lidar.is_none() || recording.lidar.is_none() {
@@ -117,18 +123,29 @@ pub(crate) fn align(
                         .into(),
                 ));
             }
-            let (trajectory, sd) =
-                estimate_trajectory(physics, recording, end_s, &Hypothesis::nominal())?;
+            let (trajectory, sd, reckoned) = estimate_trajectory(
+                physics,
+                recording,
+                end_s,
+                &Hypothesis::nominal(),
+                DeadReckoning::Commands,
+            )?;
             notes.push(format!(
                 "no truth.csv: the trajectory is estimated by matching the lidar to the \
-                 scenario's world (position s.d. {:.1} mm, heading {:.2} mrad), so only the \
-                 lidar and the sonar are diagnosed, with that uncertainty in their noise and no \
-                 whiteness test (the estimate's errors are shared by a revolution's readings); \
-                 an effect that shifts every range alike is partly absorbed into the estimate",
+                 scenario's world (position s.d. {:.1} mm, heading {:.2} mrad); every sensor is \
+                 judged against it with that uncertainty in its noise and no whiteness test \
+                 (the estimate's errors are shared by neighbouring readings), and an effect \
+                 that shifts every range alike is partly absorbed into it",
                 sd.position_m * 1000.0,
                 sd.yaw_rad * 1000.0
             ));
-            (trajectory, Alignment::Estimated, sd.position_m, sd.yaw_rad)
+            (
+                trajectory,
+                Alignment::Estimated,
+                sd.position_m,
+                sd.yaw_rad,
+                Some(reckoned),
+            )
         }
     };
     let start = trajectory.pose_at(0.0);
@@ -153,14 +170,18 @@ pub(crate) fn align(
         end_s,
         position_sd_m,
         yaw_sd_rad,
+        reckoned,
+        replayed: Hypothesis::nominal(),
         notes,
     })
 }
 
-/// `aligned` (an estimated trajectory) estimated again with the lidar predicted under
-/// `hypothesis`: a lidar effect that the nominal model cannot take is partly absorbed into the
-/// scan matching's corrections, so an effect's fit is refined against the trajectory its own
-/// model gives (one step of alternating the alignment and the fit).
+/// `aligned` (an estimated trajectory) estimated again with the lidar predicted and the
+/// commands replayed under `hypothesis` (and the drive effects `aligned` was replayed under): a
+/// lidar effect that the nominal model cannot take is partly absorbed into the scan matching's
+/// corrections, so an effect's fit is refined against the trajectory its own model gives (one
+/// step of alternating the alignment and the fit); a drive effect (motor lag) moves the path
+/// between the lidar's corrections.
 ///
 /// # Errors
 /// As [`align`].
@@ -170,13 +191,61 @@ pub(crate) fn realign(
     aligned: &Aligned,
     hypothesis: &Hypothesis,
 ) -> Result<Aligned, MismatchError> {
-    let (trajectory, sd) = estimate_trajectory(physics, recording, aligned.end_s, hypothesis)?;
+    let full = aligned
+        .replayed
+        .effects
+        .iter()
+        .filter(|(e, _)| hypothesis.param_of(*e, 0).is_none())
+        .fold(hypothesis.clone(), |h, (e, p)| h.and(*e, p.clone()));
+    let replayed = full
+        .effects
+        .iter()
+        .filter(|(e, _)| e.sensor() == Sensor::Drive)
+        .fold(Hypothesis::nominal(), |h, (e, p)| h.and(*e, p.clone()));
+    let preferred = aligned.reckoned.unwrap_or(DeadReckoning::Commands);
+    let (trajectory, sd, reckoned) =
+        estimate_trajectory(physics, recording, aligned.end_s, &full, preferred)?;
     Ok(Aligned {
         trajectory,
         alignment: aligned.alignment,
         end_s: aligned.end_s,
         position_sd_m: sd.position_m,
         yaw_sd_rad: sd.yaw_rad,
+        reckoned: Some(reckoned),
+        replayed,
         notes: aligned.notes.clone(),
     })
+}
+
+/// The trajectory of `aligned` (an estimated one) estimated again following the encoders
+/// between the lidar's corrections, for judging the drive independently of the commands;
+/// `None` when the recording has no encoders to follow.
+///
+/// # Errors
+/// As [`align`].
+pub(crate) fn along_encoders(
+    physics: &dyn Physics,
+    recording: &Recording,
+    aligned: &Aligned,
+) -> Result<Option<Aligned>, MismatchError> {
+    if recording.odometry.as_ref().is_none_or(|o| o.len() < 2) {
+        return Ok(None);
+    }
+    let (trajectory, sd, reckoned) = estimate_trajectory(
+        physics,
+        recording,
+        aligned.end_s,
+        &Hypothesis::nominal(),
+        DeadReckoning::Encoders,
+    )?;
+    Ok((reckoned == DeadReckoning::Encoders).then(|| Aligned {
+        trajectory,
+        alignment: aligned.alignment,
+        end_s: aligned.end_s,
+        position_sd_m: sd.position_m,
+        yaw_sd_rad: sd.yaw_rad,
+        reckoned: Some(reckoned),
+        replayed: Hypothesis::nominal(),
+        notes: aligned.notes.clone(),
+    }))
 }

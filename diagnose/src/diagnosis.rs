@@ -7,6 +7,7 @@ use crate::align::{self, Aligned, Alignment};
 use crate::catalogue::Sensor;
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
+use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};
 use crate::locate::{self, Evidence, TestKind};
 use crate::outcome::{Diagnosis, Options, SensorSummary};
@@ -76,6 +77,21 @@ pub fn diagnose_with_progress(
 ) -> Result<Diagnosis, MismatchError> {
     progress(Stage::Aligning);
     let aligned = align::align(physics, recording)?;
+    let options = &options.against(&aligned);
+    // Against an estimate, the drive is judged along a second one that follows the encoders
+    // between the lidar's corrections: the first follows the commands, so the drive's residuals
+    // along it would be the commands against themselves.
+    let along_encoders = match aligned.reckoned {
+        Some(DeadReckoning::Commands) => align::along_encoders(physics, recording, &aligned)?,
+        _ => None,
+    };
+    let aligned = replayed_under_drive(
+        physics,
+        recording,
+        aligned,
+        along_encoders.as_ref(),
+        options,
+    )?;
     let ctx = Context {
         physics,
         trajectory: &aligned.trajectory,
@@ -86,10 +102,16 @@ pub fn diagnose_with_progress(
         estimated: aligned.alignment == Alignment::Estimated,
     };
     let mut notes = aligned.notes.clone();
+    let drive_ctx = along_encoders.as_ref().map(|a| Context {
+        trajectory: &a.trajectory,
+        position_sd_m: a.position_sd_m,
+        yaw_sd_rad: a.yaw_sd_rad,
+        ..ctx
+    });
     progress(Stage::Gathering);
-    let mut data = gather(&ctx, &mut notes)?;
+    let mut data = gather(&ctx, drive_ctx.as_ref(), &aligned, &mut notes)?;
     progress(Stage::Locating);
-    let nominal = nominal_evidence(&ctx, &data, options);
+    let nominal = nominal_evidence(&ctx, &aligned, &data, options);
     progress(Stage::Fitting);
     let Selection {
         named,
@@ -236,31 +258,138 @@ fn structure_left(
         .collect()
 }
 
-/// The sensors' residual data with enough readings to test (a note for each with too few).
-fn gather(ctx: &Context<'_>, notes: &mut Vec<String>) -> Result<Vec<SensorData>, MismatchError> {
+impl Options {
+    /// These options against the trajectory `aligned`: an estimated one raises the encoders'
+    /// floor to its position's standard deviation. The encoders' cumulative travel is compared
+    /// with the path's, whose error at any time is the estimate's (correlated over seconds by
+    /// the smoother, so a slow departure of that size is the reference's, not the sensor's).
+    /// The drive compares 0.1 s increments, in which that error mostly cancels.
+    fn against(&self, aligned: &Aligned) -> Self {
+        let mut options = self.clone();
+        if aligned.alignment == Alignment::Estimated {
+            options.floors.odometer_m = options.floors.odometer_m.max(aligned.position_sd_m);
+        }
+        options
+    }
+}
+
+/// `aligned` (an estimate that follows the commands between the lidar's corrections)
+/// estimated again with the commands replayed under the drive's own effects (motor lag) when
+/// the drive, judged along the encoders (`along`), names one: the robot lagged its commands
+/// and a path that follows them did not, so every sensor judged along it would carry the lag
+/// (the encoders as a wrong wheel radius).
+fn replayed_under_drive(
+    physics: &dyn Physics,
+    recording: &Recording,
+    aligned: Aligned,
+    along: Option<&Aligned>,
+    options: &Options,
+) -> Result<Aligned, MismatchError> {
+    let Some(along) = along else {
+        return Ok(aligned);
+    };
+    let ctx = Context {
+        physics,
+        trajectory: &along.trajectory,
+        recording,
+        end_s: along.end_s,
+        position_sd_m: along.position_sd_m,
+        yaw_sd_rad: along.yaw_sd_rad,
+        estimated: true,
+    };
+    let Some(mut drive) = residuals::drive(&ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
+        return Ok(aligned);
+    };
+    drive.clusters = Some(residuals::shared_error_clusters(
+        &along.trajectory,
+        &drive.t,
+    ));
+    let own: Vec<CandidateFit> = select::select(&ctx, &[drive], options)
+        .named
+        .into_iter()
+        .filter(|c| c.effect.sensor() == Sensor::Drive)
+        .collect();
+    if own.is_empty() {
+        return Ok(aligned);
+    }
+    align::realign(physics, recording, &aligned, &hypothesis_of(&own))
+}
+
+/// Readings a sensor needs to be tested.
+const MIN_READINGS: usize = 60;
+
+/// What `sensor`'s readings are judged against, aligned by `aligned`.
+fn reference_of(sensor: Sensor, aligned: &Aligned) -> &'static str {
+    match (aligned.reckoned, sensor) {
+        (None, Sensor::Drive) => "commands against truth.csv",
+        (None, _) => "truth.csv",
+        (Some(_), Sensor::Drive) => {
+            "commands against the lidar-estimated path (encoders between scans)"
+        }
+        (Some(r), _) => r.describe(),
+    }
+}
+
+/// The sensors' residual data with enough readings to test (a note for each with too few, or
+/// with no reference independent of it). `drive_ctx`: against an estimate, the context whose
+/// trajectory follows the encoders.
+fn gather(
+    ctx: &Context<'_>,
+    drive_ctx: Option<&Context<'_>>,
+    aligned: &Aligned,
+    notes: &mut Vec<String>,
+) -> Result<Vec<SensorData>, MismatchError> {
     let mut data: Vec<SensorData> = Vec::new();
-    // Against an estimated trajectory only the ranges are diagnosed: the encoders and the drive
-    // would be judged against the estimate's own errors (see `estimate.rs`).
-    let proprioceptive = !ctx.estimated;
+    let has_odometry = ctx
+        .recording
+        .odometry
+        .as_ref()
+        .is_some_and(|o| !o.is_empty())
+        && ctx.physics.declared().odometer;
+    // The encoders judged against a path that follows them would be judged against themselves.
+    let odometer = if aligned.reckoned == Some(DeadReckoning::Encoders) {
+        if has_odometry {
+            notes.push(
+                "the odometer is not diagnosed: without truth.csv or commands, the only path \
+                 to judge it against is the one estimated from the encoders themselves"
+                    .into(),
+            );
+        }
+        None
+    } else {
+        residuals::odometer(ctx)?
+    };
+    let drive = match (ctx.estimated, drive_ctx) {
+        (false, _) => residuals::drive(ctx)?,
+        (true, Some(along)) => residuals::drive(along)?,
+        (true, None) => {
+            if !ctx.recording.commands.is_empty() {
+                notes.push(
+                    "the drive is not diagnosed: without truth.csv or encoders, the only path \
+                     to judge the commands against is estimated from the commands themselves"
+                        .into(),
+                );
+            }
+            None
+        }
+    };
     for d in [
         residuals::lidar(ctx)?,
         residuals::sonar(ctx)?,
-        proprioceptive
-            .then(|| residuals::odometer(ctx))
-            .transpose()?
-            .flatten(),
-        proprioceptive
-            .then(|| residuals::drive(ctx))
-            .transpose()?
-            .flatten(),
+        odometer,
+        drive,
     ]
     .into_iter()
     .flatten()
     {
-        if d.len() >= 60 {
+        if d.len() >= MIN_READINGS {
             let mut d = d;
             if ctx.estimated {
-                d.clusters = Some(residuals::shared_error_clusters(ctx.trajectory, &d.t));
+                let along = match (d.sensor, drive_ctx) {
+                    (Sensor::Drive, Some(along)) => along.trajectory,
+                    _ => ctx.trajectory,
+                };
+                d.clusters = Some(residuals::shared_error_clusters(along, &d.t));
             }
             data.push(d);
         } else if !d.y.is_empty() {
@@ -289,7 +418,12 @@ fn gather(ctx: &Context<'_>, notes: &mut Vec<String>) -> Result<Vec<SensorData>,
 }
 
 /// The residuals under the nominal model, and where they stop being noise.
-fn nominal_evidence(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Nominal {
+fn nominal_evidence(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    data: &[SensorData],
+    options: &Options,
+) -> Nominal {
     let names = |id: u32| ctx.physics.object_name(id);
     let nominal = Hypothesis::nominal();
     let mut evidence = Vec::new();
@@ -311,6 +445,7 @@ fn nominal_evidence(ctx: &Context<'_>, data: &[SensorData], options: &Options) -
             heldout_rmse_m: r,
             noise_floor_m: floor,
             strongest: ev.iter().map(|e| e.score).fold(f64::NEG_INFINITY, f64::max),
+            reference: reference_of(d.sensor, aligned),
         });
         evidence.extend(ev);
     }

@@ -30,24 +30,53 @@ const READINGS_PER_REV: usize = 90;
 /// Huber's k, in normalised residuals.
 const HUBER_K: f64 = 2.0;
 
-/// The trajectory to correct: the commands through the nominal drive, or the encoders' travel
-/// integrated from the declared start.
+/// What an estimated trajectory follows between the lidar's corrections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DeadReckoning {
+    /// The commands replayed through the nominal drive: a smooth path, independent of the
+    /// encoders (so the encoders can be judged against it).
+    Commands,
+    /// The encoders' travel integrated from the declared start: the robot's real motion at
+    /// their rate, independent of the commands (so the drive can be judged against it).
+    Encoders,
+}
+
+impl DeadReckoning {
+    /// In words, for the diagnosis's `references`.
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Commands => "lidar-estimated path (commands between scans)",
+            Self::Encoders => "lidar-estimated path (encoders between scans)",
+        }
+    }
+}
+
+/// The trajectory to correct, following `preferred` when the recording has it (else the
+/// other), and what it followed.
 fn dead_reckoning(
     physics: &dyn Physics,
     recording: &Recording,
     end_s: f64,
-) -> Result<Trajectory, MismatchError> {
+    preferred: DeadReckoning,
+    hypothesis: &Hypothesis,
+) -> Result<(Trajectory, DeadReckoning), MismatchError> {
     let d = physics.declared();
     // The commands through the nominal drive give a smooth path; the encoders' readings carry
     // their noise into every pose (2 mm per reading is ~10 mrad of heading between readings),
-    // so they are the fallback.
-    if !recording.commands.is_empty() {
-        let replay = physics.drive(&recording.commands, end_s, &Hypothesis::nominal());
-        if replay.len() >= 2 {
-            return Trajectory::new(&replay);
+    // but they follow what the robot did, lag and all.
+    let replay = || {
+        (!recording.commands.is_empty())
+            .then(|| physics.drive(&recording.commands, end_s, hypothesis))
+            .filter(|r| r.len() >= 2)
+    };
+    let odometry = recording.odometry.as_ref().filter(|o| o.len() >= 2);
+    if preferred == DeadReckoning::Commands || odometry.is_none() {
+        if let Some(replay) = replay() {
+            return Ok((Trajectory::new(&replay)?, DeadReckoning::Commands));
         }
     }
-    let Some(odometry) = recording.odometry.as_ref().filter(|o| o.len() >= 2) else {
+    let Some(odometry) = odometry else {
         return Err(MismatchError::Refused(
             "the recording has no truth.csv, no commands and no odometry to follow the robot by"
                 .into(),
@@ -77,7 +106,7 @@ fn dead_reckoning(
         }
         last = *o;
     }
-    Trajectory::new(&out)
+    Ok((Trajectory::new(&out)?, DeadReckoning::Encoders))
 }
 
 /// `base` between `t0` and `t1` (its samples there and the interpolated ends) with
@@ -139,8 +168,10 @@ pub(crate) struct Uncertainty {
     pub yaw_rad: f64,
 }
 
-/// The trajectory estimated from `recording`, and its uncertainty, with the lidar predicted
-/// under `hypothesis` (the nominal model first; a fitted effect when re-aligning).
+/// The trajectory estimated from `recording` following `preferred` between the lidar's
+/// corrections, its uncertainty and what it followed, with the lidar predicted and the
+/// commands replayed under `hypothesis` (the nominal model first; fitted effects when
+/// re-aligning).
 ///
 /// # Errors
 /// [`MismatchError::Refused`] without lidar readings to match.
@@ -149,14 +180,15 @@ pub(crate) fn estimate_trajectory(
     recording: &Recording,
     end_s: f64,
     hypothesis: &Hypothesis,
-) -> Result<(Trajectory, Uncertainty), MismatchError> {
+    preferred: DeadReckoning,
+) -> Result<(Trajectory, Uncertainty, DeadReckoning), MismatchError> {
     let Some(lidar) = recording.lidar.as_ref().filter(|l| !l.is_empty()) else {
         return Err(MismatchError::Refused(
             "the recording has no truth.csv and no lidar readings to estimate its trajectory with"
                 .into(),
         ));
     };
-    let base = dead_reckoning(physics, recording, end_s)?;
+    let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
     let matcher = Matcher {
         physics,
         base: &base,
@@ -186,7 +218,11 @@ pub(crate) fn estimate_trajectory(
         ));
     }
     let samples = corrected(&base, &knots);
-    Ok((Trajectory::new(&samples)?, uncertainty(&variances)))
+    Ok((
+        Trajectory::new(&samples)?,
+        uncertainty(&variances),
+        reckoned,
+    ))
 }
 
 /// The lidar's readings grouped by revolution, in order.

@@ -84,6 +84,9 @@ pub struct SensorSummary {
     pub noise_floor_m: f64,
     /// The strongest test's normal score.
     pub strongest: f64,
+    /// What its readings were judged against: `truth.csv`, a lidar-estimated path, or (the
+    /// drive's) the commands against one of those.
+    pub reference: &'static str,
 }
 
 /// The diagnosis of one recording.

@@ -60,6 +60,10 @@ pub struct DiagnoseArgs {
     /// write its report and its "real" recording (`DIR/recording`).
     #[arg(long, value_name = "I", requires = "self_test")]
     pub trial: Option<u64>,
+    /// Self-test: remove each "real" recording's `truth.csv` before diagnosing it, as a robot's
+    /// log without motion capture (the trajectory is then estimated from the lidar).
+    #[arg(long, requires = "self_test")]
+    pub without_truth: bool,
     /// Exit 1 when the verdict is not `none` (a mismatch was found), for CI jobs; the result is
     /// still printed.
     #[arg(long, conflicts_with = "self_test")]
@@ -151,6 +155,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             strength: args.strength,
             only,
             reality,
+            without_truth: args.without_truth,
         };
         if let Some(i) = args.trial {
             if i >= n {
@@ -188,6 +193,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
         if reality != Reality::Hilsim {
             command += &format!(" --reality {}", reality.name());
+        }
+        if args.without_truth {
+            command += " --without-truth";
         }
         let started = std::time::Instant::now();
         let progress = TrialProgress::new(n, !args.json);

@@ -15,6 +15,9 @@ pub struct Plan {
     pub only: Option<usize>,
     /// What makes the "real" recordings.
     pub reality: Reality,
+    /// Whether the "real" recordings lose their `truth.csv` before they are diagnosed, as a
+    /// robot's log without motion capture (the trajectory is then estimated from the lidar).
+    pub without_truth: bool,
 }
 
 /// What makes a self-test's "real" recordings.

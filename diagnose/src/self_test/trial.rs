@@ -59,6 +59,17 @@ pub(crate) fn real_recording(
     plan: Plan,
     i: u64,
 ) -> (Drawn, Result<Recording, String>) {
+    let (drawn, mut recording) = concealing(nominal, plan, i);
+    if plan.without_truth {
+        if let Ok(r) = &mut recording {
+            r.truth = None;
+        }
+    }
+    (drawn, recording)
+}
+
+/// Trial `i`'s "real" recording, with its truth, and what it conceals.
+fn concealing(nominal: &Scenario, plan: Plan, i: u64) -> (Drawn, Result<Recording, String>) {
     match plan.reality {
         Reality::Hilsim => {
             let (real, drawn) = real_scenario(nominal, plan.seed, i, plan.strength, plan.only);

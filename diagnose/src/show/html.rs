@@ -184,17 +184,18 @@ fn candidates(s: &mut String, d: &Diagnosis) {
 fn sensors(s: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         s,
-        "<h2>Sensors</h2><table><tr><th>sensor</th><th>readings</th><th>held-out RMSE (nominal)</th><th>noise floor</th><th>strongest test</th></tr>"
+        "<h2>Sensors</h2><table><tr><th>sensor</th><th>readings</th><th>held-out RMSE (nominal)</th><th>noise floor</th><th>strongest test</th><th>judged against</th></tr>"
     );
     for x in &d.sensors {
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}σ</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}σ</td><td>{}</td></tr>",
             x.sensor,
             x.readings,
             mm(x.heldout_rmse_m),
             mm(x.noise_floor_m),
-            x.strongest
+            x.strongest,
+            escape(x.reference)
         );
     }
     let _ = writeln!(s, "</table>");

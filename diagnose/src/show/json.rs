@@ -52,8 +52,8 @@ fn fit_of(f: &CandidateFit) -> Value {
 
 /// The diagnosis as the `hilsim diagnose --json` object of `interfaces.md` (plus `param_sd`,
 /// `fit.sensor`, `fit.noise_floor_m`, `fit.readings`, `located.score`, `located.size_m`,
-/// `effects[].heldout_gain`, `effects[].size_m`, `unexplained[].score`, `alignment` and
-/// `notes`).
+/// `effects[].heldout_gain`, `effects[].size_m`, `unexplained[].score`, `alignment`,
+/// `references` and `notes`).
 #[must_use]
 pub fn to_json(d: &Diagnosis) -> Value {
     let located = d.located.as_ref().map_or(Value::Null, evidence);
@@ -147,6 +147,11 @@ pub fn to_json(d: &Diagnosis) -> Value {
         "unexplained": unexplained,
         "candidates": candidates,
         "alignment": d.alignment.name(),
+        "references": d
+            .sensors
+            .iter()
+            .map(|s| (s.sensor.name().to_string(), json!(s.reference)))
+            .collect::<Map<String, Value>>(),
         "notes": d.notes,
     })
 }

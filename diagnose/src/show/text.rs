@@ -74,6 +74,9 @@ pub fn summary(d: &Diagnosis) -> String {
         );
     }
     let _ = writeln!(s, "aligned by {}", d.alignment.name());
+    for x in &d.sensors {
+        let _ = writeln!(s, "{} judged against {}", x.sensor, x.reference);
+    }
     for n in &d.notes {
         let _ = writeln!(s, "note: {n}");
     }

@@ -4,7 +4,7 @@
 use hilsim_recording::Recording;
 
 use crate::align::{self, Aligned, Alignment};
-use crate::catalogue::Sensor;
+use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
@@ -111,7 +111,7 @@ pub fn diagnose_with_progress(
     progress(Stage::Gathering);
     let mut data = gather(&ctx, drive_ctx.as_ref(), &aligned, &mut notes)?;
     progress(Stage::Locating);
-    let nominal = nominal_evidence(&ctx, &aligned, &data, options);
+    let mut nominal = nominal_evidence(&ctx, &aligned, &data, options);
     progress(Stage::Fitting);
     let Selection {
         named,
@@ -127,6 +127,20 @@ pub fn diagnose_with_progress(
         ..ctx
     });
     let final_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
+    let named = match &realigned_ctx {
+        Some(along) => {
+            let (named, again) =
+                rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
+            nominal = again;
+            named
+        }
+        None => named,
+    };
+    let named = if along_encoders.is_some() {
+        drive_after_odometer_latency(final_ctx, &aligned, named, &mut candidates, &mut data, options)?
+    } else {
+        named
+    };
     let mut left = structure_left(final_ctx, &data, &nominal, &named);
     let named = explaining_their_sensor(&nominal, &left, named, options);
     // A sensor whose effects were all dropped is left with its nominal structure.
@@ -271,6 +285,110 @@ impl Options {
         }
         options
     }
+}
+
+/// The sonar and the encoders judged again, and their effects chosen again, along `along`: the
+/// path estimated under the named lidar effects. Estimated under the nominal lidar, the path
+/// took up part of a lidar effect (a warm-up's early ranges are a position error), which the
+/// sonar and the encoders would otherwise carry as effects of their own. Returns the named
+/// effects and the nominal evidence along the new path (`candidates` and `data` follow it).
+fn rejudge_along(
+    along: &Context<'_>,
+    aligned: &Aligned,
+    named: Vec<CandidateFit>,
+    candidates: &mut Vec<CandidateFit>,
+    data: &mut [SensorData],
+    options: &Options,
+) -> Result<(Vec<CandidateFit>, Nominal), MismatchError> {
+    for d in data.iter_mut() {
+        let again = match d.sensor {
+            Sensor::Sonar => residuals::sonar(along)?,
+            Sensor::Odometer => residuals::odometer(along)?,
+            Sensor::Lidar | Sensor::Drive => continue,
+        };
+        if let Some(mut again) = again {
+            again.clusters = Some(residuals::shared_error_clusters(along.trajectory, &again.t));
+            *d = again;
+        }
+    }
+    let others: Vec<SensorData> = data
+        .iter()
+        .filter(|d| d.sensor != Sensor::Lidar)
+        .cloned()
+        .collect();
+    let mut named: Vec<CandidateFit> = named
+        .into_iter()
+        .filter(|c| c.effect.sensor() == Sensor::Lidar)
+        .collect();
+    if !others.is_empty() {
+        let again = select::select(along, &others, options);
+        named.extend(again.named);
+        candidates.retain(|c| c.effect.sensor() == Sensor::Lidar);
+        candidates.extend(again.candidates);
+        candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+        named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    }
+    Ok((named, nominal_evidence(along, aligned, data, options)))
+}
+
+/// The drive judged again, and its effects chosen again, along a path that follows the
+/// encoders at their corrected times when an odometer latency is named: encoders stamped late
+/// make the path that follows them lag the commands, which the drive would take for a motor
+/// lag. Returns the named effects (`candidates` and `data` follow).
+fn drive_after_odometer_latency(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    named: Vec<CandidateFit>,
+    candidates: &mut Vec<CandidateFit>,
+    data: &mut [SensorData],
+    options: &Options,
+) -> Result<Vec<CandidateFit>, MismatchError> {
+    let latency = Effect::SensorLatency(Sensor::Odometer);
+    let Some(delay_s) = named
+        .iter()
+        .find(|c| c.effect == latency)
+        .map(|c| c.params[0])
+    else {
+        return Ok(named);
+    };
+    let mut recording = ctx.recording.clone();
+    if let Some(odometry) = recording.odometry.as_mut() {
+        for o in odometry.iter_mut() {
+            o.t_s -= delay_s;
+        }
+        odometry.retain(|o| o.t_s >= 0.0);
+    }
+    let Some(along) = align::along_encoders(ctx.physics, &recording, aligned)? else {
+        return Ok(named);
+    };
+    let drive_ctx = Context {
+        trajectory: &along.trajectory,
+        position_sd_m: along.position_sd_m,
+        yaw_sd_rad: along.yaw_sd_rad,
+        ..*ctx
+    };
+    let Some(mut drive) = residuals::drive(&drive_ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
+        return Ok(named);
+    };
+    drive.clusters = Some(residuals::shared_error_clusters(&along.trajectory, &drive.t));
+    let Some(at) = data.iter().position(|d| d.sensor == Sensor::Drive) else {
+        return Ok(named);
+    };
+    data[at] = drive;
+    let wheels: Vec<SensorData> = data
+        .iter()
+        .filter(|d| matches!(d.sensor, Sensor::Odometer | Sensor::Drive))
+        .cloned()
+        .collect();
+    let again = select::select(ctx, &wheels, options);
+    let theirs = |e: Effect| matches!(e.sensor(), Sensor::Odometer | Sensor::Drive);
+    let mut named: Vec<CandidateFit> = named.into_iter().filter(|c| !theirs(c.effect)).collect();
+    named.extend(again.named);
+    named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    candidates.retain(|c| !theirs(c.effect));
+    candidates.extend(again.candidates);
+    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    Ok(named)
 }
 
 /// `aligned` (an estimate that follows the commands between the lidar's corrections)

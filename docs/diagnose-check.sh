@@ -4,6 +4,9 @@
 #                                         # diagnosed with truth.csv and without it
 #   bash docs/diagnose-check.sh nominal   # faithful runs of every checked-in scenario (its own
 #                                         # seed, 101 and 102), with truth.csv and without it
+#   bash docs/diagnose-check.sh quiet     # issue 15: every checked-in scenario at its own seed
+#                                         # and five more (101-105), without truth.csv; exit 1
+#                                         # when any names a catalogued effect
 # Prints one line per diagnosis: the run, the verdict, the fitted parameters, where.
 # Needs only the release binary (built here) and python3 for reading the JSON.
 set -euo pipefail
@@ -56,8 +59,28 @@ nominal)
         done
     done
     ;;
+quiet)
+    named=0
+    for scenario in scenarios/*.toml; do
+        name=$(basename "$scenario" .toml)
+        for seed in own 101 102 103 104 105; do
+            args=()
+            [ "$seed" = own ] || args=(--seed "$seed")
+            "$hilsim" record "$scenario" "${args[@]}" --out "$work/run" > /dev/null
+            rm -f "$work/run/truth.csv"
+            "$hilsim" diagnose --sim "$scenario" --real "$work/run" --json > "$work/out.json"
+            show "$name seed $seed (no truth)" "$work/out.json"
+            if python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1]))["effects"] else 1)' "$work/out.json"; then
+                named=$((named + 1))
+            fi
+            rm -rf "$work/run"
+        done
+    done
+    echo "faithful runs naming a catalogued effect: $named"
+    [ "$named" -eq 0 ]
+    ;;
 *)
-    echo "usage: bash docs/diagnose-check.sh effects|nominal" >&2
+    echo "usage: bash docs/diagnose-check.sh effects|nominal|quiet" >&2
     exit 2
     ;;
 esac

@@ -137,7 +137,14 @@ pub fn diagnose_with_progress(
         None => named,
     };
     let named = if along_encoders.is_some() {
-        drive_after_odometer_latency(final_ctx, &aligned, named, &mut candidates, &mut data, options)?
+        drive_after_odometer_latency(
+            final_ctx,
+            &aligned,
+            named,
+            &mut candidates,
+            &mut data,
+            options,
+        )?
     } else {
         named
     };
@@ -370,7 +377,10 @@ fn drive_after_odometer_latency(
     let Some(mut drive) = residuals::drive(&drive_ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
         return Ok(named);
     };
-    drive.clusters = Some(residuals::shared_error_clusters(&along.trajectory, &drive.t));
+    drive.clusters = Some(residuals::shared_error_clusters(
+        &along.trajectory,
+        &drive.t,
+    ));
     let Some(at) = data.iter().position(|d| d.sensor == Sensor::Drive) else {
         return Ok(named);
     };

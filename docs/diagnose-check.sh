@@ -50,6 +50,7 @@ effects)
     ;;
 nominal)
     for scenario in scenarios/*.toml; do
+        [ "$(basename "$scenario")" = Cargo.toml ] && continue
         name=$(basename "$scenario" .toml)
         for seed in own 101 102; do
             args=()
@@ -62,6 +63,7 @@ nominal)
 quiet)
     named=0
     for scenario in scenarios/*.toml; do
+        [ "$(basename "$scenario")" = Cargo.toml ] && continue
         name=$(basename "$scenario" .toml)
         for seed in own 101 102 103 104 105; do
             args=()

@@ -52,8 +52,18 @@ impl Context<'_> {
                         wb[i % 2] - wa[i % 2]
                     })
                     .collect();
-                // Two differences of the trajectory's positions per window.
-                let noise_var = 2.0 * self.position_sd_m * self.position_sd_m;
+                // Two differences of the trajectory's positions per window; against an
+                // estimate the path follows the encoders between the lidar's corrections, so a
+                // window's travel carries the difference of two encoder readings' noise too.
+                let mut noise_var = 2.0 * self.position_sd_m * self.position_sd_m;
+                if self.estimated {
+                    let encoder_sd = self
+                        .physics
+                        .odometry(self.trajectory, &[0.0], &Hypothesis::nominal())
+                        .first()
+                        .map_or(0.0, |p| p.wheels[0].sd_m);
+                    noise_var += 2.0 * encoder_sd * encoder_sd;
+                }
                 let starts: Vec<f64> = windows.iter().map(|w| w.0).collect();
                 let all = drive_predictions(
                     &increments,

@@ -363,7 +363,8 @@ impl Effect {
     /// - warm-up k: 0.00025 /m, 1 mm at 2 m at power-on;
     /// - sonar cone: 1°, four of the emulator's 0.25° rays;
     /// - speed of sound: 0.6 °C, 0.1 % of range (1 mm at 1 m);
-    /// - wheel slip g: 0.005 s, 1 mm of travel at 0.2 m/s;
+    /// - wheel slip g: 0.01 s, the odometer's 2 mm floor over a 0.2 m/s change of speed
+    ///   (slip's extra travel is g Δv);
     /// - motor lag τ: 0.02 s, two physics steps (the drive's resolution is 0.01 s);
     /// - mount yaw: 0.15°, 5 mm at 2 m, and its position 5 mm: the world's own tolerance (the
     ///   lidar's floor, `Floors`), below which a mount offset is as likely a wall a few
@@ -404,7 +405,7 @@ impl Effect {
             Effect::LidarWarmupDrift => 0.000_25,
             Effect::SonarBeamWidth => 1.0,
             Effect::SonarSpeedOfSound => 0.6,
-            Effect::OdometerWheelSlip => 0.005,
+            Effect::OdometerWheelSlip => 0.01,
             Effect::DriveMotorLag => 0.02,
             Effect::SensorLatency(_) => 0.005,
             Effect::DriveWheelBase => 0.000_5,

@@ -33,7 +33,7 @@ pub struct CandidateFit {
     pub noise_floor: f64,
     /// Held-out readings the RMSEs are over.
     pub heldout_n: usize,
-    /// How much the effect changes the predicted readings, metres: the RMS change of the
+    /// How much the effect changes the predicted readings, metres: the median change of the
     /// predictive mean over the tenth of the held-out readings it changes most (at least 30),
     /// so an effect that acts on a few readings (edges, the first seconds) is measured where
     /// it acts.
@@ -71,8 +71,9 @@ fn predictive_mean(p: &Predictive) -> f64 {
     p.iter().map(|g| g.weight * g.mean_m).sum::<f64>() / w
 }
 
-/// The effect size: the RMS change of the predictive mean from `before` to `after` over the
-/// readings it changes most, with the RMS predicted standard deviation there.
+/// The effect size: the median change of the predictive mean from `before` to `after` over the
+/// readings it changes most (the share [`SIZE_SHARE`]), with the predicted standard deviation
+/// of that reading.
 fn effect_size(before: &[Predictive], after: &[Predictive]) -> (f64, f64) {
     let mut change: Vec<(f64, f64)> = before
         .iter()
@@ -91,11 +92,11 @@ fn effect_size(before: &[Predictive], after: &[Predictive]) -> (f64, f64) {
         .max(SIZE_MIN_READINGS)
         .min(change.len());
     change.sort_by(|a, b| b.0.total_cmp(&a.0));
+    // The median of the most changed readings, not their RMS: a geometric effect (a mount, a
+    // delay) flips a few readings at an object's edge between two surfaces metres apart, and
+    // those would make a millimetre's effect look a metre large.
     let top = &change[..k];
-    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
-        (top.iter().map(|x| f(x).powi(2)).sum::<f64>() / k as f64).sqrt()
-    };
-    (rms(&|x| x.0), rms(&|x| x.1))
+    top[k / 2]
 }
 
 /// Scores `effect` with `params` on top of `base`: its gains over the base on both halves,

@@ -33,8 +33,9 @@ pub struct CandidateFit {
     pub noise_floor: f64,
     /// Held-out readings the RMSEs are over.
     pub heldout_n: usize,
-    /// How much the effect changes the predicted readings, metres: the median change of the
-    /// predictive mean over the tenth of the held-out readings it changes most (at least 30),
+    /// How much the effect changes the predicted readings, metres: the median (a range sensor)
+    /// or RMS change of the predictive mean over the tenth of the held-out readings it changes
+    /// most (at least 30),
     /// so an effect that acts on a few readings (edges, the first seconds) is measured where
     /// it acts.
     pub size_m: f64,
@@ -71,10 +72,14 @@ fn predictive_mean(p: &Predictive) -> f64 {
     p.iter().map(|g| g.weight * g.mean_m).sum::<f64>() / w
 }
 
-/// The effect size: the median change of the predictive mean from `before` to `after` over the
+/// The effect size: the change of the predictive mean from `before` to `after` over the
 /// readings it changes most (the share [`SIZE_SHARE`]), with the predicted standard deviation
-/// of that reading.
-fn effect_size(before: &[Predictive], after: &[Predictive]) -> (f64, f64) {
+/// there. For a range sensor it is the median of those changes (and the standard deviation of
+/// that reading): a geometric effect (a mount, a delay) flips a few readings at an object's
+/// edge between two surfaces metres apart, which would make a millimetre's effect look a metre
+/// large. The encoders' and the drive's predictions have no such jumps, and an effect of
+/// theirs acts on few readings (a lag on the windows after a change of command): their RMS.
+fn effect_size(before: &[Predictive], after: &[Predictive], ranges: bool) -> (f64, f64) {
     let mut change: Vec<(f64, f64)> = before
         .iter()
         .zip(after)
@@ -92,11 +97,14 @@ fn effect_size(before: &[Predictive], after: &[Predictive]) -> (f64, f64) {
         .max(SIZE_MIN_READINGS)
         .min(change.len());
     change.sort_by(|a, b| b.0.total_cmp(&a.0));
-    // The median of the most changed readings, not their RMS: a geometric effect (a mount, a
-    // delay) flips a few readings at an object's edge between two surfaces metres apart, and
-    // those would make a millimetre's effect look a metre large.
     let top = &change[..k];
-    top[k / 2]
+    if ranges {
+        return top[k / 2];
+    }
+    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        (top.iter().map(|x| f(x).powi(2)).sum::<f64>() / k as f64).sqrt()
+    };
+    (rms(&|x| x.0), rms(&|x| x.1))
 }
 
 /// Scores `effect` with `params` on top of `base`: its gains over the base on both halves,
@@ -129,7 +137,8 @@ fn score(
     let both = |i: usize| before[i].residual.is_finite() && !after[i].outlier;
     let (rmse_before, _, _) = rmse(&before, both);
     let (rmse_after, noise_floor, heldout_n) = rmse(&after, both);
-    let (size_m, size_noise_m) = effect_size(&before_p, &after_p);
+    let ranges = matches!(data.sensor, Sensor::Lidar | Sensor::Sonar);
+    let (size_m, size_noise_m) = effect_size(&before_p, &after_p, ranges);
     let train_gain = best - train_base;
     CandidateFit {
         effect,

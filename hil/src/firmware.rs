@@ -489,7 +489,12 @@ mod tests {
     /// Issue 18: a daemon that left the firmware's group (`setsid`) is reported and killed.
     #[test]
     fn issue_18_a_process_that_left_the_group_is_reported_and_killed() {
-        let mut fw = sh("setsid sleep 30 </dev/null >/dev/null 2>&1 & echo $! >&2; exit 0");
+        // The pid is told only once the daemon has left (its own session, `sleep` exec'd):
+        // on a loaded machine the firmware could otherwise exit first and its group be shut
+        // down with the daemon still in it, which kills it as a member, not as an escapee.
+        let mut fw = sh("setsid sleep 30 </dev/null >/dev/null 2>&1 & p=$!; \
+             until [ \"$(cut -d' ' -f2,6 /proc/$p/stat)\" = \"(sleep) $p\" ]; do sleep 0.01; done; \
+             echo $p >&2; exit 0");
         let deadline = Instant::now() + Duration::from_secs(5);
         while fw.stderr_tail().lines.is_empty() {
             assert!(Instant::now() < deadline);

@@ -40,13 +40,16 @@ pub fn new_lineage() -> String {
     format!("{}-{key:016x}", std::process::id())
 }
 
-/// Every live process whose environment holds `LINEAGE_VARIABLE=lineage`, zombies left out.
+/// Every live process whose environment holds `LINEAGE_VARIABLE=lineage`, zombies and the
+/// members of process group `group` left out: a member has been sent the group's `SIGKILL`
+/// and is on its way out (on a loaded machine it may not have gone yet), not escaped.
 #[must_use]
-pub fn find(lineage: &str) -> Vec<EscapedProcess> {
+pub fn find(lineage: &str, group: Option<i32>) -> Vec<EscapedProcess> {
     let wanted = format!("{LINEAGE_VARIABLE}={lineage}");
     let mut found: Vec<EscapedProcess> = crate::process::other_pids()
         .into_iter()
         .filter(|&pid| carries(pid, &wanted) && !crate::process::is_zombie(pid))
+        .filter(|&pid| group.is_none() || process_group(pid) != group)
         .map(|pid| EscapedProcess {
             pid,
             command: fs::read_to_string(format!("/proc/{pid}/comm"))
@@ -58,6 +61,18 @@ pub fn find(lineage: &str) -> Vec<EscapedProcess> {
     found
 }
 
+/// Process `pid`'s group (`/proc/PID/stat`: the third field after the command name, which is
+/// in parentheses and may hold any byte); `None` once it has gone.
+fn process_group(pid: u32) -> Option<i32> {
+    let stat = fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    stat.rsplit(')')
+        .next()?
+        .split_whitespace()
+        .nth(2)?
+        .parse()
+        .ok()
+}
+
 /// Whether process `pid`'s environment holds the entry `wanted` (a process of another user, or
 /// one that has just gone, is not read and does not).
 fn carries(pid: u32, wanted: &str) -> bool {
@@ -65,10 +80,11 @@ fn carries(pid: u32, wanted: &str) -> bool {
         .is_ok_and(|env| env.split(|&b| b == 0).any(|e| e == wanted.as_bytes()))
 }
 
-/// Finds the processes of `lineage` that are still running and kills them: what they were.
+/// Finds the processes of `lineage` that are still running outside process group `group` and
+/// kills them: what they were.
 #[must_use]
-pub fn kill_all(lineage: &str) -> Vec<EscapedProcess> {
-    let found = find(lineage);
+pub fn kill_all(lineage: &str, group: Option<i32>) -> Vec<EscapedProcess> {
+    let found = find(lineage, group);
     for p in &found {
         if let Ok(pid) = i32::try_from(p.pid) {
             let _ = kill(Pid::from_raw(pid), Signal::SIGKILL);
@@ -102,11 +118,11 @@ mod tests {
         std::io::Read::read_to_string(child.stdout.as_mut().unwrap(), &mut out).unwrap();
         child.wait().unwrap();
         let escaped: u32 = out.trim().parse().unwrap();
-        let found = kill_all(&lineage);
+        let found = kill_all(&lineage, None);
         assert!(found.iter().any(|p| p.pid == escaped), "{found:?}");
         assert!(crate::process::has_exited(escaped, Duration::from_secs(2)));
-        assert!(find(&lineage).is_empty());
+        assert!(find(&lineage, None).is_empty());
         // Another run's lineage finds nothing of this one.
-        assert!(find(&new_lineage()).is_empty());
+        assert!(find(&new_lineage(), None).is_empty());
     }
 }

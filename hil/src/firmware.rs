@@ -290,7 +290,7 @@ impl Firmware {
         };
         // Whatever the leader left running in its group goes too, and what left the group.
         signal_group(self.pgid, Signal::SIGKILL)?;
-        exit.escaped = kill_all(&self.lineage);
+        exit.escaped = kill_all(&self.lineage, Some(self.pgid.as_raw()));
         self.wait_for_stderr(Duration::from_millis(500));
         Ok(exit)
     }
@@ -341,7 +341,7 @@ impl Drop for Firmware {
     fn drop(&mut self) {
         // Every path out of the harness comes through here: nothing of the firmware survives.
         let _ = killpg(self.pgid, Signal::SIGKILL);
-        let _ = kill_all(&self.lineage);
+        let _ = kill_all(&self.lineage, Some(self.pgid.as_raw()));
         if self.status.is_none() {
             let _ = self.child.wait();
         }

@@ -7,7 +7,7 @@ use hilsim_recording::Recording;
 
 use crate::catalogue::Sensor;
 use crate::error::MismatchError;
-use crate::estimate::{estimate_trajectory, DeadReckoning};
+use crate::estimate::{estimate_trajectory, DeadReckoning, Uncertainty};
 use crate::physics::{Hypothesis, Physics};
 use crate::trajectory::{wrap, Trajectory};
 
@@ -205,16 +205,29 @@ pub(crate) fn realign(
     let preferred = aligned.reckoned.unwrap_or(DeadReckoning::Commands);
     let (trajectory, sd, reckoned) =
         estimate_trajectory(physics, recording, aligned.end_s, &full, preferred)?;
-    Ok(Aligned {
-        trajectory,
-        alignment: aligned.alignment,
-        end_s: aligned.end_s,
-        position_sd_m: sd.position_m,
-        yaw_sd_rad: sd.yaw_rad,
-        reckoned: Some(reckoned),
-        replayed,
-        notes: aligned.notes.clone(),
-    })
+    Ok(aligned.estimated_again(trajectory, sd, reckoned, replayed))
+}
+
+impl Aligned {
+    /// This run aligned by another estimate of its trajectory.
+    fn estimated_again(
+        &self,
+        trajectory: Trajectory,
+        sd: Uncertainty,
+        reckoned: DeadReckoning,
+        replayed: Hypothesis,
+    ) -> Self {
+        Self {
+            trajectory,
+            alignment: self.alignment,
+            end_s: self.end_s,
+            position_sd_m: sd.position_m,
+            yaw_sd_rad: sd.yaw_rad,
+            reckoned: Some(reckoned),
+            replayed,
+            notes: self.notes.clone(),
+        }
+    }
 }
 
 /// The trajectory of `aligned` (an estimated one) estimated again following the encoders
@@ -238,14 +251,6 @@ pub(crate) fn along_encoders(
         &Hypothesis::nominal(),
         DeadReckoning::Encoders,
     )?;
-    Ok((reckoned == DeadReckoning::Encoders).then(|| Aligned {
-        trajectory,
-        alignment: aligned.alignment,
-        end_s: aligned.end_s,
-        position_sd_m: sd.position_m,
-        yaw_sd_rad: sd.yaw_rad,
-        reckoned: Some(reckoned),
-        replayed: Hypothesis::nominal(),
-        notes: aligned.notes.clone(),
-    }))
+    Ok((reckoned == DeadReckoning::Encoders)
+        .then(|| aligned.estimated_again(trajectory, sd, reckoned, Hypothesis::nominal())))
 }

@@ -92,22 +92,9 @@ pub fn diagnose_with_progress(
         along_encoders.as_ref(),
         options,
     )?;
-    let ctx = Context {
-        physics,
-        trajectory: &aligned.trajectory,
-        recording,
-        end_s: aligned.end_s,
-        position_sd_m: aligned.position_sd_m,
-        yaw_sd_rad: aligned.yaw_sd_rad,
-        estimated: aligned.alignment == Alignment::Estimated,
-    };
+    let ctx = context(physics, recording, &aligned);
     let mut notes = aligned.notes.clone();
-    let drive_ctx = along_encoders.as_ref().map(|a| Context {
-        trajectory: &a.trajectory,
-        position_sd_m: a.position_sd_m,
-        yaw_sd_rad: a.yaw_sd_rad,
-        ..ctx
-    });
+    let drive_ctx = along_encoders.as_ref().map(|a| along(&ctx, a));
     progress(Stage::Gathering);
     let mut data = gather(&ctx, drive_ctx.as_ref(), &aligned, &mut notes)?;
     progress(Stage::Locating);
@@ -120,12 +107,7 @@ pub fn diagnose_with_progress(
     progress(Stage::Concluding);
     let (named, realigned) =
         realign_lidar(&ctx, &aligned, named, &mut candidates, &mut data, options)?;
-    let realigned_ctx = realigned.as_ref().map(|a| Context {
-        trajectory: &a.trajectory,
-        position_sd_m: a.position_sd_m,
-        yaw_sd_rad: a.yaw_sd_rad,
-        ..ctx
-    });
+    let realigned_ctx = realigned.as_ref().map(|a| along(&ctx, a));
     let final_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
     let named = match &realigned_ctx {
         Some(along) => {
@@ -323,18 +305,12 @@ fn rejudge_along(
         .filter(|d| d.sensor != Sensor::Lidar)
         .cloned()
         .collect();
-    let mut named: Vec<CandidateFit> = named
-        .into_iter()
-        .filter(|c| c.effect.sensor() == Sensor::Lidar)
-        .collect();
-    if !others.is_empty() {
+    let named = if others.is_empty() {
+        named
+    } else {
         let again = select::select(along, &others, options);
-        named.extend(again.named);
-        candidates.retain(|c| c.effect.sensor() == Sensor::Lidar);
-        candidates.extend(again.candidates);
-        candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
-        named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
-    }
+        replace_effects(named, candidates, again, |s| s != Sensor::Lidar)
+    };
     Ok((named, nominal_evidence(along, aligned, data, options)))
 }
 
@@ -365,22 +341,12 @@ fn drive_after_odometer_latency(
         }
         odometry.retain(|o| o.t_s >= 0.0);
     }
-    let Some(along) = align::along_encoders(ctx.physics, &recording, aligned)? else {
+    let Some(encoders) = align::along_encoders(ctx.physics, &recording, aligned)? else {
         return Ok(named);
     };
-    let drive_ctx = Context {
-        trajectory: &along.trajectory,
-        position_sd_m: along.position_sd_m,
-        yaw_sd_rad: along.yaw_sd_rad,
-        ..*ctx
-    };
-    let Some(mut drive) = residuals::drive(&drive_ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
+    let Some(drive) = drive_along(&along(ctx, &encoders))? else {
         return Ok(named);
     };
-    drive.clusters = Some(residuals::shared_error_clusters(
-        &along.trajectory,
-        &drive.t,
-    ));
     let Some(at) = data.iter().position(|d| d.sensor == Sensor::Drive) else {
         return Ok(named);
     };
@@ -391,14 +357,67 @@ fn drive_after_odometer_latency(
         .cloned()
         .collect();
     let again = select::select(ctx, &wheels, options);
-    let theirs = |e: Effect| matches!(e.sensor(), Sensor::Odometer | Sensor::Drive);
-    let mut named: Vec<CandidateFit> = named.into_iter().filter(|c| !theirs(c.effect)).collect();
+    Ok(replace_effects(named, candidates, again, |s| {
+        matches!(s, Sensor::Odometer | Sensor::Drive)
+    }))
+}
+
+/// `named` and `candidates` with the effects of the sensors `chosen_again` replaced by those of
+/// `again` (a selection over those sensors' data judged again), strongest first.
+fn replace_effects(
+    named: Vec<CandidateFit>,
+    candidates: &mut Vec<CandidateFit>,
+    again: Selection,
+    chosen_again: impl Fn(Sensor) -> bool,
+) -> Vec<CandidateFit> {
+    let by_gain = |a: &CandidateFit, b: &CandidateFit| b.heldout_gain.total_cmp(&a.heldout_gain);
+    let mut named: Vec<CandidateFit> = named
+        .into_iter()
+        .filter(|c| !chosen_again(c.effect.sensor()))
+        .collect();
     named.extend(again.named);
-    named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
-    candidates.retain(|c| !theirs(c.effect));
+    named.sort_by(by_gain);
+    candidates.retain(|c| !chosen_again(c.effect.sensor()));
     candidates.extend(again.candidates);
-    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
-    Ok(named)
+    candidates.sort_by(by_gain);
+    named
+}
+
+/// The context of a diagnosis along `aligned`'s trajectory.
+fn context<'a>(
+    physics: &'a dyn Physics,
+    recording: &'a Recording,
+    aligned: &'a Aligned,
+) -> Context<'a> {
+    Context {
+        physics,
+        trajectory: &aligned.trajectory,
+        recording,
+        end_s: aligned.end_s,
+        position_sd_m: aligned.position_sd_m,
+        yaw_sd_rad: aligned.yaw_sd_rad,
+        estimated: aligned.alignment == Alignment::Estimated,
+    }
+}
+
+/// `ctx` along another estimate of the same run's trajectory, `path`.
+fn along<'a>(ctx: &Context<'a>, path: &'a Aligned) -> Context<'a> {
+    Context {
+        trajectory: &path.trajectory,
+        position_sd_m: path.position_sd_m,
+        yaw_sd_rad: path.yaw_sd_rad,
+        ..*ctx
+    }
+}
+
+/// The drive's residual data along `ctx`'s (estimated) trajectory, with the groups of windows
+/// that share its errors; `None` with too few windows to test.
+fn drive_along(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let Some(mut drive) = residuals::drive(ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
+        return Ok(None);
+    };
+    drive.clusters = Some(residuals::shared_error_clusters(ctx.trajectory, &drive.t));
+    Ok(Some(drive))
 }
 
 /// `aligned` (an estimate that follows the commands between the lidar's corrections)
@@ -416,22 +435,10 @@ fn replayed_under_drive(
     let Some(along) = along else {
         return Ok(aligned);
     };
-    let ctx = Context {
-        physics,
-        trajectory: &along.trajectory,
-        recording,
-        end_s: along.end_s,
-        position_sd_m: along.position_sd_m,
-        yaw_sd_rad: along.yaw_sd_rad,
-        estimated: true,
-    };
-    let Some(mut drive) = residuals::drive(&ctx)?.filter(|d| d.len() >= MIN_READINGS) else {
+    let ctx = context(physics, recording, along);
+    let Some(drive) = drive_along(&ctx)? else {
         return Ok(aligned);
     };
-    drive.clusters = Some(residuals::shared_error_clusters(
-        &along.trajectory,
-        &drive.t,
-    ));
     let own: Vec<CandidateFit> = select::select(&ctx, &[drive], options)
         .named
         .into_iter()
@@ -639,12 +646,7 @@ fn realign_lidar(
     for _ in 0..REALIGN_ROUNDS {
         let hypothesis = base.and(current.effect, current.params.clone());
         let again = align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?;
-        let ctx2 = Context {
-            trajectory: &again.trajectory,
-            position_sd_m: again.position_sd_m,
-            yaw_sd_rad: again.yaw_sd_rad,
-            ..*ctx
-        };
+        let ctx2 = along(ctx, &again);
         let Some(mut lidar) = residuals::lidar(&ctx2)? else {
             break;
         };

@@ -5,7 +5,7 @@
 //! and the effects named in one sensor are refitted jointly.
 
 use crate::catalogue::{Effect, ParamSpec, Sensor};
-use crate::optimize::{maximize, refine, standard_errors};
+use crate::optimize::{maximize_shapes, refine, standard_errors};
 use crate::physics::Hypothesis;
 use crate::residuals::{fits, log_likelihood, rmse, Context, Predictive, SensorData};
 
@@ -167,7 +167,7 @@ pub(crate) fn fit_candidate(
     let specs = effect.params();
     let train = fit_rows(data, max_fit_rows);
     let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
-    let (params, _) = maximize(specs, &mut objective);
+    let (params, _) = maximize_shapes(specs, effect.shapes(), &effect.absent(0.0), &mut objective);
     score(ctx, data, base, effect, params, &train)
 }
 

@@ -119,6 +119,41 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
     (x, best_v)
 }
 
+/// As [`maximize`], searching `shapes` one at a time first: each a set of the parameters left
+/// free (indices into `specs`), the others held at `held`; then refining all of them together
+/// from the best shape's maximum. One shape (or none) is [`maximize`] over all.
+pub(crate) fn maximize_shapes(
+    specs: &[ParamSpec],
+    shapes: &[&[usize]],
+    held: &[f64],
+    f: &mut dyn FnMut(&[f64]) -> f64,
+) -> (Vec<f64>, f64) {
+    if shapes.len() <= 1 {
+        return maximize(specs, f);
+    }
+    let mut best = (held.to_vec(), f64::NEG_INFINITY);
+    for shape in shapes {
+        let free: Vec<ParamSpec> = shape.iter().map(|&i| specs[i]).collect();
+        let full = |y: &[f64]| {
+            let mut x = held.to_vec();
+            for (&i, &v) in shape.iter().zip(y) {
+                x[i] = v;
+            }
+            x
+        };
+        let (y, v) = maximize(&free, &mut |y: &[f64]| f(&full(y)));
+        if v > best.1 {
+            best = (full(&y), v);
+        }
+    }
+    let (x, v) = refine(specs, &best.0, simplex_evals(specs.len()), f);
+    if v > best.1 {
+        (x, v)
+    } else {
+        best
+    }
+}
+
 fn to_unit(spec: &ParamSpec, x: f64) -> f64 {
     let u = if spec.log {
         (x.max(spec.lo).ln() - spec.lo.ln()) / (spec.hi.ln() - spec.lo.ln())

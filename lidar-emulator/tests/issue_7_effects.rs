@@ -118,18 +118,19 @@ fn warmup_drift_settles_exponentially() {
     let mut long = nominal.clone();
     long.duration_s = Some(20.5);
     let mut warm = long.clone();
-    let (k, tau) = (0.004, 5.0);
+    let (c, k, tau) = (0.01, 0.004, 5.0);
     warm.effects.lidar_warmup_drift = Some(hilsim_sim::scenario::LidarWarmupDrift {
         coefficient_per_m: k,
         time_constant_s: tau,
+        offset_m: c,
     });
     let (a, b) = (lidar(&long), lidar(&warm));
     assert_eq!(a.len(), b.len());
     let mut checked = 0;
     for (ra, rb) in a.iter().zip(&b).filter(|(r, _)| r.angle_deg == 0.0) {
-        // 3 m to the wall ahead: k d² e^{−t/τ} = 36 mm at power-on.
+        // 3 m to the wall ahead: (c + k d²) e^{−t/τ} = 10 + 36 mm at power-on.
         let d = ra.true_range_m.unwrap();
-        let expected = d + k * d * d * (-ra.t_s / tau).exp();
+        let expected = d + (c + k * d * d) * (-ra.t_s / tau).exp();
         assert!((rb.range_m - expected).abs() < MM_TOL, "t = {}", ra.t_s);
         checked += 1;
     }

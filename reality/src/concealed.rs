@@ -15,10 +15,12 @@ pub enum Concealed {
     /// Each reading's geometry is taken at its own instant (the head turns while the robot
     /// moves), where the scenario says a revolution is one instant.
     LidarMotionSkew,
-    /// The range error `k d² e^{−t/τ}` of a unit warming up.
+    /// The range error `(c + k d²) e^{−t/τ}` of a unit warming up: its pointing (k) and its
+    /// housing (c) settling together.
     LidarWarmup {
         coefficient_per_m: f64,
         time_constant_s: f64,
+        offset_m: f64,
     },
     /// The sonar returns the nearest echo in a cone of this half-angle.
     SonarBeamWidth { half_angle_deg: f64 },

@@ -199,7 +199,8 @@ impl Run<'_> {
                 Concealed::LidarWarmup {
                     coefficient_per_m,
                     time_constant_s,
-                } => coefficient_per_m * d * d * (-t / time_constant_s).exp(),
+                    offset_m,
+                } => (offset_m + coefficient_per_m * d * d) * (-t / time_constant_s).exp(),
                 Concealed::LidarPeriodicRange {
                     amplitude_m,
                     period_m,

@@ -65,6 +65,9 @@ pub enum DrawSource {
     },
     /// Not drawn: the scenario lidar's own revolution period, `60 / rpm`.
     LidarRevolution,
+    /// Not drawn: zero (a part of an effect whose size another parameter draws, e.g. the
+    /// warm-up's constant term, which the self-test draws as a shape of its quadratic one).
+    Zero,
 }
 
 /// How the blind self-test draws a parameter's true value (`docs/diagnose.md`'s moderate
@@ -107,6 +110,16 @@ impl SelfTestRange {
     pub const fn lidar_revolution() -> Self {
         Self {
             source: DrawSource::LidarRevolution,
+            scaled: false,
+            ..Self::uniform(0.0, 0.0)
+        }
+    }
+
+    /// Zero, not drawn.
+    #[must_use]
+    pub const fn zero() -> Self {
+        Self {
+            source: DrawSource::Zero,
             scaled: false,
             ..Self::uniform(0.0, 0.0)
         }

@@ -54,6 +54,7 @@ impl Effect {
                 e.lidar_warmup_drift = Some(scenario::LidarWarmupDrift {
                     coefficient_per_m: p(0),
                     time_constant_s: p(1).max(1e-3),
+                    offset_m: p(2),
                 });
             }
             Effect::SonarBeamWidth => {

@@ -31,8 +31,10 @@ impl Effect {
             ),
             Effect::LidarWarmupDrift => format!(
                 "The simulated lidar is warm from power-on; the real one's range bias drifts as it \
-                 warms up ({:+.1} mm at 2 m at power-on, settling with a {:.0} s time constant).",
-                p(0) * 4.0 * 1000.0,
+                 warms up ({:+.1} mm at 0.5 m and {:+.1} mm at 4 m at power-on, settling with a \
+                 {:.0} s time constant).",
+                (p(2) + p(0) * 0.25) * 1000.0,
+                (p(2) + p(0) * 16.0) * 1000.0,
                 p(1)
             ),
             Effect::SonarBeamWidth if declared_half_angle_deg > 0.0 => format!(

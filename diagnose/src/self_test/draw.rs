@@ -106,6 +106,7 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
         Effect::LidarWarmupDrift => Concealed::LidarWarmup {
             coefficient_per_m: p(0),
             time_constant_s: p(1),
+            offset_m: p(2),
         },
         Effect::SonarBeamWidth => Concealed::SonarBeamWidth {
             half_angle_deg: p(0),
@@ -196,11 +197,8 @@ pub(crate) fn draw_independent(
     };
     for (k, e) in effects.iter().enumerate() {
         let specs = e.params();
-        let values: Vec<f64> = specs
-            .iter()
-            .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
-            .collect();
-        let truth = specs[0].self_test.scored(values[0]);
+        let values = draw_values(*e, d, strength, nominal);
+        let truth = e.scored(&values);
         if k == 0 {
             drawn.effect = Some(*e);
             drawn.truth = Some(truth);
@@ -251,15 +249,12 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
         };
     };
     let specs = effect.params();
-    let values: Vec<f64> = specs
-        .iter()
-        .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
-        .collect();
+    let values = draw_values(effect, d, strength, nominal);
     effect.apply(&values, &mut effects);
     Drawn {
         effect: Some(effect),
         effects,
-        truth: Some(specs[0].self_test.scored(values[0])),
+        truth: Some(effect.scored(&values)),
         params: specs
             .iter()
             .zip(&values)
@@ -271,6 +266,24 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
     }
 }
 
+/// `effect`'s parameters' true values, each from its [`SelfTestRange`]; the warm-up's drift
+/// then, on a fair coin, all in its constant term (the same error at 2 m at power-on, what
+/// the self-test scores it by): a unit whose housing drifts rather than its pointing, or
+/// another simulator's reading of "the range bias drifts".
+fn draw_values(effect: Effect, d: &mut Draws, strength: f64, nominal: &Scenario) -> Vec<f64> {
+    let mut values: Vec<f64> = effect
+        .params()
+        .iter()
+        .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
+        .collect();
+    if effect == Effect::LidarWarmupDrift && d.next() & 1 == 0 {
+        let at_2m = effect.scored(&values);
+        values[0] = 0.0;
+        values[2] = at_2m;
+    }
+    values
+}
+
 /// One parameter's true value, drawn from `range`.
 fn draw_value(range: &SelfTestRange, d: &mut Draws, strength: f64, nominal: &Scenario) -> f64 {
     let (lo, hi) = match range.source {
@@ -278,6 +291,7 @@ fn draw_value(range: &SelfTestRange, d: &mut Draws, strength: f64, nominal: &Sce
         DrawSource::LidarRevolution => {
             return 60.0 / nominal.sensors.lidar.as_ref().map_or(300.0, |l| l.rpm);
         }
+        DrawSource::Zero => return 0.0,
     };
     // The sign is drawn before the magnitude.
     let sign = if range.signed { d.sign() } else { 1.0 };

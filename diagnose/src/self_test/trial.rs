@@ -158,7 +158,7 @@ fn score_diagnosis(o: &mut Outcome, drawn: &Drawn, diag: &Diagnosis) {
         .collect();
     for (effect, truth) in drawn.catalogued() {
         if let Some(named) = diag.effects.iter().find(|e| e.fit.effect == effect) {
-            let got = effect.params()[0].self_test.scored(named.fit.params[0]);
+            let got = effect.scored(&named.fit.params);
             o.param_errors
                 .push((effect, (got - truth).abs() / truth.abs()));
         }

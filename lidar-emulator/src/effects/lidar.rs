@@ -1,6 +1,6 @@
 //! The lidar's effects together: which are on, and what one beam ranges with them.
 
-use hilsim_sim::scenario::Effects;
+use hilsim_sim::scenario::{Effects, LidarWarmupDrift};
 use hilsim_sim::{RayHit, World};
 
 use super::incidence::incidence_error_m;
@@ -25,8 +25,8 @@ pub struct LidarEffects {
     pub reflectivity: Option<(f64, f64)>,
     /// `lidar_mixed_pixels`: the beam's half-width, radians.
     pub mixed_half_width_rad: Option<f64>,
-    /// `lidar_warmup_drift`: (k per metre, τ seconds) of `k d² e^{−t/τ}`.
-    pub warmup: Option<(f64, f64)>,
+    /// `lidar_warmup_drift`: `(c + k d²) e^{−t/τ}`.
+    pub warmup: Option<LidarWarmupDrift>,
 }
 
 /// What one beam returns before the range model: the centre ray's hit and the range the
@@ -53,9 +53,7 @@ impl LidarEffects {
             mixed_half_width_rad: effects
                 .lidar_mixed_pixels
                 .map(|e| e.half_width_deg.to_radians()),
-            warmup: effects
-                .lidar_warmup_drift
-                .map(|e| (e.coefficient_per_m, e.time_constant_s)),
+            warmup: effects.lidar_warmup_drift,
         }
     }
 
@@ -102,8 +100,8 @@ impl LidarEffects {
         if let Some((c, reference)) = self.reflectivity {
             d += range_walk_m(c, reference, ret.hit.reflectivity);
         }
-        if let Some((k, tau)) = self.warmup {
-            d += warmup_error_m(k, tau, true_d, t_s);
+        if let Some(drift) = &self.warmup {
+            d += warmup_error_m(drift, true_d, t_s);
         }
         d
     }

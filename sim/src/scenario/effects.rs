@@ -132,15 +132,20 @@ pub struct LidarMixedPixels {
 #[serde(deny_unknown_fields)]
 pub struct LidarMotionSkew {}
 
-/// `[effects.lidar_warmup_drift]`: range error `coefficient_per_m · d² · exp(−t / τ)`, t the time
-/// since power-on (the recording's start).
+/// `[effects.lidar_warmup_drift]`: range error `(offset_m + coefficient_per_m · d²) · exp(−t / τ)`,
+/// t the time since power-on (the recording's start): the drift of the range bias's quadratic
+/// term (the laser's pointing) and of its constant term (the housing's expansion), settling
+/// together.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LidarWarmupDrift {
-    /// Per metre: the range error at power-on is this times d².
+    /// Per metre: the quadratic part of the range error at power-on is this times d².
     pub coefficient_per_m: f64,
     /// The thermal time constant τ, seconds.
     pub time_constant_s: f64,
+    /// The constant part of the range error at power-on, metres; default 0.
+    #[serde(default)]
+    pub offset_m: f64,
 }
 
 /// `[effects.sonar_beam_width]`: the sonar's real cone.

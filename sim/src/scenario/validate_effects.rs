@@ -82,6 +82,7 @@ pub(super) fn validate(s: &Scenario) -> Check {
             "a coefficient per metre",
         )?;
         positive_up_to(p("time_constant_s"), x.time_constant_s, 3600.0, "seconds")?;
+        within(p("offset_m"), x.offset_m, -0.5, 0.5, "an offset in metres")?;
     }
     if let Some(x) = e.sonar_beam_width {
         let p = |k: &'static str| key_path!["effects", "sonar_beam_width", k];

@@ -167,7 +167,12 @@ pub(crate) fn fit_candidate(
     let specs = effect.params();
     let train = fit_rows(data, max_fit_rows);
     let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
-    let (params, _) = maximize_shapes(specs, effect.shapes(), &effect.absent(0.0), &mut objective);
+    let (params, _) = maximize_shapes(
+        specs,
+        effect.shapes(ctx.estimated),
+        &effect.absent(0.0),
+        &mut objective,
+    );
     score(ctx, data, base, effect, params, &train)
 }
 

@@ -120,15 +120,16 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
 }
 
 /// As [`maximize`], searching `shapes` one at a time first: each a set of the parameters left
-/// free (indices into `specs`), the others held at `held`; then refining all of them together
-/// from the best shape's maximum. One shape (or none) is [`maximize`] over all.
+/// free (indices into `specs`), the others held at `held`; then, with several, refining all of
+/// them together from the best shape's maximum. No shape is [`maximize`] over all; one is
+/// that shape's maximum with the rest held.
 pub(crate) fn maximize_shapes(
     specs: &[ParamSpec],
     shapes: &[&[usize]],
     held: &[f64],
     f: &mut dyn FnMut(&[f64]) -> f64,
 ) -> (Vec<f64>, f64) {
-    if shapes.len() <= 1 {
+    if shapes.is_empty() {
         return maximize(specs, f);
     }
     let mut best = (held.to_vec(), f64::NEG_INFINITY);
@@ -145,6 +146,9 @@ pub(crate) fn maximize_shapes(
         if v > best.1 {
             best = (full(&y), v);
         }
+    }
+    if shapes.len() == 1 {
+        return best;
     }
     let (x, v) = refine(specs, &best.0, simplex_evals(specs.len()), f);
     if v > best.1 {
@@ -400,6 +404,31 @@ mod tests {
         // A quadratic's curvature is the same everywhere: exact from any point.
         let se = standard_errors(&specs, &x, v, &mut f, 1e-3);
         assert!((se[0] - 0.05).abs() < 1e-6, "{se:?}");
+    }
+
+    /// Two shapes, each one term with a shared scale: the maximum lies in one shape's plane
+    /// (the other term zero), found there and kept by the joint refinement; one shape alone
+    /// holds the parameter it leaves out.
+    #[test]
+    fn shapes_are_searched_one_at_a_time_then_together() {
+        let specs = [
+            spec(-0.05, 0.05, false),
+            spec(1.0, 1000.0, true),
+            spec(-0.1, 0.1, false),
+        ];
+        let m = [0.0, 12.8, 0.031];
+        let mut f = |x: &[f64]| {
+            -((x[0] - m[0]) / 1e-3).powi(2)
+                - ((x[1].ln() - m[1].ln()) / 0.05).powi(2)
+                - ((x[2] - m[2]) / 1e-3).powi(2)
+        };
+        let held = [0.0, 10.0, 0.0];
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], &held, &mut f);
+        assert!((x[0] - m[0]).abs() < 2e-4, "{x:?}");
+        assert!((x[1] / m[1] - 1.0).abs() < 0.02, "{x:?}");
+        assert!((x[2] - m[2]).abs() < 2e-4, "{x:?}");
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], &held, &mut f);
+        assert_eq!(x[2], 0.0, "{x:?}");
     }
 
     #[test]

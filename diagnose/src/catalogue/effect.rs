@@ -347,10 +347,18 @@ impl Effect {
     /// drift") sits between the joint grid's coarse points but on that shape's own grid, and
     /// Nelder–Mead over all three from the joint grid was measured to stop at τ's bound (an
     /// independent reality's k = −0.0044 /m, τ = 12.8 s fitted as τ = 1 s).
+    ///
+    /// Against a trajectory estimated from the lidar itself (`estimated`) the warm-up's
+    /// constant term is held at zero: the scan matching takes a range offset that every beam
+    /// shares into the pose (the robot a few centimetres further from what it sees), so the
+    /// term is not identifiable there and would only take up what other effects leave
+    /// (measured: the independent reality's 20 trials without truth named it beside a
+    /// concealed incidence, 7/20 false alarms against 5/20 without the term).
     #[must_use]
-    pub fn shapes(self) -> &'static [&'static [usize]] {
-        match self {
-            Effect::LidarWarmupDrift => &[&[0, 1], &[2, 1]],
+    pub fn shapes(self, estimated: bool) -> &'static [&'static [usize]] {
+        match (self, estimated) {
+            (Effect::LidarWarmupDrift, false) => &[&[0, 1], &[2, 1]],
+            (Effect::LidarWarmupDrift, true) => &[&[0, 1]],
             _ => &[],
         }
     }

@@ -118,6 +118,16 @@ mod tests {
         std::io::Read::read_to_string(child.stdout.as_mut().unwrap(), &mut out).unwrap();
         child.wait().unwrap();
         let escaped: u32 = out.trim().parse().unwrap();
+        // Until the forked shell has become `sleep`, its environment may read empty (the
+        // kernel swaps its memory during exec): wait for the exec, as a firmware's daemon
+        // would have long done by the time its run ends.
+        for _ in 0..500 {
+            let comm = std::fs::read_to_string(format!("/proc/{escaped}/comm"));
+            if comm.is_ok_and(|c| c.trim_end() == "sleep") {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
         let found = kill_all(&lineage, None);
         assert!(found.iter().any(|p| p.pid == escaped), "{found:?}");
         assert!(crate::process::has_exited(escaped, Duration::from_secs(2)));

@@ -30,8 +30,10 @@ fn setup() -> (Scenario, Recording) {
     nominal.duration_s = Some(60.0);
     let mut real = nominal.clone();
     real.seed = 1234;
-    real.effects.lidar_incidence_angle =
-        Some(hilsim_sim::scenario::LidarIncidenceAngle { coefficient: 0.02 });
+    real.effects.lidar_incidence_angle = Some(hilsim_sim::scenario::LidarIncidenceAngle {
+        coefficient: 0.02,
+        collimated_m: 0.0,
+    });
     (nominal, record(&real))
 }
 

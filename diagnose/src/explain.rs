@@ -170,6 +170,7 @@ pub(crate) fn fit_candidate(
     let (params, _) = maximize_shapes(
         specs,
         effect.shapes(ctx.estimated),
+        effect.shapes_refined_together(),
         &effect.absent(0.0),
         &mut objective,
     );

@@ -120,12 +120,13 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
 }
 
 /// As [`maximize`], searching `shapes` one at a time first: each a set of the parameters left
-/// free (indices into `specs`), the others held at `held`; then, with several, refining all of
-/// them together from the best shape's maximum. No shape is [`maximize`] over all; one is
-/// that shape's maximum with the rest held.
+/// free (indices into `specs`), the others held at `held`; then, with several and `together`,
+/// refining all of them together from the best shape's maximum. No shape is [`maximize`] over
+/// all; one (or several not `together`) is the best shape's maximum with the rest held.
 pub(crate) fn maximize_shapes(
     specs: &[ParamSpec],
     shapes: &[&[usize]],
+    together: bool,
     held: &[f64],
     f: &mut dyn FnMut(&[f64]) -> f64,
 ) -> (Vec<f64>, f64) {
@@ -147,7 +148,7 @@ pub(crate) fn maximize_shapes(
             best = (full(&y), v);
         }
     }
-    if shapes.len() == 1 {
+    if shapes.len() == 1 || !together {
         return best;
     }
     let (x, v) = refine(specs, &best.0, simplex_evals(specs.len()), f);
@@ -423,11 +424,11 @@ mod tests {
                 - ((x[2] - m[2]) / 1e-3).powi(2)
         };
         let held = [0.0, 10.0, 0.0];
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], &held, &mut f);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], true, &held, &mut f);
         assert!((x[0] - m[0]).abs() < 2e-4, "{x:?}");
         assert!((x[1] / m[1] - 1.0).abs() < 0.02, "{x:?}");
         assert!((x[2] - m[2]).abs() < 2e-4, "{x:?}");
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], &held, &mut f);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], true, &held, &mut f);
         assert_eq!(x[2], 0.0, "{x:?}");
     }
 

@@ -73,8 +73,10 @@ fn incidence_angle_adds_kappa_d_tan_theta() {
     let nominal = scenario(world, NOISELESS_LIDAR);
     let mut tilted = nominal.clone();
     let kappa = 0.01;
-    tilted.effects.lidar_incidence_angle =
-        Some(hilsim_sim::scenario::LidarIncidenceAngle { coefficient: kappa });
+    tilted.effects.lidar_incidence_angle = Some(hilsim_sim::scenario::LidarIncidenceAngle {
+        coefficient: kappa,
+        collimated_m: 0.0,
+    });
     let (a, b) = (lidar(&nominal), lidar(&tilted));
     for angle in [0u16, 5, 10] {
         let (ra, rb) = (at(&a, angle), at(&b, angle));

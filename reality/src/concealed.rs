@@ -5,8 +5,9 @@
 /// One concealed effect with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Concealed {
-    /// The lidar reads `κ d tan θ` long (θ the incidence angle, capped at 80°).
-    LidarIncidence { coefficient: f64 },
+    /// The lidar reads `(κ d + c) tan θ` long (θ the incidence angle, capped at 80°): a
+    /// diverging beam's footprint and a collimated one's.
+    LidarIncidence { coefficient: f64, collimated_m: f64 },
     /// The lidar's range walks by `c (ρ_ref/ρ − 1)` on a surface of reflectivity ρ.
     LidarReflectivity { coefficient_m: f64, reference: f64 },
     /// The beam has an angular half-width; a footprint over several surfaces returns the

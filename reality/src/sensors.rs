@@ -191,7 +191,10 @@ impl Run<'_> {
         let mut measured = d;
         for c in self.concealed {
             measured += match *c {
-                Concealed::LidarIncidence { coefficient } => coefficient * d * theta.tan(),
+                Concealed::LidarIncidence {
+                    coefficient,
+                    collimated_m,
+                } => (coefficient * d + collimated_m) * theta.tan(),
                 Concealed::LidarReflectivity {
                     coefficient_m,
                     reference,

@@ -34,7 +34,10 @@ impl Effect {
         let e = effects;
         match self {
             Effect::LidarIncidenceAngle => {
-                e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle { coefficient: p(0) });
+                e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle {
+                    coefficient: p(0),
+                    collimated_m: p(1),
+                });
             }
             Effect::LidarReflectivity => {
                 e.lidar_reflectivity = Some(scenario::LidarReflectivity {

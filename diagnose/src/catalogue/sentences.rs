@@ -11,8 +11,10 @@ impl Effect {
         match self {
             Effect::LidarIncidenceAngle => format!(
                 "The simulated lidar ranges every surface as if it met it head-on; the real one's \
-                 range error grows with the angle of incidence ({:+.1} mm per metre at 45°).",
-                p(0) * 1000.0
+                 range error grows with the angle of incidence ({:+.1} mm at 45° at 1 m, {:+.1} mm \
+                 at 4 m).",
+                (p(0) + p(1)) * 1000.0,
+                (p(0) * 4.0 + p(1)) * 1000.0
             ),
             Effect::LidarReflectivity => format!(
                 "The simulated lidar ranges every material alike; the real one's range walks with \

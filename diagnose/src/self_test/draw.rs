@@ -94,7 +94,10 @@ const TWO_EFFECTS: f64 = 0.2;
 pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
     let p = |i: usize| values.get(i).copied().unwrap_or(0.0);
     match effect {
-        Effect::LidarIncidenceAngle => Concealed::LidarIncidence { coefficient: p(0) },
+        Effect::LidarIncidenceAngle => Concealed::LidarIncidence {
+            coefficient: p(0),
+            collimated_m: p(1),
+        },
         Effect::LidarReflectivity => Concealed::LidarReflectivity {
             coefficient_m: p(0),
             reference: REFERENCE_REFLECTIVITY,
@@ -269,17 +272,26 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
 /// `effect`'s parameters' true values, each from its [`SelfTestRange`]; the warm-up's drift
 /// then, on a fair coin, all in its constant term (the same error at 2 m at power-on, what
 /// the self-test scores it by): a unit whose housing drifts rather than its pointing, or
-/// another simulator's reading of "the range bias drifts".
+/// another simulator's reading of "the range bias drifts"; the incidence's likewise in its
+/// collimated term (the same error at 2 m and 45°).
 fn draw_values(effect: Effect, d: &mut Draws, strength: f64, nominal: &Scenario) -> Vec<f64> {
     let mut values: Vec<f64> = effect
         .params()
         .iter()
         .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
         .collect();
-    if effect == Effect::LidarWarmupDrift && d.next() & 1 == 0 {
-        let at_2m = effect.scored(&values);
-        values[0] = 0.0;
-        values[2] = at_2m;
+    // The second term of the warm-up (its constant) and of the incidence (a collimated beam).
+    let second = match effect {
+        Effect::LidarWarmupDrift => Some(2),
+        Effect::LidarIncidenceAngle => Some(1),
+        _ => None,
+    };
+    if let Some(i) = second {
+        if d.next() & 1 == 0 {
+            let scored = effect.scored(&values);
+            values[0] = 0.0;
+            values[i] = scored;
+        }
     }
     values
 }

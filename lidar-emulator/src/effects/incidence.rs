@@ -8,10 +8,15 @@
 //! (its near half returns more: Lambert's cosine and 1/r², and the triangulation receiver's spot
 //! image is skewed), so the reported range sits a fixed fraction of the footprint's depth from
 //! its centre: `Δd = κ d tan θ`. κ lumps the divergence and the asymmetry; it is the unit's own,
-//! to be fitted. Measurements of terrestrial scanners show the same growth of the error with
+//! to be fitted. A collimated beam (a laser spot a few millimetres wide whatever the range, as
+//! the XV-11's over its few metres) lights a footprint of fixed width w, `w tan θ` deep, and its
+//! centroid sits `c tan θ` off for any range, c a fraction of w. The model is both,
+//! `Δd = (κ d + c) tan θ`. Measurements of terrestrial scanners show the same growth of the error with
 //! obliquity (Soudarissanane, Lindenbergh, Menenti, Teunissen, "Scanning geometry: influencing
 //! factor on the quality of terrestrial laser scanning points", ISPRS J. Photogramm. Remote
 //! Sens. 66 (2011)).
+
+use hilsim_sim::scenario::LidarIncidenceAngle;
 
 /// Incidence beyond this is treated as this (tan 80° ≈ 5.7): at grazing incidence the footprint
 /// model breaks down and the return is usually too weak to range anyway.
@@ -26,17 +31,22 @@ pub fn tan_incidence(cos_incidence: f64) -> f64 {
     theta.tan()
 }
 
-/// The range error `κ d tan θ`, metres, of a beam at range `d_m` meeting a surface with
-/// `cos θ = cos_incidence`.
+/// The range error `(κ d + c) tan θ`, metres, of a beam at range `d_m` meeting a surface with
+/// `cos θ = cos_incidence`, for `effect`'s κ (`coefficient`) and c (`collimated_m`).
 ///
 /// ```
 /// use hilsim_lidar_emulator::effects::incidence_error_m;
+/// use hilsim_sim::scenario::LidarIncidenceAngle;
+/// let diverging = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0 };
 /// // 45°: tan θ = 1, so 1 % of 2 m.
-/// let e = incidence_error_m(0.01, 2.0, std::f64::consts::FRAC_1_SQRT_2);
+/// let e = incidence_error_m(&diverging, 2.0, std::f64::consts::FRAC_1_SQRT_2);
 /// assert!((e - 0.02).abs() < 1e-12);
-/// assert_eq!(incidence_error_m(0.01, 2.0, 1.0), 0.0);
+/// assert_eq!(incidence_error_m(&diverging, 2.0, 1.0), 0.0);
+/// let collimated = LidarIncidenceAngle { coefficient: 0.0, collimated_m: 0.005 };
+/// let e = incidence_error_m(&collimated, 4.0, std::f64::consts::FRAC_1_SQRT_2);
+/// assert!((e - 0.005).abs() < 1e-12);
 /// ```
 #[must_use]
-pub fn incidence_error_m(coefficient: f64, d_m: f64, cos_incidence: f64) -> f64 {
-    coefficient * d_m * tan_incidence(cos_incidence)
+pub fn incidence_error_m(effect: &LidarIncidenceAngle, d_m: f64, cos_incidence: f64) -> f64 {
+    (effect.coefficient * d_m + effect.collimated_m) * tan_incidence(cos_incidence)
 }

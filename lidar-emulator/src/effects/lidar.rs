@@ -1,6 +1,6 @@
 //! The lidar's effects together: which are on, and what one beam ranges with them.
 
-use hilsim_sim::scenario::{Effects, LidarWarmupDrift};
+use hilsim_sim::scenario::{Effects, LidarIncidenceAngle, LidarWarmupDrift};
 use hilsim_sim::{RayHit, World};
 
 use super::incidence::incidence_error_m;
@@ -14,13 +14,15 @@ use super::warmup::warmup_error_m;
 /// use hilsim_lidar_emulator::effects::LidarEffects;
 /// let nominal = LidarEffects::default();
 /// assert!(nominal.is_nominal());
-/// let tilted = LidarEffects { incidence_coefficient: Some(0.01), ..LidarEffects::default() };
+/// use hilsim_sim::scenario::LidarIncidenceAngle;
+/// let incidence = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0 };
+/// let tilted = LidarEffects { incidence: Some(incidence), ..LidarEffects::default() };
 /// assert!(!tilted.is_nominal());
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LidarEffects {
-    /// `lidar_incidence_angle`: κ of `κ d tan θ`.
-    pub incidence_coefficient: Option<f64>,
+    /// `lidar_incidence_angle`: `(κ d + c) tan θ`.
+    pub incidence: Option<LidarIncidenceAngle>,
     /// `lidar_reflectivity`: (c metres, ρ_ref) of `c (ρ_ref / ρ − 1)`.
     pub reflectivity: Option<(f64, f64)>,
     /// `lidar_mixed_pixels`: the beam's half-width, radians.
@@ -46,7 +48,7 @@ impl LidarEffects {
     #[must_use]
     pub fn from_scenario(effects: &Effects) -> Self {
         Self {
-            incidence_coefficient: effects.lidar_incidence_angle.map(|e| e.coefficient),
+            incidence: effects.lidar_incidence_angle,
             reflectivity: effects
                 .lidar_reflectivity
                 .map(|e| (e.coefficient_m, e.reference)),
@@ -94,8 +96,8 @@ impl LidarEffects {
     pub fn ranged_m(&self, ret: &BeamReturn, t_s: f64) -> f64 {
         let mut d = ret.footprint_m;
         let true_d = ret.hit.distance;
-        if let Some(k) = self.incidence_coefficient {
-            d += incidence_error_m(k, true_d, ret.cos_incidence);
+        if let Some(incidence) = &self.incidence {
+            d += incidence_error_m(incidence, true_d, ret.cos_incidence);
         }
         if let Some((c, reference)) = self.reflectivity {
             d += range_walk_m(c, reference, ret.hit.reflectivity);

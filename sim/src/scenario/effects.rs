@@ -89,14 +89,18 @@ impl Effects {
     }
 }
 
-/// `[effects.lidar_incidence_angle]`: range error `coefficient · d · tan θ`, θ the angle between
-/// the beam and the surface normal.
+/// `[effects.lidar_incidence_angle]`: range error `(coefficient · d + collimated_m) · tan θ`, θ
+/// the angle between the beam and the surface normal: the footprint of a diverging beam (its
+/// depth grows with the range) and of a collimated one (a fixed width).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LidarIncidenceAngle {
     /// Dimensionless: the range error per metre of range per unit of `tan θ`; positive reads
     /// long.
     pub coefficient: f64,
+    /// Metres: the range-independent error per unit of `tan θ` (at 45°); default 0.
+    #[serde(default)]
+    pub collimated_m: f64,
 }
 
 /// `[effects.lidar_reflectivity]`: range walk `coefficient_m · (reference / ρ − 1)`, ρ the

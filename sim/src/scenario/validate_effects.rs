@@ -48,6 +48,7 @@ pub(super) fn validate(s: &Scenario) -> Check {
         let p = |k: &'static str| key_path!["effects", "lidar_incidence_angle", k];
         needs(p("coefficient"), lidar.is_some(), "lidar")?;
         within(p("coefficient"), x.coefficient, -0.2, 0.2, "a coefficient")?;
+        within(p("collimated_m"), x.collimated_m, -0.1, 0.1, "metres")?;
     }
     if let Some(x) = e.lidar_reflectivity {
         let p = |k: &'static str| key_path!["effects", "lidar_reflectivity", k];

@@ -118,11 +118,28 @@ fn score(
     params: Vec<f64>,
     train: &[usize],
 ) -> CandidateFit {
-    let specs = effect.params();
+    // The curvature and the BIC's count are the free parameters' (a held one was not fitted,
+    // its standard error is 0).
+    let free = effect.free(&params, ctx.estimated);
+    let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
     let train_base = total_ll(ctx, data, base, train);
-    let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), train);
-    let best = objective(&params);
-    let param_sd = standard_errors(specs, &params, best, &mut objective, 2e-3);
+    let with_free = |y: &[f64]| {
+        let mut x = params.clone();
+        for (&i, &v) in free.iter().zip(y) {
+            x[i] = v;
+        }
+        x
+    };
+    let mut objective = |y: &[f64]| total_ll(ctx, data, &base.and(effect, with_free(y)), train);
+    let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
+    let best = objective(&at);
+    let mut param_sd = vec![0.0; params.len()];
+    for (&i, sd) in free
+        .iter()
+        .zip(standard_errors(&specs, &at, best, &mut objective, 2e-3))
+    {
+        param_sd[i] = sd;
+    }
     let fitted = base.and(effect, params.clone());
     let heldout = data.rows(Some(true));
     let before_p = ctx.predict(data, base, &heldout);
@@ -192,19 +209,33 @@ pub(crate) fn refit_jointly(
         return chosen.to_vec();
     }
     let train = fit_rows(data, max_fit_rows);
+    // Each effect's free parameters refitted, its held ones kept.
+    let free: Vec<Vec<usize>> = chosen
+        .iter()
+        .map(|c| c.effect.free(&c.params, ctx.estimated))
+        .collect();
     let specs: Vec<ParamSpec> = chosen
         .iter()
-        .flat_map(|c| c.effect.params().iter().copied())
+        .zip(&free)
+        .flat_map(|(c, f)| f.iter().map(|&i| c.effect.params()[i]))
         .collect();
-    let start: Vec<f64> = chosen.iter().flat_map(|c| c.params.clone()).collect();
+    let start: Vec<f64> = chosen
+        .iter()
+        .zip(&free)
+        .flat_map(|(c, f)| f.iter().map(|&i| c.params[i]))
+        .collect();
     let split = |x: &[f64]| -> Vec<(Effect, Vec<f64>)> {
         let mut at = 0;
         chosen
             .iter()
-            .map(|c| {
-                let k = c.effect.params().len();
-                at += k;
-                (c.effect, x[at - k..at].to_vec())
+            .zip(&free)
+            .map(|(c, f)| {
+                let mut params = c.params.clone();
+                for &i in f {
+                    params[i] = x[at];
+                    at += 1;
+                }
+                (c.effect, params)
             })
             .collect()
     };

@@ -373,6 +373,43 @@ impl Effect {
         }
     }
 
+    /// The parameters its fit left free at `params` (indices into [`Effect::params`]): those of
+    /// its [`Effect::shapes`] (all with none), and of alternative shapes the one `params` is
+    /// in (a parameter of another shape departs from its absence); the rest were held at
+    /// their absence and are not estimates.
+    #[must_use]
+    pub fn free(self, params: &[f64], estimated: bool) -> Vec<usize> {
+        let shapes = self.shapes(estimated);
+        if shapes.is_empty() {
+            return (0..self.params().len()).collect();
+        }
+        let absent = self.absent(0.0);
+        let mut free: Vec<usize> = Vec::new();
+        let mut chosen: Vec<&[usize]> = shapes.to_vec();
+        if !self.shapes_refined_together() {
+            let departs = |shape: &[usize]| {
+                shape
+                    .iter()
+                    .any(|&i| params.get(i) != absent.get(i) && !shapes[0].contains(&i))
+            };
+            chosen = vec![shapes
+                .iter()
+                .skip(1)
+                .find(|s| departs(s))
+                .copied()
+                .unwrap_or(shapes[0])];
+        }
+        for shape in chosen {
+            for &i in shape {
+                if !free.contains(&i) {
+                    free.push(i);
+                }
+            }
+        }
+        free.sort_unstable();
+        free
+    }
+
     /// Whether the best of [`Effect::shapes`] is refined with all parameters free. Not the
     /// incidence's: a beam diverges or is collimated over a unit's range, and the two terms
     /// together trade against each other (an independent simulator's range-independent error,

@@ -136,7 +136,11 @@ fn fix(s: &mut String, d: &Diagnosis) {
                 "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 spec.name,
                 fmt_sig(f.params[i]),
-                fmt_sig(f.param_sd[i]),
+                if f.param_sd[i] == 0.0 {
+                    "held".to_string()
+                } else {
+                    fmt_sig(f.param_sd[i])
+                },
                 spec.unit
             );
         }

@@ -20,6 +20,13 @@ pub fn summary(d: &Diagnosis) -> String {
             .enumerate()
             .map(|(i, spec)| {
                 let sd = f.param_sd[i];
+                // A standard error of exactly 0: a parameter the fit held at its absence.
+                if sd == 0.0 {
+                    return format!("{} = {} {}", spec.name, fmt_sig(f.params[i]), spec.unit)
+                        .trim_end()
+                        .to_string()
+                        + " (held)";
+                }
                 let sd = if sd.is_finite() {
                     format!(" ± {}", fmt_sig(sd))
                 } else {

@@ -180,9 +180,10 @@ impl Effect {
     /// The fit's ranges are wide enough for any plausible unit (several times the self-test's
     /// draws) and the grids fine enough that the likelihood is unimodal between neighbouring
     /// points. The self-test's moderate ranges (× its strength unless said): incidence κ
-    /// ±[0.01, 0.03], on a fair coin moved to its collimated term (the same error at 2 m); reflectivity c ±[0.008, 0.02] m; mixed pixels half-width [0.5, 1.5]°
+    /// ±[0.01, 0.03]; reflectivity c ±[0.008, 0.02] m; mixed pixels half-width [0.5, 1.5]°
     /// (at most 5°); motion skew the head's own period; warm-up k ±[0.004, 0.01] /m with τ in
-    /// [5, 20] s (unscaled), on a fair coin moved to its constant term (the same error at 2 m); sonar cone [8, 20]° (at most 60°); air temperature 20 °C ±
+    /// [5, 20] s (unscaled) — these two, on a fair coin, moved whole to their second term (the
+    /// same scored error; `draw_values`); sonar cone [8, 20]° (at most 60°); air temperature 20 °C ±
     /// [15, 30] °C (within [−50, 60] °C, scored as the departure from 20 °C); slip gain
     /// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
     /// position ±[0.01, 0.03] m; latency [0.02, 0.08] s; each wheel's radius scale 1 ±
@@ -344,9 +345,10 @@ impl Effect {
         }
     }
 
-    /// The shapes its fit searches one at a time before refining every parameter together:
-    /// each the parameters left free (indices into [`Effect::params`]), the others at their
-    /// [`Effect::absent`] values. One shape (all parameters) but for the warm-up, whose drift
+    /// The shapes its fit searches one at a time before (see
+    /// [`Effect::shapes_refined_together`]) refining every parameter together: each the
+    /// parameters left free (indices into [`Effect::params`]), the others at their
+    /// [`Effect::absent`] values. None (all parameters at once) but for the warm-up, whose drift
     /// is searched in its quadratic term with τ and in its constant term with τ: a drift all in
     /// one term (as a unit's pointing or its housing makes it, or another simulator's "bias
     /// drift") sits between the joint grid's coarse points but on that shape's own grid, and

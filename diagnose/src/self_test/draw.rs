@@ -280,13 +280,13 @@ fn draw_values(effect: Effect, d: &mut Draws, strength: f64, nominal: &Scenario)
         .iter()
         .map(|spec| draw_value(&spec.self_test, d, strength, nominal))
         .collect();
-    // The second term of the warm-up (its constant) and of the incidence (a collimated beam).
-    let second = match effect {
-        Effect::LidarWarmupDrift => Some(2),
-        Effect::LidarIncidenceAngle => Some(1),
-        _ => None,
-    };
-    if let Some(i) = second {
+    // An effect of two shapes (the warm-up's constant, the incidence's collimated beam): the
+    // parameter of the second that the first does not have.
+    let shapes = effect.shapes(false);
+    let second = shapes
+        .get(1)
+        .and_then(|s| s.iter().find(|i| !shapes[0].contains(i)));
+    if let Some(&i) = second {
         if d.next() & 1 == 0 {
             let scored = effect.scored(&values);
             values[0] = 0.0;

@@ -11,8 +11,8 @@
 //! to be fitted. A collimated beam (a laser spot a few millimetres wide whatever the range, as
 //! the XV-11's over its few metres) lights a footprint of fixed width w, `w tan θ` deep, and its
 //! centroid sits `c tan θ` off for any range, c a fraction of w. The model is both,
-//! `Δd = (κ d + c) tan θ`. Measurements of terrestrial scanners show the same growth of the error with
-//! obliquity (Soudarissanane, Lindenbergh, Menenti, Teunissen, "Scanning geometry: influencing
+//! `Δd = (κ d + c) tan θ`. Measurements of terrestrial scanners show the same growth of the
+//! error with obliquity (Soudarissanane, Lindenbergh, Menenti, Teunissen, "Scanning geometry: influencing
 //! factor on the quality of terrestrial laser scanning points", ISPRS J. Photogramm. Remote
 //! Sens. 66 (2011)).
 

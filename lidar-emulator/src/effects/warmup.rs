@@ -14,8 +14,8 @@
 //! timing, or a simulator that drifts the whole bias, shows centimetres). The model is the
 //! drift of the range bias's constant and quadratic terms, `(c + k d²) e^{−t/τ}`; the linear
 //! term's drift, the baseline's own expansion (`Δd = d Δb / b`, 0.05 % over 20 K: 2 mm at
-//! 4 m), is below the unit's noise and left out. Such drift of a range finder during its first minutes of operation is well
-//! documented (e.g. Ye and Borenstein, "Characterization of a 2-D laser scanner for mobile robot
+//! 4 m), is below the unit's noise and left out. Such drift of a range finder during its first
+//! minutes of operation is well documented (e.g. Ye and Borenstein, "Characterization of a 2-D laser scanner for mobile robot
 //! obstacle negotiation", ICRA 2002, on the SICK LMS 200).
 
 use hilsim_sim::scenario::LidarWarmupDrift;

@@ -136,8 +136,8 @@ pub struct LidarMixedPixels {
 #[serde(deny_unknown_fields)]
 pub struct LidarMotionSkew {}
 
-/// `[effects.lidar_warmup_drift]`: range error `(offset_m + coefficient_per_m · d²) · exp(−t / τ)`,
-/// t the time since power-on (the recording's start): the drift of the range bias's quadratic
+/// `[effects.lidar_warmup_drift]`: range error
+/// `(offset_m + coefficient_per_m · d²) · exp(−t / τ)`, t the time since power-on (the recording's start): the drift of the range bias's quadratic
 /// term (the laser's pointing) and of its constant term (the housing's expansion), settling
 /// together.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]

@@ -47,7 +47,7 @@ pub use locate::{Evidence, Floors, TestKind};
 pub use outcome::{Diagnosis, NamedEffect, Options, SensorSummary, Verdict};
 pub use physics::{
     Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
-    OdometryPrediction, Physics, SonarPrediction,
+    Mixture, OdometryPrediction, Physics, SonarPrediction,
 };
 pub use plot::PlotData;
 pub use residuals::Covariate;

@@ -18,7 +18,10 @@ pub struct Options {
     pub floors: Floors,
     /// The effects tried (default: the whole catalogue).
     pub effects: Vec<Effect>,
-    /// Training readings per sensor used to fit an effect (evenly thinned beyond this).
+    /// Training readings per sensor used to fit an effect (evenly thinned beyond this). The
+    /// default, 6,000, fits a lidar effect's parameters to a standard error well under the
+    /// self-test's 20 % (`--self-test 20 --seed 1 --reality independent`: median error 0.4 %,
+    /// the same as with 15,000) in 2.2 times less time; the held-out score uses every reading.
     pub max_fit_rows: usize,
     /// Share of a sensor's readings that are outliers to the simulation (the outlier component
     /// explains them better than the prediction) above which the recording "does not align".
@@ -32,7 +35,7 @@ impl Default for Options {
             min_gain: 10.0,
             floors: Floors::default(),
             effects: Effect::ALL.to_vec(),
-            max_fit_rows: 15_000,
+            max_fit_rows: 6_000,
             misaligned_share: 0.5,
         }
     }

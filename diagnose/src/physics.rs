@@ -6,6 +6,7 @@
 //! statistics here would work with any simulator that implements it.
 
 pub use hilsim_lidar_emulator::normal::Gaussian;
+pub use hilsim_lidar_emulator::prediction::Mixture;
 use hilsim_recording::{CommandSample, TruthSample};
 
 use crate::catalogue::Effect;
@@ -125,7 +126,7 @@ pub struct LidarQuery {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LidarPrediction {
     /// The mixture a valid reading comes from; empty: no valid reading expected.
-    pub components: Vec<Gaussian>,
+    pub components: Mixture,
     /// The centre ray's true range, metres.
     pub true_range_m: Option<f64>,
     /// The angle between the beam and the surface normal, degrees.

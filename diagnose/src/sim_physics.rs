@@ -5,7 +5,7 @@
 
 use crate::{
     Declared, DeclaredActuation, DeclaredLidar, Effect, Gaussian, Hypothesis, LidarPrediction,
-    LidarQuery, MismatchError, OdometryPrediction, Physics, SonarPrediction, Trajectory,
+    LidarQuery, MismatchError, Mixture, OdometryPrediction, Physics, SonarPrediction, Trajectory,
 };
 use hilsim_lidar_emulator::effects::{real_mount, LidarEffects};
 use hilsim_lidar_emulator::prediction::{
@@ -407,7 +407,7 @@ impl Physics for SimPhysics {
 
 fn empty_lidar() -> LidarPrediction {
     LidarPrediction {
-        components: Vec::new(),
+        components: Mixture::new(),
         true_range_m: None,
         incidence_deg: 0.0,
         object: None,

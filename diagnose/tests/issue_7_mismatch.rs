@@ -102,7 +102,7 @@ impl Physics for Corridor {
                 let p = tr.pose_at(q.t_s);
                 let (mean, cos) = Corridor::mean(p, q.angle_deg, kappa, 0.0);
                 LidarPrediction {
-                    components: vec![Gaussian::new(1.0, mean, SD)],
+                    components: [Gaussian::new(1.0, mean, SD)].into_iter().collect(),
                     true_range_m: Some(cast(p, p.yaw + q.angle_deg.to_radians()).0),
                     incidence_deg: cos.acos().to_degrees(),
                     object: Some(0),

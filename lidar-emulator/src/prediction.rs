@@ -15,6 +15,7 @@
 //! Readings are millimetres, so every spread includes the rounding's `1 mm / √12`.
 
 use hilsim_sim::{scenario, Obstacle, Pose, World};
+use smallvec::SmallVec;
 
 use crate::effects::{BeamReturn, LidarEffects};
 use crate::neato_packet::MAX_DISTANCE_MM;
@@ -52,6 +53,10 @@ const GH_WEIGHTS: [f64; 7] = [
 const DENSE_NODES: usize = 15;
 const DENSE_SPACING: f64 = 0.5;
 
+/// A predictive mixture: one Gaussian per surface the beam can land on; held inline, as it is
+/// one or two but at an edge, so that a prediction allocates nothing.
+pub type Mixture = SmallVec<[Gaussian; 2]>;
+
 /// The predictive distribution of one lidar reading, and the beam's geometry.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExpectedLidar {
@@ -59,7 +64,7 @@ pub struct ExpectedLidar {
     /// noise can land on, truncated to the readings reported valid (a reading beyond a range
     /// limit is reported invalid instead); empty when no valid reading is expected (nothing
     /// hit, or out of range).
-    pub components: Vec<Gaussian>,
+    pub components: Mixture,
     /// The centre ray's true range, when it hit something.
     pub true_range_m: Option<f64>,
     /// `|cos θ|` of the centre ray on its surface.
@@ -85,6 +90,20 @@ pub struct BeamNodes {
     /// Whether the nodes sample the direction densely (an edge within reach) rather than by
     /// Gauss–Hermite quadrature.
     pub dense: bool,
+}
+
+/// A beam's nodes as cast, on the stack (at most [`DENSE_NODES`]).
+struct CastNodes {
+    at: [(f64, Option<BeamReturn>); DENSE_NODES],
+    len: usize,
+    centre: usize,
+    dense: bool,
+}
+
+impl CastNodes {
+    fn nodes(&self) -> &[(f64, Option<BeamReturn>)] {
+        &self.at[..self.len]
+    }
 }
 
 /// Predicts the readings of a scenario's lidar with given effects.
@@ -137,50 +156,62 @@ impl LidarPredictor {
     /// pixels when that effect is on).
     #[must_use]
     pub fn beam_nodes(&self, world: &World, robot: &Pose, angle_deg: f64) -> BeamNodes {
+        let cast = self.cast_nodes(world, robot, angle_deg);
+        BeamNodes {
+            nodes: cast.nodes().to_vec(),
+            centre: cast.centre,
+            dense: cast.dense,
+        }
+    }
+
+    /// [`LidarPredictor::beam_nodes`] on the stack: a prediction that is not kept allocates
+    /// nothing for its nodes.
+    fn cast_nodes(&self, world: &World, robot: &Pose, angle_deg: f64) -> CastNodes {
         let (origin, heading) = self.beam(robot, angle_deg);
         let cast = |o: f64| {
             self.effects
                 .beam_return(world, origin, heading + o, self.cast_limit_m)
         };
+        let mut out = CastNodes {
+            at: [(0.0, None); DENSE_NODES],
+            len: 1,
+            centre: 0,
+            dense: false,
+        };
         if self.angle_noise_rad <= 0.0 {
-            return BeamNodes {
-                nodes: vec![(1.0, cast(0.0))],
-                centre: 0,
-                dense: false,
-            };
+            out.at[0] = (1.0, cast(0.0));
+            return out;
         }
         let sigma = self.angle_noise_rad;
-        let nodes: Vec<(f64, Option<BeamReturn>)> = GH_NODES
-            .iter()
-            .zip(GH_WEIGHTS)
-            .map(|(x, w)| (w, cast(std::f64::consts::SQRT_2 * sigma * x)))
-            .collect();
-        let centre = nodes[3].1.map(|r| r.hit.obstacle);
-        let uniform = nodes.iter().all(|(_, r)| {
+        for (k, (x, w)) in GH_NODES.iter().zip(GH_WEIGHTS).enumerate() {
+            out.at[k] = (w, cast(std::f64::consts::SQRT_2 * sigma * x));
+        }
+        out.len = GH_NODES.len();
+        out.centre = GH_NODES.len() / 2;
+        let centre = out.at[out.centre].1.map(|r| r.hit.obstacle);
+        let uniform = out.nodes().iter().all(|(_, r)| {
             r.map(|r| r.hit.obstacle) == centre && r.is_none_or(|r| r.footprint_m == r.hit.distance)
         });
         if uniform {
-            return BeamNodes {
-                nodes,
-                centre: 3,
-                dense: false,
-            };
+            return out;
         }
         // An edge (or a footprint that mixes) within reach of the direction noise: the reading
         // is no longer a smooth function of the direction, so sample it densely.
         let half = DENSE_NODES / 2;
-        let nodes = (0..DENSE_NODES)
-            .map(|k| {
-                let x = (k as f64 - half as f64) * DENSE_SPACING;
-                ((-0.5 * x * x).exp(), cast(x * sigma))
-            })
-            .collect::<Vec<_>>();
-        let total: f64 = nodes.iter().map(|(w, _)| w).sum();
-        BeamNodes {
-            nodes: nodes.into_iter().map(|(w, r)| (w / total, r)).collect(),
-            centre: half,
-            dense: true,
+        let mut total = 0.0;
+        for k in 0..DENSE_NODES {
+            let x = (k as f64 - half as f64) * DENSE_SPACING;
+            let w = (-0.5 * x * x).exp();
+            total += w;
+            out.at[k] = (w, cast(x * sigma));
         }
+        for node in &mut out.at {
+            node.0 /= total;
+        }
+        out.len = DENSE_NODES;
+        out.centre = half;
+        out.dense = true;
+        out
     }
 
     /// Whether no surface but the centre's lies within `margin_rad` (beyond the quadrature's
@@ -215,9 +246,21 @@ impl LidarPredictor {
     /// (and the skew of the mean) its direction noise gives, and an edge a mixture.
     #[must_use]
     pub fn predict_nodes(&self, beam: &BeamNodes, t_s: f64) -> ExpectedLidar {
-        let centre = beam.nodes.get(beam.centre).and_then(|(_, r)| *r);
+        self.predict_from(&beam.nodes, beam.centre, beam.dense, t_s)
+    }
+
+    /// [`LidarPredictor::predict_nodes`] of the nodes `beam` (centre `centre`, sampled densely
+    /// when `dense`), with its working sets on the stack.
+    fn predict_from(
+        &self,
+        beam: &[(f64, Option<BeamReturn>)],
+        centre: usize,
+        dense: bool,
+        t_s: f64,
+    ) -> ExpectedLidar {
+        let centre = beam.get(centre).and_then(|(_, r)| *r);
         let mut out = ExpectedLidar {
-            components: Vec::new(),
+            components: Mixture::new(),
             true_range_m: centre.map(|c| c.hit.distance),
             cos_incidence: centre.map_or(1.0, |c| c.cos_incidence),
             obstacle: centre.map(|c| c.hit.obstacle),
@@ -227,11 +270,11 @@ impl LidarPredictor {
         // (weight × chance of a valid reading, mean, variance, surface, weight) per node whose
         // reading can be valid.
         type Node = (f64, f64, f64, Obstacle, f64);
-        let mut nodes: Vec<Option<Node>> = Vec::with_capacity(beam.nodes.len());
-        for (w, ret) in &beam.nodes {
+        let mut nodes: [Option<Node>; DENSE_NODES] = [None; DENSE_NODES];
+        let nodes = &mut nodes[..beam.len()];
+        for ((w, ret), node) in beam.iter().zip(nodes.iter_mut()) {
             let Some(ret) = ret else {
                 out.near_edge |= centre.is_some();
-                nodes.push(None);
                 continue;
             };
             out.near_edge |= ret.footprint_m != ret.hit.distance;
@@ -242,9 +285,9 @@ impl LidarPredictor {
             // A reading outside [min, max] is reported invalid: a valid one comes from the part
             // of each node's distribution inside (its weight the probability of landing there).
             let valid = self.limited(Gaussian::new(1.0, mean, var.sqrt())).mass();
-            nodes.push((valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle, *w)));
+            *node = (valid >= 1e-9).then_some((w * valid, mean, var, ret.hit.obstacle, *w));
         }
-        if beam.dense {
+        if dense {
             out.near_edge = true;
             // One Gaussian per node, widened by the spread of the reading across the node's
             // share of directions: the slope to its neighbours on the same surface (or across a
@@ -258,15 +301,11 @@ impl LidarPredictor {
                         .filter(|n| n.3 == what || (n.1 - mean).abs() < 10.0 * var.sqrt())
                         .map(|n| (n.1 - mean).abs())
                 };
-                let steps: Vec<f64> = [step(k.checked_sub(1)), step(Some(k + 1))]
+                let (sum, count) = [step(k.checked_sub(1)), step(Some(k + 1))]
                     .into_iter()
                     .flatten()
-                    .collect();
-                let spread = if steps.is_empty() {
-                    0.0
-                } else {
-                    steps.iter().sum::<f64>() / steps.len() as f64
-                };
+                    .fold((0.0, 0.0), |(sum, count), d| (sum + d, count + 1.0));
+                let spread = if count == 0.0 { 0.0 } else { sum / count };
                 out.components.push(self.limited(Gaussian::new(
                     w,
                     mean,
@@ -279,20 +318,24 @@ impl LidarPredictor {
             // The moments are of the reading before the range limits (weights: the directions'
             // own), so that the limits, applied once to the surface's Gaussian (its
             // truncation), are not applied twice; its weight is its chance of a valid reading.
-            let mut groups: Vec<(Obstacle, f64, f64, f64, f64)> = Vec::with_capacity(1);
-            for (wv, mean, var, what, w) in nodes.into_iter().flatten() {
-                match groups.iter_mut().find(|g| g.0 == what) {
+            let mut groups = [None::<(Obstacle, f64, f64, f64, f64)>; DENSE_NODES];
+            let mut count = 0;
+            for &(wv, mean, var, what, w) in nodes.iter().flatten() {
+                match groups[..count].iter_mut().flatten().find(|g| g.0 == what) {
                     Some(g) => {
                         g.1 += wv;
                         g.2 += w * mean;
                         g.3 += w * (var + mean * mean);
                         g.4 += w;
                     }
-                    None => groups.push((what, wv, w * mean, w * (var + mean * mean), w)),
+                    None => {
+                        groups[count] = Some((what, wv, w * mean, w * (var + mean * mean), w));
+                        count += 1;
+                    }
                 }
             }
-            out.near_edge |= groups.len() > 1;
-            for (_, wv, sm, ss, w) in groups {
+            out.near_edge |= count > 1;
+            for &(_, wv, sm, ss, w) in groups[..count].iter().flatten() {
                 let mean = sm / w;
                 let var = (ss / w - mean * mean).max(ROUNDING_VAR_M2);
                 out.components
@@ -317,7 +360,8 @@ impl LidarPredictor {
     /// after power-on.
     #[must_use]
     pub fn predict(&self, world: &World, robot: &Pose, angle_deg: f64, t_s: f64) -> ExpectedLidar {
-        self.predict_nodes(&self.beam_nodes(world, robot, angle_deg), t_s)
+        let cast = self.cast_nodes(world, robot, angle_deg);
+        self.predict_from(cast.nodes(), cast.centre, cast.dense, t_s)
     }
 }
 

@@ -201,7 +201,19 @@ impl World {
     #[must_use]
     pub fn cast_ray(&self, origin: [f64; 2], heading_rad: f64, max_m: f64) -> Option<RayHit> {
         let (sin, cos) = heading_rad.sin_cos();
-        let ray = Ray::new(vec2(origin), Vector::new(cos as f32, sin as f32));
+        self.cast_ray_along(origin, [cos, sin], max_m)
+    }
+
+    /// [`World::cast_ray`] along the unit direction `[cos, sin]` of the heading, for a caller
+    /// that needs the direction itself too (the beam's incidence) and so computes it once.
+    #[must_use]
+    pub fn cast_ray_along(
+        &self,
+        origin: [f64; 2],
+        direction: [f64; 2],
+        max_m: f64,
+    ) -> Option<RayHit> {
+        let ray = Ray::new(vec2(origin), vec2(direction));
         let mut nearest = max_m as f32;
         let mut best = None;
         for shape in &self.fixed {

@@ -4,7 +4,7 @@
 use hilsim_recording::Recording;
 
 use crate::catalogue::Sensor;
-use crate::physics::{Gaussian, LidarQuery, Physics};
+use crate::physics::{Gaussian, LidarQuery, Mixture, Physics};
 use crate::trajectory::Trajectory;
 
 /// Length of the alternating training / held-out blocks, seconds.
@@ -127,7 +127,7 @@ pub(crate) struct SensorData {
 }
 
 /// One reading's predictive distribution (empty: no reading expected).
-pub(crate) type Predictive = Vec<Gaussian>;
+pub(crate) type Predictive = Mixture;
 
 impl SensorData {
     pub fn len(&self) -> usize {

@@ -4,6 +4,7 @@ use super::data::{Context, Predictive, Queries, SensorData};
 use super::drive_filter::drive_predictions;
 use crate::physics::{Hypothesis, LidarQuery};
 use crate::trajectory::Trajectory;
+use smallvec::smallvec;
 
 impl Context<'_> {
     /// The predictive distributions of `rows` of `data` under `h`.
@@ -35,14 +36,14 @@ impl Context<'_> {
                     .map(|(&i, p)| {
                         let mut g = p.wheels[i % 2];
                         g.sd_m = (g.sd_m * g.sd_m + extra).sqrt();
-                        vec![g]
+                        smallvec![g]
                     })
                     .collect()
             }
             Queries::Drive(windows) => {
                 let predicted = self.physics.drive(&self.recording.commands, self.end_s, h);
                 let Ok(path) = Trajectory::new(&predicted) else {
-                    return rows.iter().map(|_| Vec::new()).collect();
+                    return rows.iter().map(|_| Predictive::new()).collect();
                 };
                 let travel = path.wheel_travel(self.physics.declared().wheel_base_m);
                 let increments: Vec<f64> = (0..data.len())
@@ -72,7 +73,7 @@ impl Context<'_> {
                     self.physics.declared().actuation,
                     noise_var,
                 );
-                rows.iter().map(|&i| vec![all[i]]).collect()
+                rows.iter().map(|&i| smallvec![all[i]]).collect()
             }
         }
     }

@@ -75,8 +75,8 @@ impl LidarEffects {
         heading: f64,
         max_m: f64,
     ) -> Option<BeamReturn> {
-        let hit = world.cast_ray(origin, heading, max_m)?;
         let (sin, cos) = heading.sin_cos();
+        let hit = world.cast_ray_along(origin, [cos, sin], max_m)?;
         let cos_incidence = (hit.normal[0] * cos + hit.normal[1] * sin).abs();
         let footprint_m = self
             .mixed_half_width_rad

@@ -17,8 +17,8 @@ use crate::residuals::{self, Context, SensorData};
 use crate::select::{self, hypothesis_of, Selection};
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
-/// it (against an estimated trajectory only); they stop once the parameter moves by less than
-/// [`REALIGN_SETTLED`] of its value.
+/// it (against an estimated trajectory only); they stop once each free parameter moves by less
+/// than [`REALIGN_SETTLED`] of its value.
 const REALIGN_ROUNDS: usize = 6;
 const REALIGN_SETTLED: f64 = 0.02;
 
@@ -675,8 +675,11 @@ fn realign_lidar(
     let base = hypothesis_of(&others);
     let cone = declared_cone(ctx);
     let mut realigned: Option<Aligned> = None;
-    // The parameters the trajectory is estimated under next, and each round's (those, refit).
+    // The parameters the trajectory is estimated under next; the parameter followed to its
+    // fixed point (the one free parameter, when there is one) and each round's (value it was
+    // estimated under, refit).
     let mut proposal = current.params.clone();
+    let mut followed: Option<usize> = None;
     let mut rounds: Vec<(f64, f64)> = Vec::new();
     for _ in 0..REALIGN_ROUNDS {
         let hypothesis = base.and(current.effect, proposal.clone());
@@ -691,8 +694,23 @@ fn realign_lidar(
         if !select::earns_place(&refit, cone, options) {
             break;
         }
-        let (under, after) = (proposal[0], refit.params[0]);
-        rounds.push((under, after));
+        // Settled when every parameter the refit chose freely (of a two-shape effect, the
+        // shape it took) moved by less than `REALIGN_SETTLED` of its value.
+        let free = refit.effect.free(&refit.params, ctx.estimated);
+        let settled = free.iter().all(|&i| {
+            (refit.params[i] - proposal[i]).abs() <= REALIGN_SETTLED * refit.params[i].abs()
+        });
+        let single = match free[..] {
+            [i] => Some(i),
+            _ => None,
+        };
+        if single != followed {
+            rounds.clear();
+            followed = single;
+        }
+        if let Some(i) = single {
+            rounds.push((proposal[i], refit.params[i]));
+        }
         proposal = refit.params.clone();
         current = refit;
         // The plots show the data against the trajectory the verdict rests on.
@@ -700,13 +718,12 @@ fn realign_lidar(
             *d = lidar;
         }
         realigned = Some(again);
-        if (after - under).abs() <= REALIGN_SETTLED * after.abs() {
+        if settled {
             break;
         }
-        if let [spec] = current.effect.params() {
-            if let Some(next) = fixed_point_step(&rounds) {
-                proposal[0] = next.clamp(spec.lo, spec.hi);
-            }
+        if let Some((i, next)) = single.zip(fixed_point_step(&rounds)) {
+            let spec = current.effect.params()[i];
+            proposal[i] = next.clamp(spec.lo, spec.hi);
         }
     }
     if realigned.is_none() {

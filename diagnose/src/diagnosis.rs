@@ -10,7 +10,7 @@ use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};
 use crate::locate::{self, Evidence, TestKind};
-use crate::outcome::{Diagnosis, Options, SensorSummary};
+use crate::outcome::{Diagnosis, Options, SensorSummary, ESTIMATED_PATH_TIMING_S};
 use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, SensorData};
@@ -271,6 +271,7 @@ impl Options {
         let mut options = self.clone();
         if aligned.alignment == Alignment::Estimated {
             options.floors.odometer_m = options.floors.odometer_m.max(aligned.position_sd_m);
+            options.path_timing_s = options.path_timing_s.max(ESTIMATED_PATH_TIMING_S);
         }
         options
     }

@@ -44,7 +44,9 @@ pub use error::MismatchError;
 pub use explain::CandidateFit;
 pub use hilsim_recording::Pose;
 pub use locate::{Evidence, Floors, TestKind};
-pub use outcome::{Diagnosis, NamedEffect, Options, SensorSummary, Verdict};
+pub use outcome::{
+    Diagnosis, NamedEffect, Options, SensorSummary, Verdict, ESTIMATED_PATH_TIMING_S,
+};
 pub use physics::{
     Declared, DeclaredActuation, DeclaredLidar, Gaussian, Hypothesis, LidarPrediction, LidarQuery,
     Mixture, OdometryPrediction, Physics, SonarPrediction,

@@ -183,7 +183,7 @@ pub struct OdometryPrediction {
 ///             let p = tr.pose_at(q.t_s);
 ///             let d = (2.0 - p.x) / (p.yaw + q.angle_deg.to_radians()).cos();
 ///             LidarPrediction {
-///                 components: vec![Gaussian::new(1.0, d, 0.01)],
+///                 components: [Gaussian::new(1.0, d, 0.01)].into_iter().collect(),
 ///                 true_range_m: Some(d), incidence_deg: q.angle_deg, object: Some(0),
 ///                 reflectivity: 0.8, near_edge: false,
 ///             }

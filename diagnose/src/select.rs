@@ -11,7 +11,9 @@
 //! departs from the effect's absence by more than the sensors resolve (`Effect::departs`),
 //! and it changes the predicted readings by more than the sensor's practical floor
 //! ([`crate::locate::Floors`]): a small difference between the recording and the simulation
-//! that some effect can mimic is not that effect.
+//! that some effect can mimic is not that effect. Against a path estimated from the lidar, a
+//! delay of the sonar or the encoders must also exceed the path's own timing
+//! ([`Options::path_timing_s`]).
 
 use rayon::prelude::*;
 
@@ -43,6 +45,19 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
         && c.rmse_after.partial_cmp(&c.rmse_before) != Some(std::cmp::Ordering::Greater)
         && c.effect.departs(&c.params, declared_cone)
         && c.size_m > options.floors.floor_m(c.effect.sensor(), c.size_noise_m)
+        && !within_path_timing(c, options)
+}
+
+/// Whether `c` is a delay of a sensor judged along the trajectory (the sonar, the encoders)
+/// no larger than the trajectory's own timing is known to ([`Options::path_timing_s`]).
+fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
+    matches!(
+        c.effect,
+        Effect::SensorLatency(Sensor::Sonar | Sensor::Odometer)
+    ) && c
+        .params
+        .first()
+        .is_some_and(|d| d.abs() <= options.path_timing_s)
 }
 
 /// The hypothesis of the effects `fits` with their parameters.

@@ -112,13 +112,7 @@ pub(crate) fn conclude(
     let effects: Vec<NamedEffect> = named
         .into_iter()
         .map(|fit| NamedEffect {
-            located: place_of(
-                &nominal.evidence,
-                Some(fit.effect.sensor()),
-                threshold,
-                floors,
-                true,
-            ),
+            located: place_of(&nominal.evidence, Some(fit.sensor), threshold, floors, true),
             fit,
         })
         .collect();

@@ -15,6 +15,10 @@ use crate::residuals::{fits, log_likelihood, rmse, Context, Predictive, SensorDa
 pub struct CandidateFit {
     /// The effect.
     pub effect: Effect,
+    /// The sensor whose readings scored it: the effect's own, but for a lidar mount offset
+    /// seen, against a path estimated from the lidar, through the sensors that look from the
+    /// robot.
+    pub sensor: Sensor,
     /// Maximum-likelihood parameters (training half).
     pub params: Vec<f64>,
     /// Their standard errors (inverse observed information); NaN where the likelihood is flat.
@@ -49,7 +53,7 @@ const SIZE_SHARE: f64 = 0.1;
 const SIZE_MIN_READINGS: usize = 30;
 
 /// Training rows for fitting: every `stride`-th, at most `max_rows`.
-fn fit_rows(data: &SensorData, max_rows: usize) -> Vec<usize> {
+pub(crate) fn fit_rows(data: &SensorData, max_rows: usize) -> Vec<usize> {
     let train = data.rows(Some(false));
     let stride = train.len().div_ceil(max_rows.max(1)).max(1);
     train.into_iter().step_by(stride).collect()
@@ -110,7 +114,7 @@ fn effect_size(before: &[Predictive], after: &[Predictive], ranges: bool) -> (f6
 /// Scores `effect` with `params` on top of `base`: its gains over the base on both halves,
 /// the held-out RMSE before and after, its size; `param_sd` from the curvature of the training
 /// likelihood in its own parameters (the base held fixed).
-fn score(
+pub(crate) fn score(
     ctx: &Context<'_>,
     data: &SensorData,
     base: &Hypothesis,
@@ -118,28 +122,12 @@ fn score(
     params: Vec<f64>,
     train: &[usize],
 ) -> CandidateFit {
-    // The curvature and the BIC's count are the free parameters' (a held one was not fitted,
-    // its standard error is 0).
-    let free = effect.free(&params, ctx.estimated);
-    let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
     let train_base = total_ll(ctx, data, base, train);
-    let with_free = |y: &[f64]| {
-        let mut x = params.clone();
-        for (&i, &v) in free.iter().zip(y) {
-            x[i] = v;
-        }
-        x
-    };
-    let mut objective = |y: &[f64]| total_ll(ctx, data, &base.and(effect, with_free(y)), train);
-    let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
-    let best = objective(&at);
-    let mut param_sd = vec![0.0; params.len()];
-    for (&i, sd) in free
-        .iter()
-        .zip(standard_errors(&specs, &at, best, &mut objective, 2e-3))
-    {
-        param_sd[i] = sd;
-    }
+    let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), train);
+    let best = objective(&params);
+    let param_sd = free_standard_errors(effect, &params, ctx.estimated, best, &mut objective);
+    // The BIC's count is the free parameters' (a held one was not fitted).
+    let free = effect.free(&params, ctx.estimated);
     let fitted = base.and(effect, params.clone());
     let heldout = data.rows(Some(true));
     let before_p = ctx.predict(data, base, &heldout);
@@ -159,7 +147,8 @@ fn score(
     let train_gain = best - train_base;
     CandidateFit {
         effect,
-        bic_gain: 2.0 * train_gain - specs.len() as f64 * (train.len() as f64).ln(),
+        sensor: data.sensor,
+        bic_gain: 2.0 * train_gain - free.len() as f64 * (train.len() as f64).ln(),
         params,
         param_sd,
         train_gain,
@@ -192,6 +181,65 @@ pub(crate) fn fit_candidate(
         &mut objective,
     );
     score(ctx, data, base, effect, params, &train)
+}
+
+/// Fits `effect` on top of `base` to several sensors' data at once (their summed training
+/// log-likelihood): the parameters and their standard errors (from that sum's curvature; a
+/// held parameter's 0).
+pub(crate) fn fit_across(
+    ctx: &Context<'_>,
+    data: &[&SensorData],
+    base: &Hypothesis,
+    effect: Effect,
+    max_fit_rows: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let trains: Vec<Vec<usize>> = data.iter().map(|d| fit_rows(d, max_fit_rows)).collect();
+    let mut objective = |x: &[f64]| {
+        let h = base.and(effect, x.to_vec());
+        data.iter()
+            .zip(&trains)
+            .map(|(d, rows)| total_ll(ctx, d, &h, rows))
+            .sum()
+    };
+    let (params, best) = maximize_shapes(
+        effect.params(),
+        effect.shapes(ctx.estimated),
+        effect.shapes_refined_together(),
+        &effect.absent(0.0),
+        &mut objective,
+    );
+    let param_sd = free_standard_errors(effect, &params, ctx.estimated, best, &mut objective);
+    (params, param_sd)
+}
+
+/// The standard errors of `effect`'s `params` from the curvature of `log_likelihood` (whose
+/// value there is `best`) in the free parameters; a parameter the fit held at its absence was
+/// not fitted, its standard error is 0.
+fn free_standard_errors(
+    effect: Effect,
+    params: &[f64],
+    estimated: bool,
+    best: f64,
+    log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
+) -> Vec<f64> {
+    let free = effect.free(params, estimated);
+    let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
+    let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
+    let mut in_free = |y: &[f64]| {
+        let mut x = params.to_vec();
+        for (&i, &v) in free.iter().zip(y) {
+            x[i] = v;
+        }
+        log_likelihood(&x)
+    };
+    let mut param_sd = vec![0.0; params.len()];
+    for (&i, sd) in free
+        .iter()
+        .zip(standard_errors(&specs, &at, best, &mut in_free, 2e-3))
+    {
+        param_sd[i] = sd;
+    }
+    param_sd
 }
 
 /// Refits the effects of one sensor `chosen` (each fitted in turn on top of those before it

@@ -10,7 +10,7 @@ pub use hilsim_lidar_emulator::prediction::Mixture;
 use hilsim_recording::{CommandSample, TruthSample};
 
 use crate::catalogue::Effect;
-use hilsim_recording::Pose;
+use hilsim_recording::{Mount, Pose};
 
 use crate::trajectory::Trajectory;
 
@@ -109,6 +109,8 @@ pub struct DeclaredLidar {
     pub max_range_m: f64,
     /// The nearest valid range, metres.
     pub min_range_m: f64,
+    /// Where the lidar sits on the robot, as declared.
+    pub mount: Mount,
 }
 
 /// One lidar reading to predict.
@@ -199,7 +201,10 @@ pub struct OdometryPrediction {
 /// }
 /// let physics = Corridor(Declared {
 ///     scenario: "corridor".into(), start: Pose::default(), wheel_base_m: 0.23,
-///     lidar: Some(DeclaredLidar { snapshot: false, rpm: 300.0, max_range_m: 6.0, min_range_m: 0.06 }),
+///     lidar: Some(DeclaredLidar {
+///         snapshot: false, rpm: 300.0, max_range_m: 6.0, min_range_m: 0.06,
+///         mount: Default::default(),
+///     }),
 ///     sonar_half_angle_deg: None, odometer: false,
 ///     actuation: Default::default(),
 /// });

@@ -44,7 +44,7 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
         && c.bic_gain > 0.0
         && c.rmse_after.partial_cmp(&c.rmse_before) != Some(std::cmp::Ordering::Greater)
         && c.effect.departs(&c.params, declared_cone)
-        && c.size_m > options.floors.floor_m(c.effect.sensor(), c.size_noise_m)
+        && c.size_m > options.floors.floor_m(c.sensor, c.size_noise_m)
         && !within_path_timing(c, options)
 }
 

@@ -101,6 +101,7 @@ impl SimPhysics {
                     rpm: l.rpm,
                     max_range_m: l.max_range_m,
                     min_range_m: l.min_range_m,
+                    mount: l.mount.into(),
                 }),
                 sonar_half_angle_deg: s.sensors.sonar.as_ref().map(|u| {
                     s.effects

@@ -1,7 +1,7 @@
 //! The robot's trajectory: poses at increasing times, interpolated linearly between them (the
 //! heading along the shorter arc), as the simulator interpolates within a physics step.
 
-use hilsim_recording::{Pose, TruthSample};
+use hilsim_recording::{Mount, Pose, TruthSample};
 
 use crate::error::MismatchError;
 
@@ -68,6 +68,32 @@ impl Trajectory {
             });
         }
         Ok(Self { t, poses })
+    }
+
+    /// The robot's path when this one was found by placing the lidar (scan matching) through
+    /// the mount `declared` while the lidar really sits at `real`: the matching placed the
+    /// lidar at `pose ⊕ declared`, and the robot is where that lidar pose puts it through the
+    /// real mount, `pose ⊕ declared ⊕ real⁻¹`.
+    #[must_use]
+    pub fn under_mount(&self, declared: &Mount, real: &Mount) -> Self {
+        let poses = self
+            .poses
+            .iter()
+            .map(|p| {
+                let lidar = declared.in_world(p);
+                let yaw = lidar.yaw - real.yaw_rad();
+                let (sin, cos) = yaw.sin_cos();
+                Pose {
+                    x: lidar.x - (cos * real.x_m - sin * real.y_m),
+                    y: lidar.y - (sin * real.x_m + cos * real.y_m),
+                    yaw: wrap(yaw),
+                }
+            })
+            .collect();
+        Self {
+            t: self.t.clone(),
+            poses,
+        }
     }
 
     /// The sample times.
@@ -169,5 +195,63 @@ impl Trajectory {
             travel[k][0] + (travel[k + 1][0] - travel[k][0]) * u,
             travel[k][1] + (travel[k + 1][1] - travel[k][1]) * u,
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_path_under_another_mount_keeps_the_lidar_where_the_matching_placed_it() {
+        let path = Trajectory::new(&[
+            TruthSample {
+                t_s: 0.0,
+                x_m: 1.0,
+                y_m: 2.0,
+                yaw_rad: 0.3,
+            },
+            TruthSample {
+                t_s: 1.0,
+                x_m: 1.2,
+                y_m: 2.1,
+                yaw_rad: 1.9,
+            },
+            TruthSample {
+                t_s: 2.0,
+                x_m: 0.9,
+                y_m: 2.4,
+                yaw_rad: -3.0,
+            },
+        ])
+        .unwrap();
+        let declared = Mount {
+            x_m: 0.05,
+            y_m: 0.0,
+            yaw_deg: 0.0,
+        };
+        let real = Mount {
+            x_m: 0.03,
+            y_m: -0.02,
+            yaw_deg: 2.0,
+        };
+        let moved = path.under_mount(&declared, &real);
+        for (p, q) in path.poses().iter().zip(moved.poses()) {
+            let (a, b) = (declared.in_world(p), real.in_world(q));
+            assert!(
+                (a.x - b.x).abs() < 1e-12 && (a.y - b.y).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
+            assert!(wrap(a.yaw - b.yaw).abs() < 1e-12, "{a:?} {b:?}");
+            // The robot itself moved: by the mounts' difference, turned with it.
+            assert!((p.x - q.x).hypot(p.y - q.y) > 0.01);
+        }
+        assert_eq!(moved.times(), path.times());
+        // Through the declared mount itself, nothing moves.
+        let same = path.under_mount(&declared, &declared);
+        for (p, q) in path.poses().iter().zip(same.poses()) {
+            assert!((p.x - q.x).abs() < 1e-12 && (p.y - q.y).abs() < 1e-12);
+            assert!(wrap(p.yaw - q.yaw).abs() < 1e-12);
+        }
     }
 }

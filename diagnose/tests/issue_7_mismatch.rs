@@ -65,6 +65,7 @@ impl Corridor {
                     rpm: REV_HZ * 60.0,
                     max_range_m: 8.0,
                     min_range_m: 0.06,
+                    mount: Default::default(),
                 }),
                 sonar_half_angle_deg: None,
                 odometer: false,

@@ -1,6 +1,8 @@
 //! The scenario's `[effects]` table that switches each effect on: how the diagnosis's physics
 //! tries a hypothesis, and how the self-test conceals a drawn effect in its "real" run.
 
+use hilsim_lidar_emulator::effects::real_mount;
+use hilsim_recording::Mount;
 use hilsim_sim::scenario::{self, Effects};
 
 use super::{Effect, Sensor};
@@ -10,6 +12,14 @@ use super::{Effect, Sensor};
 pub(crate) const REFERENCE_REFLECTIVITY: f64 = 0.8;
 /// The temperature the sonar's speed of sound is calibrated at, °C.
 const CALIBRATED_AT_C: f64 = 20.0;
+
+/// The lidar's real mount under a `lidar_mount_offset` of `params` (in the order of
+/// [`Effect::params`]) from the `declared` one: the simulator's own [`real_mount`].
+pub(crate) fn mounted(declared: &Mount, params: &[f64]) -> Mount {
+    let mut e = Effects::default();
+    Effect::LidarMountOffset.apply(params, &mut e);
+    real_mount(*declared, e.lidar_mount_offset)
+}
 
 impl Effect {
     /// Switches the effect on in `effects` with `params` (in the order of [`Effect::params`]; a

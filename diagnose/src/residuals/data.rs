@@ -1,10 +1,10 @@
 //! What the residuals are computed from: one sensor's readings, the variables they are tested
 //! against, and the context the diagnosis holds while it works.
 
-use hilsim_recording::Recording;
+use hilsim_recording::{Mount, Recording};
 
-use crate::catalogue::Sensor;
-use crate::physics::{Gaussian, LidarQuery, Mixture, Physics};
+use crate::catalogue::{mounted, Effect, Sensor};
+use crate::physics::{Gaussian, Hypothesis, LidarQuery, Mixture, Physics};
 use crate::trajectory::Trajectory;
 
 /// Length of the alternating training / held-out blocks, seconds.
@@ -162,9 +162,26 @@ pub(crate) struct Context<'a> {
     pub yaw_sd_rad: f64,
     /// Whether the trajectory is estimated (its errors then widen every range).
     pub estimated: bool,
+    /// The mount the trajectory was found through by placing the lidar, when the sensors that
+    /// look from the robot (the sonar, the encoders) are to see a hypothesised lidar mount as
+    /// the robot's path it implies (`Trajectory::under_mount`); `None`: the path is the
+    /// robot's under every hypothesis.
+    pub placed_through: Option<Mount>,
 }
 
 impl Context<'_> {
+    /// The robot's path under `h` when it differs from [`Context::trajectory`]: with
+    /// [`Context::placed_through`] set and a lidar mount offset in `h`, the path that mount
+    /// implies.
+    pub(super) fn robot_path(&self, h: &Hypothesis) -> Option<Trajectory> {
+        let through = self.placed_through?;
+        let offset: Vec<f64> = (0..3)
+            .map(|i| h.param_of(Effect::LidarMountOffset, i))
+            .collect::<Option<_>>()?;
+        let real = mounted(&through, &offset);
+        Some(self.trajectory.under_mount(&through, &real))
+    }
+
     /// Widens range predictions by the estimated trajectory's uncertainty: its position error
     /// along the beam and its heading error times the range.
     pub(super) fn widen(&self, mut g: Gaussian) -> Gaussian {

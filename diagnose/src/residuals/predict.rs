@@ -20,15 +20,19 @@ impl Context<'_> {
             }
             Queries::Sonar(times) => {
                 let ts: Vec<f64> = rows.iter().map(|&i| times[i]).collect();
+                let moved = self.robot_path(h);
                 self.physics
-                    .sonar(self.trajectory, &ts, h)
+                    .sonar(moved.as_ref().unwrap_or(self.trajectory), &ts, h)
                     .into_iter()
                     .map(|p| p.reading.into_iter().map(|g| self.widen(g)).collect())
                     .collect()
             }
             Queries::Odometer(times) => {
                 let ts: Vec<f64> = rows.iter().map(|&i| times[i / 2]).collect();
-                let preds = self.physics.odometry(self.trajectory, &ts, h);
+                let moved = self.robot_path(h);
+                let preds =
+                    self.physics
+                        .odometry(moved.as_ref().unwrap_or(self.trajectory), &ts, h);
                 // The trajectory's own position noise enters each wheel's travel.
                 let extra = self.position_sd_m * self.position_sd_m;
                 rows.iter()

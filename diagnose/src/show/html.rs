@@ -147,7 +147,7 @@ fn fix(s: &mut String, d: &Diagnosis) {
         let _ = writeln!(
             s,
             "</table><p>Held-out {} RMSE: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
-            f.effect.sensor(),
+            f.sensor,
             mm(f.rmse_before),
             mm(f.rmse_after),
             mm(f.noise_floor),

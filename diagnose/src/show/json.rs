@@ -42,7 +42,7 @@ fn params_of(f: &CandidateFit) -> (Map<String, Value>, Map<String, Value>) {
 fn fit_of(f: &CandidateFit) -> Value {
     json!({
         "metric": "heldout_rmse_m",
-        "sensor": f.effect.sensor().name(),
+        "sensor": f.sensor.name(),
         "before": num(f.rmse_before),
         "after": num(f.rmse_after),
         "noise_floor_m": num(f.noise_floor),

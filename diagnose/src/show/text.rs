@@ -47,7 +47,7 @@ pub fn summary(d: &Diagnosis) -> String {
             s,
             "  held-out {} RMSE: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
              changes the readings by {})",
-            f.effect.sensor(),
+            f.sensor,
             mm(f.rmse_before),
             mm(f.rmse_after),
             mm(f.noise_floor),

@@ -679,6 +679,14 @@ fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
 /// concealed incidence, skew, reflectivity or sonar delay (trials 19, 26, 37, 44, 50, 67,
 /// 74, 84, 91), the yaw then 0.02–2.7° and meaningless (the sonar's axis alone sees it).
 const MOUNT_THROUGH_PATH_MIN_M: f64 = 0.01;
+/// The least span of headings a run must turn through for a mount to be fitted through the
+/// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
+/// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
+/// fit has only the sonar's ranges and a crab of the heading against the direction of travel
+/// (`cos ψ` of each step), which mimic a wheel's radius: measured on the other simulator's
+/// straight runs in front of a board (`board-b`, `board-d`, no turns), a "mount" of 6.3° and
+/// 0.1 m was fitted and named. A quarter turn with a 1 cm offset is 16 mm of travel.
+const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 
 /// Against a path estimated from the lidar, a lidar mount offset goes into the path: scan
 /// matching places the lidar, and the robot is inferred from it through the declared mount, so
@@ -689,7 +697,8 @@ const MOUNT_THROUGH_PATH_MIN_M: f64 = 0.01;
 /// encoders' training log-likelihood along it is maximised. It is named when it gains on their
 /// held-out readings more than the effects named in them gain together (it explains what they
 /// were named for), it earns its place in the sensor it gains most in, and it moves the robot
-/// by at least [`MOUNT_THROUGH_PATH_MIN_M`]. Returns it (scored
+/// by at least [`MOUNT_THROUGH_PATH_MIN_M`]; a run that does not turn through
+/// [`MOUNT_THROUGH_PATH_MIN_TURN_RAD`] is not tried. Returns it (scored
 /// there) with the path estimated again under it and the named lidar effects; the caller
 /// judges the sonar and the encoders again along that path.
 fn mount_through_path(
@@ -713,6 +722,7 @@ fn mount_through_path(
         || !options.effects.contains(&mount)
         || others.is_empty()
         || named.iter().any(|c| c.effect == mount)
+        || ctx.trajectory.heading_span_rad() < MOUNT_THROUGH_PATH_MIN_TURN_RAD
     {
         return Ok(None);
     }

@@ -96,6 +96,20 @@ impl Trajectory {
         }
     }
 
+    /// The span of headings the path turns through, radians: the largest minus the smallest
+    /// heading along it, unwrapped (a full turn is 2π, not 0).
+    #[must_use]
+    pub fn heading_span_rad(&self) -> f64 {
+        let mut heading = 0.0;
+        let (mut lo, mut hi) = (0.0f64, 0.0f64);
+        for w in self.poses.windows(2) {
+            heading += wrap(w[1].yaw - w[0].yaw);
+            lo = lo.min(heading);
+            hi = hi.max(heading);
+        }
+        hi - lo
+    }
+
     /// The sample times.
     #[must_use]
     pub fn times(&self) -> &[f64] {
@@ -247,6 +261,12 @@ mod tests {
             assert!((p.x - q.x).hypot(p.y - q.y) > 0.01);
         }
         assert_eq!(moved.times(), path.times());
+        // 0.3 → 1.9 → −3.0 (through ±π): 1.6 then 1.38 rad further, unwrapped.
+        let span = path.heading_span_rad();
+        assert!(
+            (span - (1.6 + (2.0 * std::f64::consts::PI - 4.9))).abs() < 1e-12,
+            "{span}"
+        );
         // Through the declared mount itself, nothing moves.
         let same = path.under_mount(&declared, &declared);
         for (p, q) in path.poses().iter().zip(same.poses()) {

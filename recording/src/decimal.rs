@@ -15,6 +15,9 @@ pub(crate) trait Text {
     /// Appends the ASCII text `write` puts at the start of a buffer of [`SHORT_MAX`] bytes
     /// (it returns its length).
     fn push_short(&mut self, write: impl FnOnce(&mut [u8]) -> usize);
+    /// Appends a row that `write` puts into a [`Row`] of [`ROW_MAX`] bytes; nothing when it
+    /// gives `None` (a number off the fast path: the caller writes the row the long way).
+    fn push_row(&mut self, write: impl FnOnce(&mut Row<'_>) -> Option<()>) -> bool;
 }
 
 impl Text for String {
@@ -29,6 +32,20 @@ impl Text for String {
         let len = write(&mut bytes);
         // ASCII: digits, '-' and '.'.
         String::push_str(self, std::str::from_utf8(&bytes[..len]).unwrap_or_default());
+    }
+    fn push_row(&mut self, write: impl FnOnce(&mut Row<'_>) -> Option<()>) -> bool {
+        let mut bytes = [0; ROW_MAX];
+        let mut row = Row {
+            out: &mut bytes,
+            len: 0,
+        };
+        if write(&mut row).is_none() {
+            return false;
+        }
+        let len = row.len;
+        // ASCII: digits, '-', '.', ',' and '\n'.
+        String::push_str(self, std::str::from_utf8(&bytes[..len]).unwrap_or_default());
+        true
     }
 }
 
@@ -46,6 +63,94 @@ impl Text for Vec<u8> {
         self.extend_from_slice(&[0; SHORT_MAX]);
         let len = write(&mut self[start..]);
         self.truncate(start + len);
+    }
+    fn push_row(&mut self, write: impl FnOnce(&mut Row<'_>) -> Option<()>) -> bool {
+        // In place, as `push_short`: one length check and one cut a row, not one a field.
+        let start = self.len();
+        self.resize(start + ROW_MAX, 0);
+        let mut row = Row {
+            out: &mut self[start..],
+            len: 0,
+        };
+        let written = write(&mut row).map(|()| row.len);
+        self.truncate(start + written.unwrap_or(0));
+        written.is_some()
+    }
+}
+
+/// Room for a row written in one piece: a lidar row with its true range is at most 7 fields
+/// of [`SHORT_MAX`] and 8 separators.
+pub(crate) const ROW_MAX: usize = 8 * SHORT_MAX;
+
+/// A row being written into a buffer of [`ROW_MAX`] bytes, field by field, for the common case
+/// only: numbers on the grid (below), zeros and integers. A field it does not take makes the
+/// row `None`, to be written the long way ([`push_f64`], [`push_int`]) with the same bytes.
+pub(crate) struct Row<'a> {
+    out: &'a mut [u8],
+    len: usize,
+}
+
+impl Row<'_> {
+    /// Room for one more field and its separator, or `None`.
+    fn room(&mut self) -> Option<&mut [u8]> {
+        self.out.get_mut(self.len..self.len + SHORT_MAX + 1)
+    }
+
+    /// `x` as `Display` writes it, if it is 0 or on the grid.
+    pub(crate) fn f64(&mut self, x: f64) -> Option<()> {
+        let room = self.room()?;
+        let len = if x == 0.0 {
+            // "0" or "-0".
+            let sign = usize::from(x.is_sign_negative());
+            room[0] = b'-';
+            room[sign] = b'0';
+            sign + 1
+        } else {
+            write_grid(room, x < 0.0, on_grid(x)?)
+        };
+        self.len += len;
+        Some(())
+    }
+
+    /// n·10^−`scale` as `Display` writes the `f64` closest to it, if the decimal is on the grid
+    /// (`scale` ≤ 9, n·10^(9−scale) < 10¹⁵): written from its digits, no `f64` involved.
+    pub(crate) fn decimal(&mut self, n: u64, scale: u32) -> Option<()> {
+        const TO_GRID: [u64; 10] = [
+            1_000_000_000,
+            100_000_000,
+            10_000_000,
+            1_000_000,
+            100_000,
+            10_000,
+            1_000,
+            100,
+            10,
+            1,
+        ];
+        let on_grid = n.checked_mul(*TO_GRID.get(usize::try_from(scale).ok()?)?)?;
+        if on_grid >= GRID_LIMIT_N {
+            return None;
+        }
+        if on_grid == 0 {
+            return self.byte(b'0');
+        }
+        let room = self.room()?;
+        self.len += write_grid(room, false, on_grid);
+        Some(())
+    }
+
+    /// An unsigned integer as `Display` writes it.
+    pub(crate) fn int(&mut self, n: impl Into<u64>) -> Option<()> {
+        let room = self.room()?;
+        self.len += write_unsigned(room, n.into());
+        Some(())
+    }
+
+    /// One ASCII byte (a separator, a flag).
+    pub(crate) fn byte(&mut self, b: u8) -> Option<()> {
+        *self.out.get_mut(self.len)? = b;
+        self.len += 1;
+        Some(())
     }
 }
 
@@ -90,6 +195,27 @@ fn write_unsigned(out: &mut [u8], n: u64) -> usize {
     let count = digit_count(n);
     write_digits(out, n, count);
     count
+}
+
+/// The 8 decimal digits of `n` < 10⁸ (zero-padded), one a byte, first digit in the lowest byte
+/// (so `to_le_bytes` reads them in order), as values 0–9: a zero digit is a zero byte. Divisions
+/// by 10⁴, 10² and 10 done on all lanes at once by multiplying with a reciprocal (SWAR): exact
+/// for the lanes' ranges (x/100 = x·10486 >> 20 for x < 10⁴; x/10 = x·103 >> 10 for x < 100,
+/// both checked over every x in the tests).
+fn eight_digits(n: u64) -> u64 {
+    // Two 32-bit lanes of 4 digits.
+    let lanes = (n / 10_000) | ((n % 10_000) << 32);
+    // Four 16-bit lanes of 2 digits.
+    let hundreds = ((lanes * 10_486) >> 20) & 0x0000_007F_0000_007F;
+    let lanes = hundreds | ((lanes - hundreds * 100) << 16);
+    // Eight bytes of 1 digit.
+    let tens = ((lanes * 103) >> 10) & 0x000F_000F_000F_000F;
+    tens | ((lanes - tens * 10) << 8)
+}
+
+/// Digits from [`eight_digits`] as ASCII.
+fn ascii(digits: u64) -> u64 {
+    digits | 0x3030_3030_3030_3030
 }
 
 /// At and above this magnitude, and for "NaN" and "inf", `Display` itself writes the number:
@@ -149,8 +275,8 @@ pub(crate) fn push_f64(out: &mut impl Text, x: f64) {
 /// ranges to the millimetre, wheel travel to the nanometre): numbers that are the `f64`
 /// closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵.
 const GRID: f64 = 1e9;
-const GRID_DIGITS: usize = 9;
 const GRID_LIMIT: f64 = 1e15;
+const GRID_LIMIT_N: u64 = 1_000_000_000_000_000;
 
 /// |n| when `x` is the `f64` closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵; `None`
 /// otherwise (and for a few within 10⁻⁶ of a tie between two `f64`, which lose nothing but
@@ -198,27 +324,21 @@ fn write_grid(out: &mut [u8], negative: bool, n: u64) -> usize {
     out[0] = b'-';
     let mut len = sign + write_unsigned(&mut out[sign..], whole);
     if fraction != 0 {
+        // The first of the 9 digits, then 8 at once; the trailing zeros (zero bytes at the
+        // top of the 8) are not kept: no loop, no division.
+        let first = fraction / 100_000_000;
+        let rest = eight_digits(fraction % 100_000_000);
+        let kept = if rest == 0 {
+            1
+        } else {
+            9 - (rest.leading_zeros() / 8) as usize
+        };
         out[len] = b'.';
-        let digits = &mut out[len + 1..len + 1 + GRID_DIGITS];
-        write_nine_digits(digits, fraction);
-        // The fraction's trailing zeros are not written (found in the text: no divisions).
-        let mut kept = GRID_DIGITS;
-        while digits[kept - 1] == b'0' {
-            kept -= 1;
-        }
+        out[len + 1] = b'0' + u8::try_from(first).unwrap_or(0);
+        out[len + 2..len + 10].copy_from_slice(&ascii(rest).to_le_bytes());
         len += 1 + kept;
     }
     len
-}
-
-/// Writes the 9 digits of `n` < 10⁹ (zero-padded) into `out[..9]`, in independent pieces of
-/// 4 digits (shorter chains of dependent divisions).
-fn write_nine_digits(out: &mut [u8], n: u64) {
-    let first = n / 100_000_000;
-    let rest = n % 100_000_000;
-    out[0] = b'0' + u8::try_from(first).unwrap_or(0);
-    write_digits(&mut out[1..5], rest / 10_000, 4);
-    write_digits(&mut out[5..9], rest % 10_000, 4);
 }
 
 /// A decimal 0.d1d2…dn × 10^point, without leading or trailing zero digits.
@@ -321,7 +441,70 @@ mod tests {
         let mut bytes = b"a,".to_vec();
         push_f64(&mut bytes, x);
         assert_eq!(bytes, format!("a,{s}").into_bytes());
+        // A row's fast path, where it takes the number, writes the same.
+        let mut row = b"a,".to_vec();
+        if row.push_row(|row| row.f64(x)) {
+            assert_eq!(row, bytes, "{x:?}");
+        } else {
+            assert_eq!(row, b"a,");
+        }
+        let mut row = String::new();
+        if row.push_row(|row| row.f64(x)) {
+            assert_eq!(row, s, "{x:?}");
+        }
         s
+    }
+
+    #[test]
+    fn the_reciprocals_divide_exactly() {
+        for x in 0..10_000u64 {
+            assert_eq!((x * 10_486) >> 20, x / 100, "{x}");
+        }
+        for x in 0..100u64 {
+            assert_eq!((x * 103) >> 10, x / 10, "{x}");
+        }
+        for n in [
+            0, 1, 9, 10, 1_234, 10_000, 12_345_678, 99_999_999, 50_000_000,
+        ] {
+            let digits = ascii(eight_digits(n)).to_le_bytes();
+            assert_eq!(digits.as_slice(), format!("{n:08}").as_bytes());
+        }
+    }
+
+    /// Whole rows: the fast path takes the common ones, and gives up on the others leaving
+    /// nothing behind.
+    #[test]
+    fn a_row_is_written_in_one_piece_or_not_at_all() {
+        let mut bytes = b"x\n".to_vec();
+        let taken = bytes.push_row(|row| {
+            row.f64(12.000_345)?;
+            row.byte(b',')?;
+            row.int(7u64)?;
+            row.byte(b',')?;
+            row.f64(-0.0)?;
+            row.byte(b',')?;
+            row.f64(0.0)?;
+            row.byte(b',')?;
+            row.f64(-359.5)?;
+            row.byte(b'\n')
+        });
+        assert!(taken);
+        assert_eq!(bytes, b"x\n12.000345,7,-0,0,-359.5\n");
+        let taken = bytes.push_row(|row| {
+            row.f64(1.5)?;
+            row.byte(b',')?;
+            row.f64(0.1 + 0.2)
+        });
+        assert!(!taken);
+        assert_eq!(bytes, b"x\n12.000345,7,-0,0,-359.5\n");
+        // More fields than a row has room for: refused, not a panic.
+        let taken = bytes.push_row(|row| {
+            for _ in 0..100 {
+                row.f64(999_999.999_999_999)?;
+            }
+            Some(())
+        });
+        assert!(!taken);
     }
 
     #[test]
@@ -441,6 +624,9 @@ mod tests {
                 push_int(&mut bytes, m);
                 assert_eq!(s, m.to_string());
                 assert_eq!(bytes, m.to_string().into_bytes());
+                let mut row = Vec::new();
+                assert!(row.push_row(|row| row.int(m)));
+                assert_eq!(row, m.to_string().into_bytes());
             }
             n = n.saturating_mul(10);
         }

@@ -40,7 +40,9 @@ pub use error::{Error, ErrorKind};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
-pub use samples::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
+pub use samples::{
+    CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
+};
 pub use stream::{RecordingStream, SampleSink, Tables};
 
 /// A whole recording: the metadata and one table per sensor.

@@ -45,6 +45,47 @@ pub struct LidarSample {
     pub true_range_m: Option<f64>,
 }
 
+/// A lidar reading whose numbers are decimals already, as an importer reads them (times to
+/// the microsecond, angles to 10⁻⁴°, ranges as the decimal a float32 field was written as):
+/// [`SampleSink::lidar_decimals`](crate::SampleSink::lidar_decimals) writes their digits
+/// without a round trip through `f64`, byte for byte what [`LidarDecimals::sample`] gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LidarDecimals {
+    /// Microseconds from t = 0.
+    pub t_us: u64,
+    /// Revolution counter, from 0.
+    pub rev: u64,
+    /// The beam angle in ten-thousandths of a degree, [0, 3,600,000).
+    pub angle_e4_deg: u32,
+    /// The range is `range_digits` · 10^−`range_scale` metres (0 when invalid).
+    pub range_digits: u64,
+    /// See `range_digits`.
+    pub range_scale: u32,
+    /// Signal strength as reported.
+    pub strength: u16,
+    /// The invalid-data flag.
+    pub invalid: bool,
+    /// The strength-warning flag.
+    pub warning: bool,
+}
+
+impl LidarDecimals {
+    /// The reading as a [`LidarSample`]: each number the `f64` closest to its decimal.
+    #[must_use]
+    pub fn sample(&self) -> LidarSample {
+        LidarSample {
+            t_s: self.t_us as f64 / 1e6,
+            rev: self.rev,
+            angle_deg: f64::from(self.angle_e4_deg) / 1e4,
+            range_m: self.range_digits as f64 / 10f64.powi(self.range_scale.min(300) as i32),
+            strength: self.strength,
+            invalid: self.invalid,
+            warning: self.warning,
+            true_range_m: None,
+        }
+    }
+}
+
 /// One sonar ping (`sonar.csv`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SonarSample {

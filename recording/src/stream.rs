@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 use crate::atomic::{check_replaceable_recording, new_sibling_dir, put_in_place};
 use crate::write::rows;
 use crate::{
-    CommandSample, Error, LidarSample, Meta, OdometrySample, Recording, SonarSample, TruthSample,
+    CommandSample, Error, LidarDecimals, LidarSample, Meta, OdometrySample, Recording, SonarSample,
+    TruthSample,
 };
 
 /// Where samples go as they are taken: a recording in memory, or its files as they are written.
@@ -34,6 +35,15 @@ pub trait SampleSink {
     /// # Errors
     /// As [`SampleSink::command`].
     fn lidar(&mut self, r: &LidarSample) -> Result<(), Self::Error>;
+    /// A lidar reading whose numbers are decimals already (an importer's): kept as
+    /// [`SampleSink::lidar`] keeps [`LidarDecimals::sample`], which is what this default does;
+    /// a stream writes the digits as they are, without the round trip through `f64`.
+    ///
+    /// # Errors
+    /// As [`SampleSink::command`].
+    fn lidar_decimals(&mut self, r: &LidarDecimals) -> Result<(), Self::Error> {
+        self.lidar(&r.sample())
+    }
     /// A sonar ping.
     ///
     /// # Errors
@@ -368,6 +378,13 @@ impl SampleSink for RecordingStream {
             Some(r.true_range_m.is_some()),
             rows::lidar_header,
             |s, with_truth| rows::lidar(s, r, with_truth),
+        )
+    }
+    fn lidar_decimals(&mut self, r: &LidarDecimals) -> Result<(), Error> {
+        table(&mut self.lidar, &self.tmp, "lidar.csv")?.row(
+            Some(false),
+            rows::lidar_header,
+            |s, _| rows::lidar_decimals(s, r),
         )
     }
     fn sonar(&mut self, p: &SonarSample) -> Result<(), Error> {

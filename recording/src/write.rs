@@ -89,7 +89,9 @@ impl Recording {
 /// (`stream.rs`) both write it: floats in Rust's shortest round-trip form.
 pub(crate) mod rows {
     use crate::decimal::{push_f64, push_int, Text};
-    use crate::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
+    use crate::{
+        CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
+    };
 
     pub(crate) const COMMANDS_HEADER: &str = "t_s,left_mps,right_mps\n";
     pub(crate) const ODOMETRY_HEADER: &str = "t_s,left_m,right_m\n";
@@ -113,6 +115,19 @@ pub(crate) mod rows {
 
     /// Fields joined by commas, each written as `Display` writes it.
     fn fields(s: &mut impl Text, numbers: &[f64]) {
+        // In one piece when every field takes the fast path (wheel travel, sonar ranges).
+        let in_one_piece = s.push_row(|row| {
+            for (i, &x) in numbers.iter().enumerate() {
+                if i > 0 {
+                    row.byte(b',')?;
+                }
+                row.f64(x)?;
+            }
+            Some(())
+        });
+        if in_one_piece {
+            return;
+        }
         for (i, &x) in numbers.iter().enumerate() {
             if i > 0 {
                 s.push_byte(b',');
@@ -137,6 +152,30 @@ pub(crate) mod rows {
     }
 
     pub(crate) fn lidar(s: &mut impl Text, r: &LidarSample, with_truth: bool) {
+        // Nearly every row in one piece (a `Row`); the same bytes the long way below.
+        let in_one_piece = s.push_row(|row| {
+            row.f64(r.t_s)?;
+            row.byte(b',')?;
+            row.int(r.rev)?;
+            row.byte(b',')?;
+            row.f64(r.angle_deg)?;
+            row.byte(b',')?;
+            row.f64(r.range_m)?;
+            row.byte(b',')?;
+            row.int(r.strength)?;
+            for flag in [r.invalid, r.warning] {
+                row.byte(b',')?;
+                row.byte(if flag { b'1' } else { b'0' })?;
+            }
+            if let Some(t) = r.true_range_m.filter(|_| with_truth) {
+                row.byte(b',')?;
+                row.f64(t)?;
+            }
+            row.byte(b'\n')
+        });
+        if in_one_piece {
+            return;
+        }
         push_f64(s, r.t_s);
         s.push_byte(b',');
         push_int(s, r.rev);
@@ -154,6 +193,30 @@ pub(crate) mod rows {
         true_range(s, r.true_range_m.filter(|_| with_truth));
     }
 
+    /// A reading whose numbers are decimals already: the same bytes as [`lidar`] writes for
+    /// [`LidarDecimals::sample`], from the digits.
+    pub(crate) fn lidar_decimals(s: &mut impl Text, r: &LidarDecimals) {
+        let in_one_piece = s.push_row(|row| {
+            row.decimal(r.t_us, 6)?;
+            row.byte(b',')?;
+            row.int(r.rev)?;
+            row.byte(b',')?;
+            row.decimal(r.angle_e4_deg.into(), 4)?;
+            row.byte(b',')?;
+            row.decimal(r.range_digits, r.range_scale)?;
+            row.byte(b',')?;
+            row.int(r.strength)?;
+            for flag in [r.invalid, r.warning] {
+                row.byte(b',')?;
+                row.byte(if flag { b'1' } else { b'0' })?;
+            }
+            row.byte(b'\n')
+        });
+        if !in_one_piece {
+            lidar(s, &r.sample(), false);
+        }
+    }
+
     pub(crate) fn sonar(s: &mut impl Text, r: &SonarSample, with_truth: bool) {
         fields(s, &[r.t_s, r.range_m]);
         true_range(s, r.true_range_m.filter(|_| with_truth));
@@ -165,5 +228,34 @@ pub(crate) mod rows {
             push_f64(s, t);
         }
         s.push_byte(b'\n');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rows;
+    use crate::LidarDecimals;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A reading written from its decimals is, byte for byte, the reading written from the
+        /// `f64`s closest to them, on either kind of text.
+        #[test]
+        fn decimals_write_what_their_floats_write(
+            t_us in 0u64..100_000_000_000, rev in any::<u64>(), angle_e4_deg in 0u32..3_600_000,
+            range_digits in 0u64..100_000_000, range_scale in 0u32..13, strength in any::<u16>(),
+            invalid in any::<bool>(), warning in any::<bool>(),
+        ) {
+            let r = LidarDecimals {
+                t_us, rev, angle_e4_deg, range_digits, range_scale, strength, invalid, warning,
+            };
+            let (mut from_decimals, mut from_floats) = (Vec::new(), Vec::new());
+            rows::lidar_decimals(&mut from_decimals, &r);
+            rows::lidar(&mut from_floats, &r.sample(), false);
+            prop_assert_eq!(&from_decimals, &from_floats);
+            let mut text = String::new();
+            rows::lidar_decimals(&mut text, &r);
+            prop_assert_eq!(text.as_bytes(), from_floats.as_slice());
+        }
     }
 }

@@ -5,8 +5,8 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use hilsim_recording::{
-    wrap_angle, CommandSample, LidarSample, Meta, OdometrySample, RecordingStream, SampleSink,
-    SonarMount, SonarSample, Tables, TruthSample,
+    wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample, RecordingStream,
+    SampleSink, SonarMount, SonarSample, Tables, TruthSample,
 };
 
 use crate::bag::{self, Item};
@@ -383,33 +383,77 @@ pub struct Converter {
     odometry_start_m: (f64, f64),
     sonar_out_of_range: u64,
     sonar_fov_rad: Option<f64>,
+    /// The last scan's reading angles: a lidar's scans share them.
+    scan_angles: ScanAngles,
+}
+
+/// Each reading's angle of a scan's `angle_min` and `angle_increment`, computed once for the
+/// scans that share them (every scan of a lidar, usually) rather than once a reading.
+#[derive(Default)]
+struct ScanAngles {
+    /// The float32 fields' bits, as the message gave them.
+    angle_min: u32,
+    increment: u32,
+    /// Ten-thousandths of a degree, [0, 3,600,000) ([`angle_e4_deg`]).
+    e4_deg: Vec<u32>,
+}
+
+impl ScanAngles {
+    /// The angles of the first `count` readings of a scan with these fields; `None` when either
+    /// is not finite.
+    fn of(&mut self, angle_min: f32, increment: f32, count: usize) -> Option<&[u32]> {
+        if !(angle_min.is_finite() && increment.is_finite()) {
+            return None;
+        }
+        let same = self.angle_min == angle_min.to_bits() && self.increment == increment.to_bits();
+        if !same || self.e4_deg.len() < count {
+            let (start, step) = (decimal_of_f32(angle_min), decimal_of_f32(increment));
+            self.angle_min = angle_min.to_bits();
+            self.increment = increment.to_bits();
+            self.e4_deg.clear();
+            self.e4_deg
+                .extend((0..count).map(|i| angle_e4_deg(start + i as f64 * step)));
+        }
+        Some(&self.e4_deg[..count])
+    }
 }
 
 /// A table's time order: the latest time written, and the rows that came earlier than it.
 #[derive(Default)]
 struct TableClock {
-    last_s: f64,
+    last_us: u64,
     reordered: u64,
-    worst_s: f64,
+    worst_us: u64,
 }
 
 impl TableClock {
-    /// `t_s`, or the latest time written when `t_s` is earlier (counted).
-    fn order(&mut self, t_s: f64) -> f64 {
-        if t_s < self.last_s {
-            self.reordered += 1;
-            self.worst_s = f64::max(self.worst_s, self.last_s - t_s);
-            return self.last_s;
+    /// `t_us`, or the latest time written when `t_us` is earlier (counted; a time before
+    /// t = 0 is put at 0).
+    fn order(&mut self, t_us: i64) -> u64 {
+        match u64::try_from(t_us) {
+            Ok(t) if t >= self.last_us => {
+                self.last_us = t;
+                t
+            }
+            _ => {
+                self.reordered += 1;
+                let early = i128::from(self.last_us) - i128::from(t_us);
+                self.worst_us = self.worst_us.max(u64::try_from(early).unwrap_or(u64::MAX));
+                self.last_us
+            }
         }
-        self.last_s = t_s;
-        t_s
     }
 }
 
-/// Seconds to the microsecond of `ns` plus `extra_ns` (the difference from t = 0 taken in
+/// Microseconds of `ns` plus `extra_ns`, to the nearest (the difference from t = 0 taken in
 /// integers first, as a stamp, ~1.7e18 ns, is finer than an f64 resolves).
-fn microseconds(ns_from_start: i64, extra_ns: f64) -> f64 {
-    round_half_away((ns_from_start as f64 + extra_ns) / 1e3) / 1e6
+fn microseconds(ns_from_start: i64, extra_ns: f64) -> i64 {
+    round_half_away((ns_from_start as f64 + extra_ns) / 1e3) as i64
+}
+
+/// Seconds of a whole number of microseconds: the `f64` closest to the decimal.
+fn seconds_of(us: u64) -> f64 {
+    us as f64 / 1e6
 }
 
 /// `f64::round` (half away from zero) without its call into the C library, which the
@@ -474,6 +518,7 @@ impl Converter {
             odometry_start_m: (0.0, 0.0),
             sonar_out_of_range: 0,
             sonar_fov_rad: None,
+            scan_angles: ScanAngles::default(),
         }
     }
 
@@ -510,8 +555,8 @@ impl Converter {
     /// an f64 resolves.
     fn seconds(&mut self, role: Role, ns: i64, extra_ns: f64) -> f64 {
         let t0 = *self.t0_ns.get_or_insert(ns);
-        let t_s = microseconds(ns - t0, extra_ns);
-        self.clocks.entry(role).or_default().order(t_s)
+        let t_us = microseconds(ns - t0, extra_ns);
+        seconds_of(self.clocks.entry(role).or_default().order(t_us))
     }
 
     /// Counts a message skipped for a NaN or infinite value (a driver's "unknown").
@@ -639,15 +684,19 @@ impl Converter {
         if scan.ranges.is_empty() {
             return Ok(());
         }
-        let angle_min = decimal_of_f32(scan.angle_min);
-        let increment = decimal_of_f32(scan.angle_increment);
         let time_increment_ns = decimal_of_f32(scan.time_increment) * 1e9;
+        let angles = self
+            .scan_angles
+            .of(scan.angle_min, scan.angle_increment, scan.ranges.len());
+        let Some(angles) = angles.filter(|_| time_increment_ns.is_finite()) else {
+            self.not_finite(Role::Lidar);
+            return Ok(());
+        };
         let (range_min, range_max) = (scan.range_min, scan.range_max);
         let from_start_ns = ns - *self.t0_ns.get_or_insert(ns);
         let clock = self.clocks.entry(Role::Lidar).or_default();
-        for (i, &range) in scan.ranges.iter().enumerate() {
-            let i_f = i as f64;
-            let t_s = clock.order(microseconds(from_start_ns, i_f * time_increment_ns));
+        for (i, (&range, &angle_e4_deg)) in scan.ranges.iter().zip(angles).enumerate() {
+            let t_us = clock.order(microseconds(from_start_ns, i as f64 * time_increment_ns));
             // 0 is no echo too (drivers that leave range_min 0 send it for none).
             let valid =
                 range.is_finite() && range > 0.0 && range >= range_min && range <= range_max;
@@ -657,16 +706,35 @@ impl Converter {
                 .get(i)
                 .filter(|s| s.is_finite())
                 .map_or(0, |&s| (f64::from(s.clamp(0.0, 65_535.0)) + 0.5) as u16);
-            sink.lidar(&LidarSample {
-                t_s,
-                rev: self.rev,
-                angle_deg: angle_deg(angle_min + i_f * increment),
-                range_m: if valid { decimal_of_f32(range) } else { 0.0 },
-                strength,
-                invalid: !valid,
-                warning: false,
-                true_range_m: None,
-            })?;
+            let range_decimal = if valid {
+                short_decimal_of_f32(range)
+            } else {
+                Some((0, 0))
+            };
+            if let Some((range_digits, range_scale)) = range_decimal {
+                sink.lidar_decimals(&LidarDecimals {
+                    t_us,
+                    rev: self.rev,
+                    angle_e4_deg,
+                    range_digits,
+                    range_scale,
+                    strength,
+                    invalid: !valid,
+                    warning: false,
+                })?;
+            } else {
+                // A range of more than 6 significant digits (a float lidar's noise).
+                sink.lidar(&LidarSample {
+                    t_s: seconds_of(t_us),
+                    rev: self.rev,
+                    angle_deg: f64::from(angle_e4_deg) / 1e4,
+                    range_m: decimal_of_f32(range),
+                    strength,
+                    invalid: false,
+                    warning: false,
+                    true_range_m: None,
+                })?;
+            }
         }
         self.count(Role::Lidar, scan.ranges.len() as u64);
         self.rev += 1;
@@ -867,7 +935,7 @@ impl Converter {
                 "{} {role} rows came before the row written ahead of them (by up to {:.3} ms) \
                  and were put at its time",
                 clock.reordered,
-                clock.worst_s * 1e3
+                clock.worst_us as f64 / 1e3
             ));
         }
         for (role, count) in &self.not_finite {
@@ -921,8 +989,9 @@ pub fn decimal_of_f32(x: f32) -> f64 {
     if !x.is_finite() {
         return f64::from(x);
     }
-    if let Some(decimal) = short_decimal_of_f32(x) {
-        return decimal;
+    if let Some((digits, scale)) = short_decimal_of_f32(x) {
+        let decimal = digits as f64 / POWERS_OF_TEN[scale as usize];
+        return if x < 0.0 { -decimal } else { decimal };
     }
     let mut buffer = zmij::Buffer::new();
     buffer
@@ -939,15 +1008,28 @@ pub fn decimal_of_f32(x: f32) -> f64 {
 /// one [`decimal_of_f32`] gives. The 6-digit decimals are 10⁻ˢ apart, 10 to 100 times the
 /// float32's step, so only the one closest to `x` can read as `x`: n·10⁻ˢ for n the whole
 /// number closest to |x|·10ˢ, with s such that n has 6 digits.
-fn short_decimal_of_f32(x: f32) -> Option<f64> {
-    const POWERS: [f64; 16] = [
-        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-    ];
+fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
+    const POWERS: [f64; 16] = POWERS_OF_TEN;
     let magnitude = f64::from(x).abs();
     if !(1e-10..1e6).contains(&magnitude) {
         return None;
     }
-    let power = POWERS.iter().copied().find(|p| magnitude * p >= 1e5)?;
+    // x = 1.m × 2^e (normal: |x| ≥ 1e-10), so log10 |x| is within one of e·log10 2
+    // (1233/4096): s from that guess, moved by one at most.
+    let bits = x.abs().to_bits();
+    let e = i32::try_from(bits >> 23).unwrap_or(0) - 127;
+    let guess = 5 - ((e * 1233) >> 12);
+    let mut s = usize::try_from(guess).unwrap_or(0).min(POWERS.len() - 1);
+    if magnitude * POWERS[s] < 1e5 {
+        s = (s + 1).min(POWERS.len() - 1);
+    } else if s > 0 && magnitude * POWERS[s - 1] >= 1e5 {
+        s -= 1;
+    }
+    let power = POWERS[s];
+    if magnitude * power < 1e5 || (s > 0 && magnitude * POWERS[s - 1] >= 1e5) {
+        // The guess was off by more than one: no such float32 (checked by the tests).
+        return None;
+    }
     let scaled = round_half_away(magnitude * power);
     // n ≥ 10⁵ by the choice of s: n ≤ 10⁶ has at most 6 significant digits. (A power one
     // off at a boundary makes 7 digits, or a decimal that misses `x`: `None` either way.)
@@ -957,38 +1039,43 @@ fn short_decimal_of_f32(x: f32) -> Option<f64> {
     // The f64 closest to n·10⁻ˢ (n and 10ˢ are exact: one rounding), what parsing the
     // decimal gives.
     let decimal = scaled / power;
-    // It reads as `x` when it lies within half a step of `x` towards either neighbour (the
-    // steps differ at a power of two); the margin of one part in 10⁶ is far above the f64
-    // rounding of `decimal` (10⁻¹⁶), so that no double rounding decides.
-    let bits = x.abs().to_bits();
-    let below = f64::from(f32::from_bits(bits - 1));
-    let above = f64::from(f32::from_bits(bits + 1));
-    let half_step = 0.5 * f64::min(magnitude - below, above - magnitude);
-    ((decimal - magnitude).abs() < half_step * (1.0 - 1e-6)).then_some(if x < 0.0 {
-        -decimal
+    // It reads as `x` when it lies within half a step of `x` towards either neighbour; the
+    // margin of one part in 10⁶ is far above the f64 rounding of `decimal` (10⁻¹⁶), so that
+    // no double rounding decides. The step is 2^(e−23), and half that below a power of two.
+    let step = f64::from_bits(u64::try_from(e - 23 + 1023).unwrap_or(0) << 52);
+    let half_step = if bits & 0x007F_FFFF == 0 {
+        0.25 * step
     } else {
-        decimal
-    })
+        0.5 * step
+    };
+    // n ≤ 10⁶ and s ≤ 15: both exact in their integer types.
+    ((decimal - magnitude).abs() < half_step * (1.0 - 1e-6)).then_some((scaled as u64, s as u32))
 }
+
+/// 10⁰ to 10¹⁵, each exact in an `f64`.
+const POWERS_OF_TEN: [f64; 16] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+];
 
 /// A LaserScan angle (radians, any turn) as a recording's degrees in [0, 360), to 1e-4°: the
 /// float32 angle and increment put reading i of a 360-reading scan about 1e-5° off its nominal
 /// angle, and no lidar resolves 1e-4°.
 #[must_use]
 pub fn angle_deg(angle_rad: f64) -> f64 {
-    let deg = round_half_away(angle_rad.to_degrees() * 1e4) / 1e4;
-    // Most angles of a scan are in [0, 360) already: no `fmod` for them.
-    let deg = if (0.0..360.0).contains(&deg) {
-        deg
-    } else {
-        deg.rem_euclid(360.0)
-    };
-    // A turn rounded up to 360 is 0, and so is -0 (a tiny negative angle): written "0".
-    if deg >= 360.0 || deg == 0.0 {
-        0.0
-    } else {
-        deg
+    f64::from(angle_e4_deg(angle_rad)) / 1e4
+}
+
+/// [`angle_deg`] in ten-thousandths of a degree, [0, 3,600,000): the turn taken off in
+/// integers, exactly (a float remainder leaves 269.99990000000003 for −90.0001); 0 for an
+/// angle that is not finite.
+fn angle_e4_deg(angle_rad: f64) -> u32 {
+    const TURN: i64 = 3_600_000;
+    let e4 = round_half_away(angle_rad.to_degrees() * 1e4);
+    // Within ±2⁵³ every whole f64 is an exact i64.
+    if e4.is_nan() || e4.abs() >= 9.0e15 {
+        return 0;
     }
+    u32::try_from((e4 as i64).rem_euclid(TURN)).unwrap_or(0)
 }
 
 #[cfg(test)]
@@ -1021,11 +1108,23 @@ mod tests {
         ] {
             let x: f32 = text.parse().unwrap();
             let expected: f64 = text.parse().unwrap();
-            assert_eq!(short_decimal_of_f32(x), Some(expected), "{text}");
-            assert_eq!(short_decimal_of_f32(-x), Some(-expected), "-{text}");
+            for x in [x, -x] {
+                let (digits, scale) = short_decimal_of_f32(x).unwrap();
+                assert_eq!(digits as f64 / 10f64.powi(scale as i32), expected, "{text}");
+                assert_eq!(decimal_of_f32(x), expected.copysign(f64::from(x)), "{text}");
+            }
         }
         assert_eq!(short_decimal_of_f32(1.234_567_8), None);
         assert!(short > 0);
+        // Every millimetre range to 100 m (the fast path of an import) is short.
+        for mm in 1..100_000u32 {
+            let x = mm as f32 / 1000.0;
+            let (digits, scale) = short_decimal_of_f32(x).unwrap();
+            assert_eq!(
+                digits as f64 / 10f64.powi(scale as i32),
+                f64::from(mm) / 1e3
+            );
+        }
     }
 
     #[test]
@@ -1058,6 +1157,78 @@ mod tests {
         }
     }
 
+    /// A scan whose angles or timing are not numbers is skipped and counted, not written as
+    /// NaN; the readings of a good scan reach a sink as the decimals they were sent as.
+    #[test]
+    fn a_scan_of_nan_fields_is_skipped() {
+        use crate::cdr::encode;
+        use crate::msgs::Header;
+        let chosen: Chosen = [(Role::Lidar, ("/scan".to_string(), Kind::LaserScan))].into();
+        let mut converter = Converter::new(&chosen, 0.2, None);
+        /// Keeps the lidar's readings (through `SampleSink::lidar_decimals`'s default).
+        #[derive(Default)]
+        struct Kept(Vec<LidarSample>);
+        impl SampleSink for Kept {
+            type Error = hilsim_recording::Error;
+            fn command(&mut self, _: &CommandSample) -> Result<(), Self::Error> {
+                Ok(())
+            }
+            fn odometry(&mut self, _: &OdometrySample) -> Result<(), Self::Error> {
+                Ok(())
+            }
+            fn lidar(&mut self, r: &LidarSample) -> Result<(), Self::Error> {
+                self.0.push(*r);
+                Ok(())
+            }
+            fn sonar(&mut self, _: &SonarSample) -> Result<(), Self::Error> {
+                Ok(())
+            }
+            fn truth(&mut self, _: &TruthSample) -> Result<(), Self::Error> {
+                Ok(())
+            }
+        }
+        let mut kept = Kept::default();
+        let scan = |angle_min: f32, time_increment: f32| {
+            let mut bytes = Vec::new();
+            let message = LaserScan {
+                header: Header {
+                    stamp: Time { sec: 7, nanosec: 0 },
+                    frame_id: "laser".into(),
+                },
+                angle_min,
+                angle_increment: 0.5f32.to_radians(),
+                time_increment,
+                range_min: 0.1,
+                range_max: 6.0,
+                ranges: vec![1.234, 0.05, f32::NAN],
+                ..LaserScan::default()
+            };
+            encode(&message, &mut bytes);
+            bytes
+        };
+        for bytes in [scan(f32::NAN, 0.0), scan(0.0, f32::INFINITY)] {
+            let converted = converter.message(Role::Lidar, Kind::LaserScan, 0, &bytes, &mut kept);
+            assert!(converted.is_ok());
+        }
+        assert!(kept.0.is_empty());
+        assert!(converter
+            .notes()
+            .iter()
+            .any(|n| n.contains("2 lidar messages with a value that is not finite")));
+        let good = scan(-0.5f32.to_radians(), 1e-4);
+        let converted = converter.message(Role::Lidar, Kind::LaserScan, 0, &good, &mut kept);
+        assert!(converted.is_ok());
+        let row = |r: &LidarSample| (r.t_s, r.angle_deg, r.range_m, r.invalid);
+        assert_eq!(
+            kept.0.iter().map(row).collect::<Vec<_>>(),
+            [
+                (0.0, 359.5, 1.234, false),
+                (0.0001, 0.0, 0.0, true),
+                (0.0002, 0.5, 0.0, true)
+            ]
+        );
+    }
+
     #[test]
     fn angles_wrap_and_round() {
         let step = (1.0f64.to_radians() as f32) as f64;
@@ -1065,6 +1236,10 @@ mod tests {
         assert_eq!(angle_deg(-std::f64::consts::FRAC_PI_2), 270.0);
         assert_eq!(angle_deg(2.0 * std::f64::consts::PI), 0.0);
         assert_eq!(angle_deg(-1e-12).to_bits(), 0.0f64.to_bits());
+        // The turn comes off exactly: on the 10⁻⁴° grid, not 269.99990000000003.
+        assert_eq!(angle_deg((-90.0001f64).to_radians()), 269.9999);
+        assert_eq!(angle_deg((725.5f64).to_radians()), 5.5);
+        assert_eq!(angle_deg(f64::NAN), 0.0);
         let half = decimal_of_f32(0.5f64.to_radians() as f32);
         for i in 0..720 {
             assert_eq!(angle_deg(f64::from(i) * half), f64::from(i) * 0.5, "{i}");

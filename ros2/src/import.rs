@@ -1014,10 +1014,26 @@ fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
     if !(1e-10..1e6).contains(&magnitude) {
         return None;
     }
-    // x = 1.m × 2^e (normal: |x| ≥ 1e-10), so log10 |x| is within one of e·log10 2
-    // (1233/4096): s from that guess, moved by one at most.
     let bits = x.abs().to_bits();
     let e = i32::try_from(bits >> 23).unwrap_or(0) - 127;
+    // Within half a step of `x` towards either neighbour, a decimal reads as `x`; the margin
+    // of one part in 10⁶ is far above the f64 rounding of the products (10⁻¹⁶), so that no
+    // double rounding decides. The step is 2^(e−23), and half that below a power of two.
+    let step = f64::from_bits(u64::try_from(e - 23 + 1023).unwrap_or(0) << 52);
+    let half_step = if bits & 0x007F_FFFF == 0 {
+        0.25 * step
+    } else {
+        0.5 * step
+    } * (1.0 - 1e-6);
+    // Millimetres first (most lidars' and sonars' ranges): n·10⁻³ with n < 10⁶ has at most
+    // 6 significant digits, so if it reads as `x` it is the one such decimal.
+    let millimetres = magnitude * 1e3;
+    let n = round_half_away(millimetres);
+    if n < 1e6 && (n - millimetres).abs() < half_step * 1e3 {
+        return Some((n as u64, 3));
+    }
+    // x = 1.m × 2^e (normal: |x| ≥ 1e-10), so log10 |x| is within one of e·log10 2
+    // (1233/4096): s from that guess, moved by one at most.
     let guess = 5 - ((e * 1233) >> 12);
     let mut s = usize::try_from(guess).unwrap_or(0).min(POWERS.len() - 1);
     if magnitude * POWERS[s] < 1e5 {
@@ -1039,17 +1055,8 @@ fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
     // The f64 closest to n·10⁻ˢ (n and 10ˢ are exact: one rounding), what parsing the
     // decimal gives.
     let decimal = scaled / power;
-    // It reads as `x` when it lies within half a step of `x` towards either neighbour; the
-    // margin of one part in 10⁶ is far above the f64 rounding of `decimal` (10⁻¹⁶), so that
-    // no double rounding decides. The step is 2^(e−23), and half that below a power of two.
-    let step = f64::from_bits(u64::try_from(e - 23 + 1023).unwrap_or(0) << 52);
-    let half_step = if bits & 0x007F_FFFF == 0 {
-        0.25 * step
-    } else {
-        0.5 * step
-    };
     // n ≤ 10⁶ and s ≤ 15: both exact in their integer types.
-    ((decimal - magnitude).abs() < half_step * (1.0 - 1e-6)).then_some((scaled as u64, s as u32))
+    ((decimal - magnitude).abs() < half_step).then_some((scaled as u64, s as u32))
 }
 
 /// 10⁰ to 10¹⁵, each exact in an `f64`.

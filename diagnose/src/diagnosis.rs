@@ -10,7 +10,9 @@ use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};
 use crate::locate::{self, Evidence, TestKind};
-use crate::outcome::{Diagnosis, Options, SensorSummary, ESTIMATED_PATH_TIMING_S};
+use crate::outcome::{
+    Diagnosis, Options, SensorSummary, ESTIMATED_MOUNT_MIN_M, ESTIMATED_PATH_TIMING_S,
+};
 use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, SensorData};
@@ -295,6 +297,7 @@ impl Options {
         if aligned.alignment == Alignment::Estimated {
             options.floors.odometer_m = options.floors.odometer_m.max(aligned.position_sd_m);
             options.path_timing_s = options.path_timing_s.max(ESTIMATED_PATH_TIMING_S);
+            options.mount_min_m = options.mount_min_m.max(ESTIMATED_MOUNT_MIN_M);
         }
         options
     }
@@ -671,14 +674,6 @@ fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
     })
 }
 
-/// The least displacement of the robot (the mount's position offset) a mount fitted through the
-/// sonar and the encoders must have to be named. The path estimated under a lidar effect the
-/// matching does not model (an incidence, a reflectivity walk, motion skew) is bent
-/// systematically, and a mount offset of that size mimics the bend: measured
-/// (`--self-test 100 --seed 1 --reality independent --without-truth`) 2–7.5 mm beside a
-/// concealed incidence, skew, reflectivity or sonar delay (trials 19, 26, 37, 44, 50, 67,
-/// 74, 84, 91), the yaw then 0.02–2.7° and meaningless (the sonar's axis alone sees it).
-const MOUNT_THROUGH_PATH_MIN_M: f64 = 0.01;
 /// The least span of headings a run must turn through for a mount to be fitted through the
 /// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
 /// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
@@ -697,7 +692,7 @@ const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// encoders' training log-likelihood along it is maximised. It is named when it gains on their
 /// held-out readings more than the effects named in them gain together (it explains what they
 /// were named for), it earns its place in the sensor it gains most in, and it moves the robot
-/// by at least [`MOUNT_THROUGH_PATH_MIN_M`]; a run that does not turn through
+/// by at least [`Options::mount_min_m`]; a run that does not turn through
 /// [`MOUNT_THROUGH_PATH_MIN_TURN_RAD`] is not tried. Returns it (scored
 /// there) with the path estimated again under it and the named lidar effects; the caller
 /// judges the sonar and the encoders again along that path.
@@ -755,9 +750,8 @@ fn mount_through_path(
     // Estimated from every sensor that sees it (the encoders see the mount's position as the
     // robot turns, the sonar its yaw too).
     best.param_sd = param_sd;
-    let moved_m = best.params[1].hypot(best.params[2]);
+    // Its place earned includes the mount's least offset against an estimated path.
     if gain <= explained + options.min_gain
-        || moved_m < MOUNT_THROUGH_PATH_MIN_M
         || !select::earns_place(&best, declared_cone(ctx), options)
     {
         return Ok(None);

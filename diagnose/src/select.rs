@@ -46,6 +46,20 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
         && c.effect.departs(&c.params, declared_cone)
         && c.size_m > options.floors.floor_m(c.sensor, c.size_noise_m)
         && !within_path_timing(c, options)
+        && !below_mount_floor(c, options)
+}
+
+/// Whether `c` is a lidar mount whose position offset is under [`Options::mount_min_m`].
+fn below_mount_floor(c: &CandidateFit, options: &Options) -> bool {
+    c.effect == Effect::LidarMountOffset && mount_offset_m(&c.params) < options.mount_min_m
+}
+
+/// The offset of a lidar mount's position (its parameters yaw, x, y), metres.
+pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
+    match params {
+        [_yaw, x, y] => x.hypot(*y),
+        _ => 0.0,
+    }
 }
 
 /// Whether `c` is a delay of a sensor judged along the trajectory (the sonar, the encoders)
@@ -185,4 +199,39 @@ pub(crate) fn select(ctx: &Context<'_>, data: &[SensorData], options: &Options) 
     }
     named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
     Selection { named, candidates }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lidar mount fitted 7 mm off earns its place against truth (its own 5 mm departure) but
+    /// not against an estimated path, whose floor is 1 cm; one 2 cm off earns it against both.
+    #[test]
+    fn a_small_mount_is_not_named_against_an_estimated_path() {
+        let mount = |x_m: f64| CandidateFit {
+            effect: Effect::LidarMountOffset,
+            sensor: Sensor::Lidar,
+            params: vec![1.0, x_m, 0.0],
+            param_sd: vec![0.01; 3],
+            train_gain: 500.0,
+            heldout_gain: 400.0,
+            bic_gain: 300.0,
+            rmse_before: 0.03,
+            rmse_after: 0.02,
+            noise_floor: 0.02,
+            heldout_n: 10_000,
+            size_m: 0.02,
+            size_noise_m: 0.01,
+        };
+        let truth = Options::default();
+        let estimated = Options {
+            mount_min_m: crate::outcome::ESTIMATED_MOUNT_MIN_M,
+            ..Options::default()
+        };
+        assert!(earns_place(&mount(0.007), 15.0, &truth));
+        assert!(!earns_place(&mount(0.007), 15.0, &estimated));
+        assert!(earns_place(&mount(0.02), 15.0, &estimated));
+        assert_eq!(mount_offset_m(&[2.0, 0.003, -0.004]), 0.005);
+    }
 }

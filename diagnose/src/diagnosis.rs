@@ -120,8 +120,10 @@ pub fn diagnose_with_progress(
         }
         None => named,
     };
-    // A lidar mount offset the estimated path took up, seen by the sonar and the encoders.
-    let mounted = mount_through_path(
+    // A lidar mount offset or delay the estimated path took up, seen by the sonar and the
+    // encoders (the mount tried first; a delay when no mount is named).
+    let mut seen_through = through_path(
+        Effect::LidarMountOffset,
         final_ctx,
         realigned.as_ref().unwrap_or(&aligned),
         &named,
@@ -129,15 +131,26 @@ pub fn diagnose_with_progress(
         &data,
         options,
     )?;
-    let (mount_fit, mount_path) = mounted.unzip();
-    let mounted_ctx = mount_path.as_ref().map(|a| along(&ctx, a));
-    let final_ctx = mounted_ctx.as_ref().unwrap_or(final_ctx);
-    let named = match (mount_fit, &mounted_ctx) {
-        (Some(mount), Some(along)) => {
+    if seen_through.is_none() {
+        seen_through = through_path(
+            Effect::SensorLatency(Sensor::Lidar),
+            final_ctx,
+            realigned.as_ref().unwrap_or(&aligned),
+            &named,
+            &mut candidates,
+            &data,
+            options,
+        )?;
+    }
+    let (through_fit, through_aligned) = seen_through.unzip();
+    let through_ctx = through_aligned.as_ref().map(|a| along(&ctx, a));
+    let final_ctx = through_ctx.as_ref().unwrap_or(final_ctx);
+    let named = match (through_fit, &through_ctx) {
+        (Some(fit), Some(along)) => {
             let (mut named, again) =
                 rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
             nominal = again;
-            named.push(mount);
+            named.push(fit);
             named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
             named
         }
@@ -696,7 +709,15 @@ const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// [`MOUNT_THROUGH_PATH_MIN_TURN_RAD`] is not tried. Returns it (scored
 /// there) with the path estimated again under it and the named lidar effects; the caller
 /// judges the sonar and the encoders again along that path.
-fn mount_through_path(
+///
+/// A lidar delay (`sensor_latency` of the lidar) goes into the path the same way: the matching
+/// puts each pose at the scan's late stamp, so the lidar fits and the sonar and the encoders,
+/// judged along a path that runs late, show the delay (the encoders as a lead proportional to
+/// the wheel speed, a slip's signature; the sonar as a range error proportional to the speed).
+/// It is fitted and named through them by the same rule (`effect`), the path then put back by
+/// the delay.
+fn through_path(
+    effect: Effect,
     ctx: &Context<'_>,
     aligned: &Aligned,
     named: &[CandidateFit],
@@ -704,9 +725,15 @@ fn mount_through_path(
     data: &[SensorData],
     options: &Options,
 ) -> Result<Option<(CandidateFit, Aligned)>, MismatchError> {
-    let mount = Effect::LidarMountOffset;
     let Some(declared) = ctx.physics.declared().lidar.map(|l| l.mount) else {
         return Ok(None);
+    };
+    let seen_through_path = match effect {
+        Effect::LidarMountOffset => {
+            ctx.trajectory.heading_span_rad() >= MOUNT_THROUGH_PATH_MIN_TURN_RAD
+        }
+        Effect::SensorLatency(Sensor::Lidar) => true,
+        _ => false,
     };
     let looking_from_robot = |s: Sensor| matches!(s, Sensor::Sonar | Sensor::Odometer);
     let others: Vec<&SensorData> = data
@@ -714,10 +741,10 @@ fn mount_through_path(
         .filter(|d| looking_from_robot(d.sensor))
         .collect();
     if !ctx.estimated
-        || !options.effects.contains(&mount)
+        || !seen_through_path
+        || !options.effects.contains(&effect)
         || others.is_empty()
-        || named.iter().any(|c| c.effect == mount)
-        || ctx.trajectory.heading_span_rad() < MOUNT_THROUGH_PATH_MIN_TURN_RAD
+        || named.iter().any(|c| c.effect == effect)
     {
         return Ok(None);
     }
@@ -727,12 +754,12 @@ fn mount_through_path(
     };
     let nominal = Hypothesis::nominal();
     let (params, param_sd) =
-        explain::fit_across(&through, &others, &nominal, mount, options.max_fit_rows);
+        explain::fit_across(&through, &others, &nominal, effect, options.max_fit_rows);
     let fits: Vec<CandidateFit> = others
         .iter()
         .map(|d| {
             let train = explain::fit_rows(d, options.max_fit_rows);
-            explain::score(&through, d, &nominal, mount, params.clone(), &train)
+            explain::score(&through, d, &nominal, effect, params.clone(), &train)
         })
         .collect();
     let gain: f64 = fits.iter().map(|f| f.heldout_gain).sum();
@@ -747,7 +774,7 @@ fn mount_through_path(
     else {
         return Ok(None);
     };
-    // Estimated from every sensor that sees it (the encoders see the mount's position as the
+    // Estimated from every sensor that sees it (the encoders see a mount's position as the
     // robot turns, the sonar its yaw too).
     best.param_sd = param_sd;
     // Its place earned includes the mount's least offset against an estimated path.
@@ -761,9 +788,18 @@ fn mount_through_path(
         .filter(|c| c.effect.sensor() == Sensor::Lidar)
         .cloned()
         .collect();
-    let hypothesis = hypothesis_of(&lidar_named).and(mount, best.params.clone());
-    let again = align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?;
-    if let Some(c) = candidates.iter_mut().find(|c| c.effect == mount) {
+    let again = match (effect, best.params.as_slice()) {
+        // The path the delay was fitted along: the estimate put back by it.
+        (Effect::SensorLatency(Sensor::Lidar), &[delay_s]) => Aligned {
+            trajectory: aligned.trajectory.delayed(delay_s),
+            ..aligned.clone()
+        },
+        _ => {
+            let hypothesis = hypothesis_of(&lidar_named).and(effect, best.params.clone());
+            align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?
+        }
+    };
+    if let Some(c) = candidates.iter_mut().find(|c| c.effect == effect) {
         *c = best.clone();
     }
     Ok(Some((best, again)))

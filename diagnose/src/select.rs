@@ -62,16 +62,14 @@ pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
     }
 }
 
-/// Whether `c` is a delay of a sensor judged along the trajectory (the sonar, the encoders)
-/// no larger than the trajectory's own timing is known to ([`Options::path_timing_s`]).
+/// Whether `c` is a delay no larger than the trajectory's own timing is known to
+/// ([`Options::path_timing_s`]): of a sensor judged along it (the sonar, the encoders), or of the
+/// lidar it was estimated from (told only through the other two).
 fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
-    matches!(
-        c.effect,
-        Effect::SensorLatency(Sensor::Sonar | Sensor::Odometer)
-    ) && c
-        .params
-        .first()
-        .is_some_and(|d| d.abs() <= options.path_timing_s)
+    matches!(c.effect, Effect::SensorLatency(_))
+        && c.params
+            .first()
+            .is_some_and(|d| d.abs() <= options.path_timing_s)
 }
 
 /// The hypothesis of the effects `fits` with their parameters.

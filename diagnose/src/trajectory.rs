@@ -96,6 +96,16 @@ impl Trajectory {
         }
     }
 
+    /// The robot's path when this one was found by matching scans whose stamps ran `delay_s`
+    /// late: the pose the matching put at stamp t the robot had at t − `delay_s`.
+    #[must_use]
+    pub fn delayed(&self, delay_s: f64) -> Self {
+        Self {
+            t: self.t.iter().map(|t| t - delay_s).collect(),
+            poses: self.poses.clone(),
+        }
+    }
+
     /// The span of headings the path turns through, radians: the largest minus the smallest
     /// heading along it, unwrapped (a full turn is 2π, not 0).
     #[must_use]
@@ -215,6 +225,23 @@ impl Trajectory {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A path matched from scans stamped late is put back by the delay: the pose found at
+    /// stamp t is the robot's at t − delay.
+    #[test]
+    fn a_delayed_path_runs_early_by_the_delay() {
+        let sample = |t_s: f64, x_m: f64| TruthSample {
+            t_s,
+            x_m,
+            y_m: 0.0,
+            yaw_rad: 0.0,
+        };
+        let path = Trajectory::new(&[sample(0.0, 0.0), sample(1.0, 1.0)]).unwrap();
+        let delayed = path.delayed(0.25);
+        assert_eq!(delayed.times(), &[-0.25, 0.75]);
+        assert_eq!(delayed.poses(), path.poses());
+        assert!((delayed.pose_at(0.25).x - 0.5).abs() < 1e-12);
+    }
 
     #[test]
     fn a_path_under_another_mount_keeps_the_lidar_where_the_matching_placed_it() {

@@ -246,9 +246,9 @@ fn without_truth_the_trajectory_is_estimated() {
     );
 }
 
-/// The text of a two-trial self-test without truth on the small room, `only` concealed,
-/// after asserting that it named it in both trials with its parameters within 20 %.
-fn both_named_without_truth(only: &str) -> String {
+/// The text of a two-trial self-test (of `seed`) without truth on the small room, `only`
+/// concealed, after asserting that it named it in both trials with its parameters within 20 %.
+fn both_named_without_truth(only: &str, seed: u64) -> String {
     let tmp = tempfile::tempdir().unwrap();
     let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
     let out = hilsim(
@@ -258,7 +258,7 @@ fn both_named_without_truth(only: &str) -> String {
             "--self-test",
             "2",
             "--seed",
-            "1",
+            &seed.to_string(),
             "--sim",
             &nominal,
             "--only",
@@ -280,7 +280,7 @@ fn both_named_without_truth(only: &str) -> String {
 /// is named in both trials, its time constant within 20 %, and no other effect is named.
 #[test]
 fn without_truth_a_motor_lag_is_named_from_the_drive() {
-    let text = both_named_without_truth("drive_motor_lag");
+    let text = both_named_without_truth("drive_motor_lag", 1);
     assert!(
         text.contains("reproduce: hilsim diagnose --self-test 2 --seed 1 --sim ")
             && text.contains("--without-truth"),
@@ -293,7 +293,16 @@ fn without_truth_a_motor_lag_is_named_from_the_drive() {
 /// through the sonar and the encoders in both trials, within 20 %.
 #[test]
 fn without_truth_a_lidar_mount_offset_is_named_through_the_other_sensors() {
-    both_named_without_truth("lidar_mount_offset");
+    both_named_without_truth("lidar_mount_offset", 1);
+}
+
+/// Issue 15: without truth a lidar delay goes into the path estimated from the lidar (the
+/// matching puts each pose at its scan's late stamp); it is named through the sonar and the
+/// encoders, within 20 % (before: trial 1 of seed 3, a 65 ms lidar delay, came out a wheel slip
+/// of 66 ms with the speed of sound beside it). Trial 0 conceals a sonar delay.
+#[test]
+fn without_truth_a_lidar_delay_is_named_through_the_other_sensors() {
+    both_named_without_truth("sensor_latency", 3);
 }
 
 #[test]

@@ -171,15 +171,22 @@ pub(crate) struct Context<'a> {
 
 impl Context<'_> {
     /// The robot's path under `h` when it differs from [`Context::trajectory`]: with
-    /// [`Context::placed_through`] set and a lidar mount offset in `h`, the path that mount
-    /// implies.
+    /// [`Context::placed_through`] set (the trajectory was found by matching the lidar), the
+    /// path that a lidar mount offset in `h` implies, and a lidar delay in `h` (its stamps late,
+    /// the matched poses late with them).
     pub(super) fn robot_path(&self, h: &Hypothesis) -> Option<Trajectory> {
         let through = self.placed_through?;
-        let offset: Vec<f64> = (0..3)
+        let offset: Option<Vec<f64>> = (0..3)
             .map(|i| h.param_of(Effect::LidarMountOffset, i))
-            .collect::<Option<_>>()?;
-        let real = mounted(&through, &offset);
-        Some(self.trajectory.under_mount(&through, &real))
+            .collect();
+        let mounted = offset.map(|o| {
+            self.trajectory
+                .under_mount(&through, &mounted(&through, &o))
+        });
+        match h.param_of(Effect::SensorLatency(Sensor::Lidar), 0) {
+            Some(delay_s) => Some(mounted.as_ref().unwrap_or(self.trajectory).delayed(delay_s)),
+            None => mounted,
+        }
     }
 
     /// Widens range predictions by the estimated trajectory's uncertainty: its position error

@@ -122,18 +122,13 @@ pub fn diagnose_with_progress(
     };
     // A lidar mount offset or delay the estimated path took up, seen by the sonar and the
     // encoders (the mount tried first; a delay when no mount is named).
-    let mut seen_through = through_path(
+    let mut seen_through = None;
+    for effect in [
         Effect::LidarMountOffset,
-        final_ctx,
-        realigned.as_ref().unwrap_or(&aligned),
-        &named,
-        &mut candidates,
-        &data,
-        options,
-    )?;
-    if seen_through.is_none() {
+        Effect::SensorLatency(Sensor::Lidar),
+    ] {
         seen_through = through_path(
-            Effect::SensorLatency(Sensor::Lidar),
+            effect,
             final_ctx,
             realigned.as_ref().unwrap_or(&aligned),
             &named,
@@ -141,6 +136,9 @@ pub fn diagnose_with_progress(
             &data,
             options,
         )?;
+        if seen_through.is_some() {
+            break;
+        }
     }
     let (through_fit, through_aligned) = seen_through.unzip();
     let through_ctx = through_aligned.as_ref().map(|a| along(&ctx, a));

@@ -27,7 +27,9 @@ pub struct Options {
     /// explains them better than the prediction) above which the recording "does not align".
     pub misaligned_share: f64,
     /// The timing the trajectory the sonar and the encoders are judged along is known to,
-    /// seconds: a delay of theirs within it is not told from the trajectory's own. 0 against
+    /// seconds: a delay of theirs (or of the lidar it was estimated from), or a wheel slip's
+    /// gain (encoders leading it by `g v`, a delay's mirror), within it is not told from the
+    /// trajectory's own. 0 against
     /// `truth.csv`; the diagnosis sets [`ESTIMATED_PATH_TIMING_S`] against a path estimated
     /// from the lidar.
     pub path_timing_s: f64,

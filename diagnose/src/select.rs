@@ -64,12 +64,16 @@ pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
 
 /// Whether `c` is a delay no larger than the trajectory's own timing is known to
 /// ([`Options::path_timing_s`]): of a sensor judged along it (the sonar, the encoders), or of the
-/// lidar it was estimated from (told only through the other two).
+/// lidar it was estimated from (told only through the other two); or a wheel slip's gain, the
+/// mirror of such a delay (encoders leading the path by `g v`, as ones stamped early would).
 fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
-    matches!(c.effect, Effect::SensorLatency(_))
-        && c.params
-            .first()
-            .is_some_and(|d| d.abs() <= options.path_timing_s)
+    matches!(
+        c.effect,
+        Effect::SensorLatency(_) | Effect::OdometerWheelSlip
+    ) && c
+        .params
+        .first()
+        .is_some_and(|d| d.abs() <= options.path_timing_s)
 }
 
 /// The hypothesis of the effects `fits` with their parameters.
@@ -203,15 +207,13 @@ pub(crate) fn select(ctx: &Context<'_>, data: &[SensorData], options: &Options) 
 mod tests {
     use super::*;
 
-    /// A lidar mount fitted 7 mm off earns its place against truth (its own 5 mm departure) but
-    /// not against an estimated path, whose floor is 1 cm; one 2 cm off earns it against both.
-    #[test]
-    fn a_small_mount_is_not_named_against_an_estimated_path() {
-        let mount = |x_m: f64| CandidateFit {
-            effect: Effect::LidarMountOffset,
+    /// A fit of `effect` that earns its place on every count but the ones under test.
+    fn fitted(effect: Effect, params: Vec<f64>) -> CandidateFit {
+        CandidateFit {
+            effect,
             sensor: Sensor::Lidar,
-            params: vec![1.0, x_m, 0.0],
-            param_sd: vec![0.01; 3],
+            param_sd: vec![0.001; params.len()],
+            params,
             train_gain: 500.0,
             heldout_gain: 400.0,
             bic_gain: 300.0,
@@ -221,15 +223,44 @@ mod tests {
             heldout_n: 10_000,
             size_m: 0.02,
             size_noise_m: 0.01,
-        };
-        let truth = Options::default();
-        let estimated = Options {
+        }
+    }
+
+    /// Against an estimated path (as `Options::against` sets it).
+    fn estimated() -> Options {
+        Options {
             mount_min_m: crate::outcome::ESTIMATED_MOUNT_MIN_M,
+            path_timing_s: crate::outcome::ESTIMATED_PATH_TIMING_S,
             ..Options::default()
-        };
+        }
+    }
+
+    /// A lidar mount fitted 7 mm off earns its place against truth (its own 5 mm departure) but
+    /// not against an estimated path, whose floor is 1 cm; one 2 cm off earns it against both.
+    #[test]
+    fn a_small_mount_is_not_named_against_an_estimated_path() {
+        let mount = |x_m: f64| fitted(Effect::LidarMountOffset, vec![1.0, x_m, 0.0]);
+        let truth = Options::default();
         assert!(earns_place(&mount(0.007), 15.0, &truth));
-        assert!(!earns_place(&mount(0.007), 15.0, &estimated));
-        assert!(earns_place(&mount(0.02), 15.0, &estimated));
+        assert!(!earns_place(&mount(0.007), 15.0, &estimated()));
+        assert!(earns_place(&mount(0.02), 15.0, &estimated()));
         assert_eq!(mount_offset_m(&[2.0, 0.003, -0.004]), 0.005);
+    }
+
+    /// A delay of any sensor, and a wheel slip's gain (a delay's mirror), within the estimated
+    /// path's timing is not named against it; against truth it is.
+    #[test]
+    fn delays_and_slips_within_the_paths_timing_are_not_named() {
+        let truth = Options::default();
+        for effect in [
+            Effect::SensorLatency(Sensor::Lidar),
+            Effect::SensorLatency(Sensor::Odometer),
+            Effect::OdometerWheelSlip,
+        ] {
+            let short = fitted(effect, vec![0.010]);
+            assert!(earns_place(&short, 15.0, &truth), "{effect:?}");
+            assert!(!earns_place(&short, 15.0, &estimated()), "{effect:?}");
+            assert!(earns_place(&fitted(effect, vec![0.03]), 15.0, &estimated()));
+        }
     }
 }

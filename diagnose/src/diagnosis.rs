@@ -781,11 +781,6 @@ fn through_path(
     {
         return Ok(None);
     }
-    let lidar_named: Vec<CandidateFit> = named
-        .iter()
-        .filter(|c| c.effect.sensor() == Sensor::Lidar)
-        .cloned()
-        .collect();
     let again = match (effect, best.params.as_slice()) {
         // The path the delay was fitted along: the estimate put back by it.
         (Effect::SensorLatency(Sensor::Lidar), &[delay_s]) => Aligned {
@@ -793,6 +788,11 @@ fn through_path(
             ..aligned.clone()
         },
         _ => {
+            let lidar_named: Vec<CandidateFit> = named
+                .iter()
+                .filter(|c| c.effect.sensor() == Sensor::Lidar)
+                .cloned()
+                .collect();
             let hypothesis = hypothesis_of(&lidar_named).and(effect, best.params.clone());
             align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?
         }

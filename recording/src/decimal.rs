@@ -275,8 +275,8 @@ pub(crate) fn push_f64(out: &mut impl Text, x: f64) {
 /// ranges to the millimetre, wheel travel to the nanometre): numbers that are the `f64`
 /// closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵.
 const GRID: f64 = 1e9;
-const GRID_LIMIT: f64 = 1e15;
 const GRID_LIMIT_N: u64 = 1_000_000_000_000_000;
+const GRID_LIMIT: f64 = GRID_LIMIT_N as f64;
 
 /// |n| when `x` is the `f64` closest to n·10⁻⁹ for a whole n, 0 < |n| < 10¹⁵; `None`
 /// otherwise (and for a few within 10⁻⁶ of a tie between two `f64`, which lose nothing but

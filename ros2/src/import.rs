@@ -1009,7 +1009,6 @@ pub fn decimal_of_f32(x: f32) -> f64 {
 /// float32's step, so only the one closest to `x` can read as `x`: n·10⁻ˢ for n the whole
 /// number closest to |x|·10ˢ, with s such that n has 6 digits.
 fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
-    const POWERS: [f64; 16] = POWERS_OF_TEN;
     let magnitude = f64::from(x).abs();
     if !(1e-10..1e6).contains(&magnitude) {
         return None;
@@ -1032,20 +1031,8 @@ fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
     if n < 1e6 && (n - millimetres).abs() < half_step * 1e3 {
         return Some((n as u64, 3));
     }
-    // x = 1.m × 2^e (normal: |x| ≥ 1e-10), so log10 |x| is within one of e·log10 2
-    // (1233/4096): s from that guess, moved by one at most.
-    let guess = 5 - ((e * 1233) >> 12);
-    let mut s = usize::try_from(guess).unwrap_or(0).min(POWERS.len() - 1);
-    if magnitude * POWERS[s] < 1e5 {
-        s = (s + 1).min(POWERS.len() - 1);
-    } else if s > 0 && magnitude * POWERS[s - 1] >= 1e5 {
-        s -= 1;
-    }
-    let power = POWERS[s];
-    if magnitude * power < 1e5 || (s > 0 && magnitude * POWERS[s - 1] >= 1e5) {
-        // The guess was off by more than one: no such float32 (checked by the tests).
-        return None;
-    }
+    let s = POWERS_OF_TEN.iter().position(|p| magnitude * p >= 1e5)?;
+    let power = POWERS_OF_TEN[s];
     let scaled = round_half_away(magnitude * power);
     // n ≥ 10⁵ by the choice of s: n ≤ 10⁶ has at most 6 significant digits. (A power one
     // off at a boundary makes 7 digits, or a decimal that misses `x`: `None` either way.)

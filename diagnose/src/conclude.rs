@@ -135,7 +135,18 @@ pub(crate) fn conclude(
     let cone = declared_cone(ctx);
     let mut explanation = effects
         .iter()
-        .map(|e| e.fit.effect.explanation(&e.fit.params, cone))
+        .map(|e| {
+            let said = e.fit.effect.explanation(&e.fit.params, cone);
+            // A lidar mount or delay the estimated path took up is seen through another sensor.
+            if e.fit.effect.sensor() != Sensor::Lidar || e.fit.sensor == Sensor::Lidar {
+                said
+            } else {
+                format!(
+                    "{} (Seen through the {}: the path estimated from the lidar takes it up.)",
+                    said, e.fit.sensor
+                )
+            }
+        })
         .collect::<Vec<_>>()
         .join(" ");
     let left_words: Vec<String> = unexplained

@@ -45,6 +45,9 @@ pub struct CandidateFit {
     pub size_m: f64,
     /// The declared noise over those readings (RMS predicted standard deviation), metres.
     pub size_noise_m: f64,
+    /// The latest reading scored, seconds from the recording's start (a warm-up's clock):
+    /// how long a drift could be seen to settle.
+    pub seen_until_s: f64,
 }
 
 /// Readings the size of an effect is measured over: this share of the held-out ones, at
@@ -125,9 +128,9 @@ pub(crate) fn score(
     let train_base = total_ll(ctx, data, base, train);
     let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), train);
     let best = objective(&params);
-    let param_sd = free_standard_errors(effect, &params, ctx.estimated, best, &mut objective);
+    let param_sd = free_standard_errors(effect, &params, best, &mut objective);
     // The BIC's count is the free parameters' (a held one was not fitted).
-    let free = effect.free(&params, ctx.estimated);
+    let free = effect.free(&params);
     let fitted = base.and(effect, params.clone());
     let heldout = data.rows(Some(true));
     let before_p = ctx.predict(data, base, &heldout);
@@ -159,6 +162,7 @@ pub(crate) fn score(
         heldout_n,
         size_m,
         size_noise_m,
+        seen_until_s: data.t.iter().copied().fold(0.0, f64::max),
     }
 }
 
@@ -175,7 +179,7 @@ pub(crate) fn fit_candidate(
     let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
     let (params, _) = maximize_shapes(
         specs,
-        effect.shapes(ctx.estimated),
+        effect.shapes(),
         effect.shapes_refined_together(),
         &effect.absent(0.0),
         &mut objective,
@@ -203,12 +207,12 @@ pub(crate) fn fit_across(
     };
     let (params, best) = maximize_shapes(
         effect.params(),
-        effect.shapes(ctx.estimated),
+        effect.shapes(),
         effect.shapes_refined_together(),
         &effect.absent(0.0),
         &mut objective,
     );
-    let param_sd = free_standard_errors(effect, &params, ctx.estimated, best, &mut objective);
+    let param_sd = free_standard_errors(effect, &params, best, &mut objective);
     (params, param_sd)
 }
 
@@ -218,11 +222,10 @@ pub(crate) fn fit_across(
 fn free_standard_errors(
     effect: Effect,
     params: &[f64],
-    estimated: bool,
     best: f64,
     log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
 ) -> Vec<f64> {
-    let free = effect.free(params, estimated);
+    let free = effect.free(params);
     let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
     let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
     let mut in_free = |y: &[f64]| {
@@ -258,10 +261,7 @@ pub(crate) fn refit_jointly(
     }
     let train = fit_rows(data, max_fit_rows);
     // Each effect's free parameters refitted, its held ones kept.
-    let free: Vec<Vec<usize>> = chosen
-        .iter()
-        .map(|c| c.effect.free(&c.params, ctx.estimated))
-        .collect();
+    let free: Vec<Vec<usize>> = chosen.iter().map(|c| c.effect.free(&c.params)).collect();
     let specs: Vec<ParamSpec> = chosen
         .iter()
         .zip(&free)

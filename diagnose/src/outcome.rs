@@ -1,5 +1,7 @@
 //! What a diagnosis takes and gives: its options, the verdict and the diagnosis.
 
+use hilsim_recording::TruthSample;
+
 use crate::align::Alignment;
 use crate::catalogue::{Effect, Sensor};
 use crate::explain::CandidateFit;
@@ -156,6 +158,10 @@ pub struct Diagnosis {
     pub notes: Vec<String>,
     /// Residuals against the located variable, before and after the fix (held-out half).
     pub plots: Vec<PlotData>,
+    /// The trajectory every sensor was judged against when it was estimated from the lidar
+    /// (the recording has no `truth.csv`): the last one, under the named lidar effects and
+    /// put back by a mount or delay seen through the path; `None` against `truth.csv`.
+    pub estimated_path: Option<Vec<TruthSample>>,
 }
 
 impl Diagnosis {

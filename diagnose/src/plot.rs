@@ -37,6 +37,15 @@ pub struct PlotData {
     pub title: String,
 }
 
+/// Where the residuals "before the fix" are taken for an effect seen through the path (a lidar
+/// mount or delay the estimated path took up, seen by the sonar and the encoders): the path
+/// that took it up and the sensors' data along it. The fix is the path put back by the effect,
+/// so "after" is the nominal model along the diagnosis's final path.
+pub(crate) struct Before<'c, 'a> {
+    pub ctx: &'c Context<'a>,
+    pub data: &'c [SensorData],
+}
+
 /// The plots of a diagnosis: the located sensor's held-out residuals against the located
 /// variable and against time, before and after the fix.
 pub(crate) fn plots(
@@ -44,6 +53,7 @@ pub(crate) fn plots(
     data: &[SensorData],
     located: Option<&Evidence>,
     fitted: Option<&CandidateFit>,
+    through_path: Option<Before<'_, '_>>,
 ) -> Vec<PlotData> {
     let Some(sensor) = located
         .map(|l| l.sensor)
@@ -57,17 +67,30 @@ pub(crate) fn plots(
     let held = d.rows(Some(true));
     let stride = held.len().div_ceil(MAX_POINTS).max(1);
     let rows: Vec<usize> = held.into_iter().step_by(stride).collect();
-    let before: Vec<f64> = fits(d, &rows, &ctx.predict(d, &Hypothesis::nominal(), &rows))
-        .iter()
-        .map(|f| f.residual)
-        .collect();
-    let after = fitted.filter(|f| f.effect.sensor() == sensor).map(|f| {
-        let h = Hypothesis::with(f.effect, f.params.clone());
-        fits(d, &rows, &ctx.predict(d, &h, &rows))
+    let nominal = |ctx: &Context<'_>, d: &SensorData| -> Vec<f64> {
+        fits(d, &rows, &ctx.predict(d, &Hypothesis::nominal(), &rows))
             .iter()
             .map(|f| f.residual)
-            .collect::<Vec<f64>>()
+            .collect()
+    };
+    // Along the path that took the effect up, the same readings (the data of one recording).
+    let took_up = through_path.and_then(|b| {
+        let d_before = b.data.iter().find(|x| x.sensor == sensor)?;
+        (d_before.len() == d.len()).then(|| nominal(b.ctx, d_before))
     });
+    let (before, after) = match took_up {
+        Some(before) => (before, Some(nominal(ctx, d))),
+        None => (
+            nominal(ctx, d),
+            fitted.filter(|f| f.effect.sensor() == sensor).map(|f| {
+                let h = Hypothesis::with(f.effect, f.params.clone());
+                fits(d, &rows, &ctx.predict(d, &h, &rows))
+                    .iter()
+                    .map(|f| f.residual)
+                    .collect::<Vec<f64>>()
+            }),
+        ),
+    };
     let positions = world_positions(ctx, d, &rows);
     let mut variables = Vec::new();
     if let Some(c) = located.and_then(|l| l.covariate) {

@@ -88,7 +88,12 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
     if !view.truth.is_empty() {
         let stroke = Stroke::solid(colours::TRUTH, 1.8);
         chart.line(&line(&view.truth), stroke);
-        keys.push(Key::Line(stroke, "true path".into()));
+        let name = if view.inputs.truth_estimated {
+            "path estimated from the lidar"
+        } else {
+            "true path"
+        };
+        keys.push(Key::Line(stroke, name.into()));
     }
     // Landmarks a calibration found, given in the frame of the robot's start pose.
     let start = view.truth.first().or(view.odometry.first()).map(|p| p.1);

@@ -109,7 +109,11 @@ pub fn render_with(inputs: Inputs<'_>, overlay: Option<&Overlay>) -> String {
         format!(
             "Lidar revolutions {} in the world frame, each reading from the {} pose at its own time: raw readings in red{}.",
             revs.iter().map(u64::to_string).collect::<Vec<_>>().join(", "),
-            if view.reference == "truth" { "true" } else { "dead-reckoned" },
+            match (view.reference, inputs.truth_estimated) {
+                ("truth", false) => "true",
+                ("truth", true) => "estimated",
+                _ => "dead-reckoned",
+            },
             if view.calibrated(hilsim_calibrator::Sensor::Lidar).is_some() {
                 ", and with the calibrated lidar model's bias inverted in blue: calibrated readings should lie on the walls and objects"
             } else {

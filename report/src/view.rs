@@ -22,6 +22,9 @@ pub struct Inputs<'a> {
     pub scenario: Option<&'a Scenario>,
     /// Calibrations of the recording, in the order they are shown.
     pub calibrations: &'a [Calibration],
+    /// Whether the recording's truth is a path estimated from its own lidar (a diagnosis of a
+    /// recording without `truth.csv`), not measured: the page calls it so.
+    pub truth_estimated: bool,
 }
 
 /// A reading with its true distance, for the error plots.
@@ -106,7 +109,11 @@ impl<'a> View<'a> {
         let true_distance_source = if has_column {
             "the recording's true_range_m columns"
         } else if world.is_some() && !truth.is_empty() {
-            "rays cast in the scenario's world from the true path"
+            if inputs.truth_estimated {
+                "rays cast in the scenario's world from the path estimated from the lidar"
+            } else {
+                "rays cast in the scenario's world from the true path"
+            }
         } else {
             "none (the recording has no true_range_m and no truth with a scenario)"
         };

@@ -271,13 +271,20 @@ fn write_report(
         sim.display()
     );
     let name = real.display().to_string();
+    // Without truth.csv the map draws the path the diagnosis estimated from the lidar (the
+    // sensors were judged against it) and places the scans on it, not on dead reckoning.
+    let with_estimate = d.estimated_path.as_ref().map(|path| Recording {
+        truth: Some(path.clone()),
+        ..recording.clone()
+    });
     let map = hilsim_report::map_svg(
         hilsim_report::Inputs {
             title: &title,
-            recording,
+            recording: with_estimate.as_ref().unwrap_or(recording),
             recording_name: &name,
             scenario: Some(scenario),
             calibrations: &[],
+            truth_estimated: with_estimate.is_some(),
         },
         located_overlay(d).as_ref(),
     );

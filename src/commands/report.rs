@@ -33,6 +33,7 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
         recording_name: &name,
         scenario: scenario.as_ref(),
         calibrations: &calibrations,
+        truth_estimated: false,
     });
     write_report_page(&args.out, &html)?;
     writeln!(out, "report: {}", args.out.join("index.html").display())?;

@@ -48,6 +48,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             recording_name: &format!("{origin} (seed {}, in memory)", report.scenario.seed),
             scenario: Some(&report.scenario),
             calibrations: &report.calibrations,
+            truth_estimated: false,
         });
         super::report::write_report_page(dir, &html)?;
         if !args.json {

@@ -218,13 +218,19 @@ fn without_truth_the_trajectory_is_estimated() {
     std::fs::remove_file(tmp.path().join("real/truth.csv")).unwrap();
     let out = hilsim(
         tmp.path(),
-        &["diagnose", "--sim", &nominal, "--real", "real", "--json"],
+        &[
+            "diagnose", "--sim", &nominal, "--real", "real", "--json", "--report", "rep",
+        ],
     );
     let j = json(&out);
     assert_eq!(
         j["alignment"],
         "estimated (replayed commands + scan-to-map matching)"
     );
+    // The page's map draws the path every sensor was judged against, named as estimated.
+    let map = std::fs::read_to_string(tmp.path().join("rep/map.svg")).unwrap();
+    assert!(map.contains("path estimated from the lidar"), "{map}");
+    assert!(!map.contains("true path"));
     assert_eq!(j["effect"], "none", "{j}");
     let notes = j["notes"].as_array().unwrap();
     assert!(notes

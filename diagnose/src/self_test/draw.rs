@@ -282,7 +282,7 @@ fn draw_values(effect: Effect, d: &mut Draws, strength: f64, nominal: &Scenario)
         .collect();
     // An effect of two shapes (the warm-up's constant, the incidence's collimated beam): the
     // parameter of the second that the first does not have.
-    let shapes = effect.shapes(false);
+    let shapes = effect.shapes();
     let second = shapes
         .get(1)
         .and_then(|s| s.iter().find(|i| !shapes[0].contains(i)));

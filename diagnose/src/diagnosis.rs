@@ -717,46 +717,6 @@ fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
     })
 }
 
-/// The next values to estimate the trajectory under, as [`fixed_point_step`] but of several
-/// parameters at once (each round's values under which it was estimated, and their refit): by
-/// Anderson's mixing of the last two rounds, the secant along the direction the refit's change
-/// moved in (Anderson 1965; Walker & Ni 2011, depth one), which for one parameter is the
-/// secant itself (that case goes to [`fixed_point_step`], which brackets). A warm-up's drift
-/// moves between its two terms round by round (the path first takes up a constant range
-/// error, which the fit then reads as `k d²` from the near walls' shift), so following either
-/// term alone stalls. The step beyond the last refit is at most three times the last round's
-/// change, as in the one-parameter case. `None` (iterate) until two rounds differ.
-fn fixed_point_step_along(rounds: &[(Vec<f64>, Vec<f64>)]) -> Option<Vec<f64>> {
-    let (last_x, last_refit) = rounds.last()?;
-    if last_x.len() == 1 {
-        let scalar: Vec<(f64, f64)> = rounds.iter().map(|(x, r)| (x[0], r[0])).collect();
-        return fixed_point_step(&scalar).map(|next| vec![next]);
-    }
-    let (before_x, before_refit) = rounds.len().checked_sub(2).map(|i| &rounds[i])?;
-    let change = |x: &[f64], refit: &[f64]| -> Vec<f64> {
-        refit.iter().zip(x).map(|(r, x)| r - x).collect()
-    };
-    let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(a, b)| a * b).sum() };
-    let g = change(last_x, last_refit);
-    let g_before = change(before_x, before_refit);
-    let dg: Vec<f64> = g.iter().zip(&g_before).map(|(a, b)| a - b).collect();
-    let dx: Vec<f64> = last_x.iter().zip(before_x).map(|(a, b)| a - b).collect();
-    let dg2 = dot(&dg, &dg);
-    if dg2.is_nan() || dg2 <= 0.0 {
-        return None;
-    }
-    let gamma = dot(&dg, &g) / dg2;
-    let mut beyond: Vec<f64> = dx.iter().zip(&dg).map(|(x, d)| -gamma * (x + d)).collect();
-    let (length, most) = (dot(&beyond, &beyond).sqrt(), 3.0 * dot(&g, &g).sqrt());
-    if !length.is_finite() {
-        return None;
-    }
-    if length > most {
-        beyond.iter_mut().for_each(|b| *b *= most / length);
-    }
-    Some(last_refit.iter().zip(&beyond).map(|(r, b)| r + b).collect())
-}
-
 /// The least span of headings a run must turn through for a mount to be fitted through the
 /// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
 /// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
@@ -895,25 +855,104 @@ fn realign_lidar(
     else {
         return Ok((named, None));
     };
-    let mut current = named[at].clone();
+    let first = named[at].clone();
     let others: Vec<CandidateFit> = named
         .iter()
-        .filter(|c| c.effect.sensor() == Sensor::Lidar && c.effect != current.effect)
+        .filter(|c| c.effect.sensor() == Sensor::Lidar && c.effect != first.effect)
         .cloned()
         .collect();
     let base = hypothesis_of(&others);
+    // A warm-up's two terms are settled apart, each from the first fit's size, and the one
+    // the lidar's held-out readings favour along its own path is kept: the path first takes
+    // up a constant term, the fit then reads the near walls' shift as `k d²`, and rounds that
+    // follow both at once move the drift between them instead of settling it.
+    let apart: Vec<&[&[usize]]> = if first.effect == Effect::LidarWarmupDrift {
+        first
+            .effect
+            .shapes()
+            .iter()
+            .map(std::slice::from_ref)
+            .collect()
+    } else {
+        vec![first.effect.shapes()]
+    };
+    let mut best: Option<Settled> = None;
+    for shapes in apart {
+        let Some(settled) = settle(ctx, aligned, &base, &first, shapes, options)? else {
+            continue;
+        };
+        if best
+            .as_ref()
+            .is_none_or(|b| settled.heldout_ll > b.heldout_ll)
+        {
+            best = Some(settled);
+        }
+    }
+    let Some(Settled {
+        fit, lidar, path, ..
+    }) = best
+    else {
+        return Ok((named, None));
+    };
+    // The plots show the data against the trajectory the verdict rests on.
+    if let Some(d) = data.iter_mut().find(|d| d.sensor == Sensor::Lidar) {
+        *d = lidar;
+    }
+    if let Some(c) = candidates.iter_mut().find(|c| c.effect == fit.effect) {
+        *c = fit.clone();
+    }
+    named[at] = fit;
+    Ok((named, Some(path)))
+}
+
+/// What one lidar effect's rounds settled on: its fit, the lidar's data along the path
+/// estimated under it, that path, and the lidar's held-out log-likelihood there (nats a
+/// reading), by which rounds of different shapes are compared (the same readings, each along
+/// its own path).
+struct Settled {
+    fit: CandidateFit,
+    lidar: SensorData,
+    path: Aligned,
+    heldout_ll: f64,
+}
+
+/// Rounds of estimating the path under `first` (on top of `base`) and refitting it in `shapes`
+/// of its own, its size followed to the fixed point; `None` when no round earned its place.
+fn settle(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    base: &Hypothesis,
+    first: &CandidateFit,
+    shapes: &[&[usize]],
+    options: &Options,
+) -> Result<Option<Settled>, MismatchError> {
+    let effect = first.effect;
     let cone = declared_cone(ctx);
-    let mut realigned: Option<Aligned> = None;
-    // The parameters the trajectory is estimated under next; the size terms followed to their
-    // fixed point (those of `Effect::size_terms` the refit chose freely: a one-parameter
-    // effect's, the warm-up's two when its drift is in both) and each round's (values it was
-    // estimated under, refit), weighted as the size weighs them.
-    let mut proposal = current.params.clone();
-    let mut followed: Vec<(usize, f64)> = Vec::new();
-    let mut rounds: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
-    let mut last_gain = current.heldout_gain;
+    // One shape of several: its free parameters, and its start the first fit's size put in
+    // its own size term.
+    let (only, mut proposal) = match shapes {
+        [shape] if effect.shapes().len() > 1 => {
+            let mut only: Vec<usize> = shape.to_vec();
+            only.sort_unstable();
+            let mut start = effect.absent(cone);
+            for &i in &only {
+                start[i] = first.params[i];
+            }
+            if let Some(&(i, weight)) = effect.size_terms().iter().find(|(i, _)| only.contains(i)) {
+                start[i] = effect.scored(&first.params) / weight;
+            }
+            (Some(only), start)
+        }
+        _ => (None, first.params.clone()),
+    };
+    let mut current: Option<(CandidateFit, SensorData, Aligned)> = None;
+    // The size term followed to its fixed point (see below) and each round's (value it was
+    // estimated under, refit).
+    let mut followed: Option<usize> = None;
+    let mut rounds: Vec<(f64, f64)> = Vec::new();
+    let mut last_gain = first.heldout_gain;
     for _ in 0..REALIGN_ROUNDS {
-        let hypothesis = base.and(current.effect, proposal.clone());
+        let hypothesis = base.and(effect, proposal.clone());
         let again = align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?;
         let ctx2 = along(ctx, &again);
         let Some(mut lidar) = residuals::lidar(&ctx2)? else {
@@ -921,7 +960,7 @@ fn realign_lidar(
         };
         lidar.clusters = Some(residuals::shared_error_clusters(ctx2.trajectory, &lidar.t));
         let refit =
-            explain::fit_candidate(&ctx2, &lidar, &base, current.effect, options.max_fit_rows);
+            explain::fit_candidate_in(&ctx2, &lidar, base, effect, shapes, options.max_fit_rows);
         // A refit short of its place ends the rounds unless it explains more than the last
         // (the path still settling under it: a warm-up's constant term grows round by round
         // from the part the first estimate left in the ranges); the rounds go on from it, and
@@ -933,65 +972,59 @@ fn realign_lidar(
         last_gain = refit.heldout_gain;
         // Settled when every parameter the refit chose freely (of a two-shape effect, the
         // shape it took) moved by less than `REALIGN_SETTLED` of its value.
-        let free = refit.effect.free(&refit.params);
+        let free = only.clone().unwrap_or_else(|| effect.free(&refit.params));
         let settled = free.iter().all(|&i| {
             (refit.params[i] - proposal[i]).abs() <= REALIGN_SETTLED * refit.params[i].abs()
         });
-        let mut size: Vec<(usize, f64)> = current
-            .effect
+        // Followed when one size term (`Effect::size_terms`) is all the refit chose freely, but
+        // for the warm-up's time constant, which the path does not take up (it is fitted to
+        // the drift's decay); a mount's yaw and position are iterated plainly.
+        let settles_alone = usize::from(effect == Effect::LidarWarmupDrift);
+        let size = effect
             .size_terms()
             .iter()
-            .copied()
-            .filter(|(i, _)| free.contains(i))
-            .collect();
-        // Followed only when its size terms are all the refit chose freely, but for the
-        // warm-up's time constant, which the path does not take up (it is fitted to the drift's
-        // decay); a mount's yaw and position, in other units, are iterated plainly.
-        let settles_alone = usize::from(current.effect == Effect::LidarWarmupDrift);
-        if size.len() + settles_alone != free.len() {
-            size.clear();
-        }
-        if size != followed {
+            .map(|&(i, _)| i)
+            .filter(|i| free.contains(i))
+            .collect::<Vec<usize>>();
+        let single = match size[..] {
+            [i] if 1 + settles_alone == free.len() => Some(i),
+            _ => None,
+        };
+        if single != followed {
             rounds.clear();
-            followed = size;
+            followed = single;
         }
-        let weighted =
-            |params: &[f64]| -> Vec<f64> { followed.iter().map(|&(i, w)| w * params[i]).collect() };
-        if !followed.is_empty() {
-            rounds.push((weighted(&proposal), weighted(&refit.params)));
+        if let Some(i) = single {
+            rounds.push((proposal[i], refit.params[i]));
         }
         proposal = refit.params.clone();
         if earns {
-            current = refit;
-            // The plots show the data against the trajectory the verdict rests on.
-            if let Some(d) = data.iter_mut().find(|d| d.sensor == Sensor::Lidar) {
-                *d = lidar;
-            }
-            realigned = Some(again);
+            current = Some((refit, lidar, again));
         }
         if settled {
             break;
         }
-        if let Some(next) = fixed_point_step_along(&rounds) {
-            for (&(i, weight), value) in followed.iter().zip(next) {
-                let spec = current.effect.params()[i];
-                proposal[i] = (value / weight).clamp(spec.lo, spec.hi);
-            }
+        if let Some((i, next)) = single.zip(fixed_point_step(&rounds)) {
+            let spec = effect.params()[i];
+            proposal[i] = next.clamp(spec.lo, spec.hi);
         }
     }
-    if realigned.is_none() {
-        return Ok((named, None));
-    }
-    if let Some(c) = candidates.iter_mut().find(|c| c.effect == current.effect) {
-        *c = current.clone();
-    }
-    named[at] = current;
-    Ok((named, realigned))
+    Ok(current.map(|(fit, lidar, path)| {
+        let ctx2 = along(ctx, &path);
+        let heldout_ll =
+            explain::heldout_ll_per_reading(&ctx2, &lidar, &base.and(effect, fit.params.clone()));
+        Settled {
+            fit,
+            lidar,
+            path,
+            heldout_ll,
+        }
+    }))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{fixed_point_step, fixed_point_step_along, REALIGN_ROUNDS, REALIGN_SETTLED};
+    use super::{fixed_point_step, REALIGN_ROUNDS, REALIGN_SETTLED};
 
     /// The realignment's rounds as `realign_lidar` runs them, against a refit that gives back
     /// `share(s)` of the remaining gap to `truth` (the scan matching absorbing the rest).
@@ -1039,54 +1072,5 @@ mod tests {
         let next = fixed_point_step(&rounds).expect("a step");
         assert!(next > 0.1 && next < 0.25, "{next}");
         assert_eq!(fixed_point_step(&[(0.1, 0.12)]), None);
-    }
-
-    #[test]
-    fn the_realignment_follows_two_terms_that_trade_round_by_round() {
-        // A warm-up of 24 mm all in its constant term, seen first as 11 mm of `k (2 m)²` and
-        // 1.8 mm of constant (the independent trial 40's first fit), the path giving back a
-        // fifth of the gap each round and moving a tenth between the terms (a contraction that
-        // mixes them): after the rounds both terms are within 2 mm of the truth (1.7 and 1.3
-        // mm); plain iteration leaves the constant 6.5 mm short.
-        let truth = [0.0, 0.024];
-        let refit = |x: &[f64]| -> Vec<f64> {
-            let gap = [truth[0] - x[0], truth[1] - x[1]];
-            vec![
-                x[0] + 0.2 * gap[0] - 0.1 * gap[1],
-                x[1] + 0.1 * gap[0] + 0.2 * gap[1],
-            ]
-        };
-        let start = vec![0.011, 0.0018];
-        let mut rounds: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
-        let mut under = start.clone();
-        for _ in 0..REALIGN_ROUNDS {
-            let after = refit(&under);
-            rounds.push((under.clone(), after.clone()));
-            under = fixed_point_step_along(&rounds).unwrap_or(after);
-        }
-        let last = &rounds.last().expect("rounds").1;
-        assert!(
-            (last[0] - truth[0]).abs() < 0.002 && (last[1] - truth[1]).abs() < 0.002,
-            "{last:?}"
-        );
-        let mut plain = start;
-        for _ in 0..REALIGN_ROUNDS {
-            plain = refit(&plain);
-        }
-        assert!(
-            plain[1] < truth[1] - 0.005,
-            "plain iteration would have done: {plain:?}"
-        );
-        // One term alone is the secant's case.
-        let one = [(vec![0.1], vec![0.13]), (vec![0.25], vec![0.22])];
-        let next = fixed_point_step_along(&one).expect("a step");
-        assert_eq!(
-            next,
-            vec![fixed_point_step(&[(0.1, 0.13), (0.25, 0.22)]).expect("a step")]
-        );
-        assert_eq!(
-            fixed_point_step_along(&[(vec![0.0, 0.1], vec![0.01, 0.12])]),
-            None
-        );
     }
 }

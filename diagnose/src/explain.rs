@@ -174,17 +174,36 @@ pub(crate) fn fit_candidate(
     effect: Effect,
     max_fit_rows: usize,
 ) -> CandidateFit {
+    fit_candidate_in(ctx, data, base, effect, effect.shapes(), max_fit_rows)
+}
+
+/// As [`fit_candidate`], searching only `shapes` of the effect's (see [`Effect::shapes`]).
+pub(crate) fn fit_candidate_in(
+    ctx: &Context<'_>,
+    data: &SensorData,
+    base: &Hypothesis,
+    effect: Effect,
+    shapes: &[&[usize]],
+    max_fit_rows: usize,
+) -> CandidateFit {
     let specs = effect.params();
     let train = fit_rows(data, max_fit_rows);
     let mut objective = |x: &[f64]| total_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
     let (params, _) = maximize_shapes(
         specs,
-        effect.shapes(),
+        shapes,
         effect.shapes_refined_together(),
         &effect.absent(0.0),
         &mut objective,
     );
     score(ctx, data, base, effect, params, &train)
+}
+
+/// The mean log-likelihood of `data`'s held-out readings under `h`, nats a reading (a mean:
+/// paths that differ may leave a few readings near a range limit out of one and not another).
+pub(crate) fn heldout_ll_per_reading(ctx: &Context<'_>, data: &SensorData, h: &Hypothesis) -> f64 {
+    let rows = data.rows(Some(true));
+    total_ll(ctx, data, h, &rows) / rows.len().max(1) as f64
 }
 
 /// Fits `effect` on top of `base` to several sensors' data at once (their summed training

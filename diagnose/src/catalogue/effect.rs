@@ -358,8 +358,9 @@ impl Effect {
     /// Against a trajectory estimated from the lidar itself the warm-up's constant term is
     /// fitted too. The scan matching takes part of a range offset every beam shares into the
     /// pose (it weighs the near readings most, and the pose shifts away from them), and the
-    /// realignment gives it back (`realign_lidar` in the diagnosis follows both terms to their
-    /// fixed point). Held at zero there until session 10, a warm-up drawn in that term was
+    /// realignment gives it back (`realign_lidar` in the diagnosis settles each term apart, by
+    /// rounds of estimating the path under it, and keeps the one the lidar's held-out readings
+    /// favour). Held at zero there until session 10, a warm-up drawn in that term was
     /// fitted in its quadratic term (median error 44 %) and its early position error named as a
     /// wheel radius or slip; a drift that does not settle within the run, which the term freed
     /// took up beside a concealed reflectivity, is not named (`select::earns_place`).

@@ -212,19 +212,8 @@ pub fn diagnose_with_progress(
         fitted.as_ref(),
         through_before,
     );
-    let estimated_path = (aligned.alignment == Alignment::Estimated).then(|| {
-        let path = final_ctx.trajectory;
-        path.times()
-            .iter()
-            .zip(path.poses())
-            .map(|(&t_s, p)| hilsim_recording::TruthSample {
-                t_s,
-                x_m: p.x,
-                y_m: p.y,
-                yaw_rad: p.yaw,
-            })
-            .collect()
-    });
+    let estimated_path =
+        (aligned.alignment == Alignment::Estimated).then(|| final_ctx.trajectory.samples());
     Ok(Diagnosis {
         verdict,
         located,
@@ -886,15 +875,12 @@ fn realign_lidar(
             };
             if best
                 .as_ref()
-                .is_none_or(|b| settled.heldout_ll > b.heldout_ll)
+                .is_none_or(|b| settled.fit.heldout_ll_per_reading > b.fit.heldout_ll_per_reading)
             {
                 best = Some(settled);
             }
         }
-        let Some(Settled {
-            fit, lidar, path, ..
-        }) = best
-        else {
+        let Some(Settled { fit, lidar, path }) = best else {
             continue;
         };
         // The plots show the data against the trajectory the verdict rests on.
@@ -911,14 +897,12 @@ fn realign_lidar(
 }
 
 /// What one lidar effect's rounds settled on: its fit, the lidar's data along the path
-/// estimated under it, that path, and the lidar's held-out log-likelihood there (nats a
-/// reading), by which rounds of different shapes are compared (the same readings, each along
-/// its own path).
+/// estimated under it, and that path. Rounds of different shapes are compared by the fit's
+/// held-out log-likelihood a reading (the same readings, each along its own path).
 struct Settled {
     fit: CandidateFit,
     lidar: SensorData,
     path: Aligned,
-    heldout_ll: f64,
 }
 
 /// Rounds of estimating the path under `first` (on top of `base`) and refitting it in `shapes`
@@ -1014,17 +998,7 @@ fn settle(
             proposal[i] = next.clamp(spec.lo, spec.hi);
         }
     }
-    Ok(current.map(|(fit, lidar, path)| {
-        let ctx2 = along(ctx, &path);
-        let heldout_ll =
-            explain::heldout_ll_per_reading(&ctx2, &lidar, &base.and(effect, fit.params.clone()));
-        Settled {
-            fit,
-            lidar,
-            path,
-            heldout_ll,
-        }
-    }))
+    Ok(current.map(|(fit, lidar, path)| Settled { fit, lidar, path }))
 }
 
 #[cfg(test)]

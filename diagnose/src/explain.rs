@@ -37,6 +37,10 @@ pub struct CandidateFit {
     pub noise_floor: f64,
     /// Held-out readings the RMSEs are over.
     pub heldout_n: usize,
+    /// The mean log-likelihood of every held-out reading under the fit, nats a reading: how
+    /// fits along different estimated paths (which may keep a few readings near a range limit
+    /// in one and not another) compare on the same readings.
+    pub heldout_ll_per_reading: f64,
     /// How much the effect changes the predicted readings, metres: the median (a range sensor)
     /// or RMS change of the predictive mean over the tenth of the held-out readings it changes
     /// most (at least 30),
@@ -137,8 +141,8 @@ pub(crate) fn score(
     let after_p = ctx.predict(data, &fitted, &heldout);
     let before = fits(data, &heldout, &before_p);
     let after = fits(data, &heldout, &after_p);
-    let heldout_gain: f64 =
-        after.iter().map(|f| f.ll).sum::<f64>() - before.iter().map(|f| f.ll).sum::<f64>();
+    let heldout_ll: f64 = after.iter().map(|f| f.ll).sum();
+    let heldout_gain = heldout_ll - before.iter().map(|f| f.ll).sum::<f64>();
     // RMSE over the held-out readings the fitted model explains (not outliers to it), before
     // and after: a reading neither model can predict (a rare direction-noise flip past the
     // quadrature's reach) would otherwise dominate both.
@@ -160,6 +164,7 @@ pub(crate) fn score(
         rmse_after,
         noise_floor,
         heldout_n,
+        heldout_ll_per_reading: heldout_ll / after.len().max(1) as f64,
         size_m,
         size_noise_m,
         seen_until_s: data.t.iter().copied().fold(0.0, f64::max),
@@ -196,14 +201,17 @@ pub(crate) fn fit_candidate_in(
         &effect.absent(0.0),
         &mut objective,
     );
-    score(ctx, data, base, effect, params, &train)
-}
-
-/// The mean log-likelihood of `data`'s held-out readings under `h`, nats a reading (a mean:
-/// paths that differ may leave a few readings near a range limit out of one and not another).
-pub(crate) fn heldout_ll_per_reading(ctx: &Context<'_>, data: &SensorData, h: &Hypothesis) -> f64 {
-    let rows = data.rows(Some(true));
-    total_ll(ctx, data, h, &rows) / rows.len().max(1) as f64
+    let mut fit = score(ctx, data, base, effect, params, &train);
+    // A parameter of none of the shapes searched (of fewer than the effect's) was held at its
+    // absence, not fitted: its standard error is 0, shown as "held".
+    if shapes.len() < effect.shapes().len() {
+        for (i, sd) in fit.param_sd.iter_mut().enumerate() {
+            if !shapes.iter().any(|shape| shape.contains(&i)) {
+                *sd = 0.0;
+            }
+        }
+    }
+    fit
 }
 
 /// Fits `effect` on top of `base` to several sensors' data at once (their summed training

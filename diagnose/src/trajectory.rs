@@ -70,6 +70,21 @@ impl Trajectory {
         Ok(Self { t, poses })
     }
 
+    /// Its samples, as [`Trajectory::new`] takes them.
+    #[must_use]
+    pub fn samples(&self) -> Vec<TruthSample> {
+        self.t
+            .iter()
+            .zip(&self.poses)
+            .map(|(&t_s, p)| TruthSample {
+                t_s,
+                x_m: p.x,
+                y_m: p.y,
+                yaw_rad: p.yaw,
+            })
+            .collect()
+    }
+
     /// The robot's path when this one was found by placing the lidar (scan matching) through
     /// the mount `declared` while the lidar really sits at `real`: the matching placed the
     /// lidar at `pose ⊕ declared`, and the robot is where that lidar pose puts it through the

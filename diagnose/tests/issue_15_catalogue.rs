@@ -235,8 +235,12 @@ fn a_warmup_of_the_constant_term_is_named_without_truth() {
     // seconds carry it).
     let size = p[2] + 4.0 * p[0];
     assert!((size - 0.03).abs() < 0.006, "{p:?}");
-    // Its own term's shape is the one kept (the two are settled apart against the path).
+    // Its own term's shape is the one kept (the two are settled apart against the path), and
+    // the other term is reported held, not estimated.
     assert_eq!(p[0], 0.0, "{p:?}");
+    let fit = &d.effects[0].fit;
+    assert_eq!(fit.param_sd[0], 0.0, "{:?}", fit.param_sd);
+    assert!(fit.param_sd[2] > 0.0, "{:?}", fit.param_sd);
     let names: Vec<Effect> = d.effects.iter().map(|e| e.fit.effect).collect();
     assert_eq!(names, [Effect::LidarWarmupDrift], "{names:?}");
 }

@@ -134,8 +134,10 @@ pub(crate) fn align(
                 "no truth.csv: the trajectory is estimated by matching the lidar to the \
                  scenario's world (position s.d. {:.1} mm, heading {:.2} mrad); every sensor is \
                  judged against it with that uncertainty in its noise and no whiteness test \
-                 (the estimate's errors are shared by neighbouring readings), and an effect \
-                 that shifts every range alike is partly absorbed into it",
+                 (the estimate's errors are shared by neighbouring readings; the encoders' \
+                 travel, which carries the path's error for tens of seconds, is predicted from \
+                 the readings before it), and an effect that shifts every range alike is \
+                 partly absorbed into it",
                 sd.position_m * 1000.0,
                 sd.yaw_rad * 1000.0
             ));

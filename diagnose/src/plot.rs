@@ -68,10 +68,14 @@ pub(crate) fn plots(
     let stride = held.len().div_ceil(MAX_POINTS).max(1);
     let rows: Vec<usize> = held.into_iter().step_by(stride).collect();
     let nominal = |ctx: &Context<'_>, d: &SensorData| -> Vec<f64> {
-        fits(d, &rows, &ctx.predict(d, &Hypothesis::nominal(), &rows))
-            .iter()
-            .map(|f| f.residual)
-            .collect()
+        fits(
+            d,
+            &rows,
+            &ctx.predict_unconditioned(d, &Hypothesis::nominal(), &rows),
+        )
+        .iter()
+        .map(|f| f.residual)
+        .collect()
     };
     // Along the path that took the effect up, the same readings (the data of one recording).
     let took_up = through_path.and_then(|b| {
@@ -84,7 +88,7 @@ pub(crate) fn plots(
             nominal(ctx, d),
             fitted.filter(|f| f.effect.sensor() == sensor).map(|f| {
                 let h = Hypothesis::with(f.effect, f.params.clone());
-                fits(d, &rows, &ctx.predict(d, &h, &rows))
+                fits(d, &rows, &ctx.predict_unconditioned(d, &h, &rows))
                     .iter()
                     .map(|f| f.residual)
                     .collect::<Vec<f64>>()

@@ -262,3 +262,95 @@ fn a_collimated_beams_incidence_is_named_with_its_own_term() {
     assert!((p[1] - 0.02).abs() < 0.002, "{p:?}");
     assert_eq!(p[0], 0.0, "{p:?}");
 }
+
+/// A sparse world: five thin cylinders, walls up to 6 m away, the robot stopping every 0.3 m
+/// along a line (the `landmarks-5` scenario, cut to five moves).
+const SPARSE: &str = r#"
+name = "sparse-stops"
+seed = 5
+
+[world]
+cylinders = [
+    { center = [1.0, 1.2], radius = 0.12 },
+    { center = [2.0, -1.1], radius = 0.12 },
+    { center = [3.0, 1.6], radius = 0.12 },
+    { center = [4.2, -0.5], radius = 0.12 },
+    { center = [0.2, -1.5], radius = 0.12 },
+]
+walls = [
+    { from = [-1.5, -3.0], to = [6.0, -3.0] },
+    { from = [6.0, -3.0], to = [6.0, 3.0] },
+    { from = [6.0, 3.0], to = [-1.5, 3.0] },
+    { from = [-1.5, 3.0], to = [-1.5, -3.0] },
+]
+
+[robot]
+start = { x = 0.0, y = 0.0, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+
+[[drive]]
+stop_s = 2.0
+[[drive]]
+speed_mps = 0.1
+distance_m = 0.3
+[[drive]]
+stop_s = 2.0
+[[drive]]
+speed_mps = 0.1
+distance_m = 0.3
+[[drive]]
+stop_s = 2.0
+[[drive]]
+speed_mps = 0.1
+distance_m = 0.3
+[[drive]]
+stop_s = 2.0
+[[drive]]
+speed_mps = 0.1
+distance_m = 0.3
+[[drive]]
+stop_s = 2.0
+[[drive]]
+speed_mps = 0.1
+distance_m = 0.3
+[[drive]]
+stop_s = 2.0
+
+[sensors.lidar]
+bias = [0.0525, 0.8838, 0.0584]
+noise = [0.002625, 0.04419, 0.00292]
+angle_noise_deg = 0.5
+[sensors.odometer]
+slip = 0.0
+noise_m = 0.002
+"#;
+
+/// Without truth, a faithful run in a sparse world names nothing in the encoders. There one
+/// revolution pins the pose poorly and the path estimated from the lidar errs by about a
+/// centimetre for many seconds; read as independent errors, the encoders' 500 readings took
+/// that wander for wheels of 99.6 % of their radius or a slip (seeds 5 and 6 named them before
+/// the path's error was modelled as one process shared by neighbouring readings).
+#[test]
+fn a_faithful_sparse_run_without_truth_names_nothing_in_the_encoders() {
+    let scenario =
+        Scenario::from_toml(SPARSE, Path::new("sparse-stops.toml")).expect("the test's scenario");
+    let physics = SimPhysics::new(&scenario).expect("the physics");
+    let options = Options {
+        effects: vec![
+            Effect::OdometerWheelRadius,
+            Effect::OdometerWheelSlip,
+            Effect::SensorLatency(Sensor::Odometer),
+        ],
+        ..Options::default()
+    };
+    for seed in [5, 6] {
+        let mut recording = Emulation::new(&scenario, seed)
+            .expect("the emulation")
+            .run()
+            .recording;
+        recording.truth = None;
+        let d = diagnose(&physics, &recording, &options).expect("a diagnosis");
+        let names: Vec<String> = d.effects.iter().map(|e| e.fit.effect.label()).collect();
+        assert!(names.is_empty(), "seed {seed}: named {names:?}");
+    }
+}

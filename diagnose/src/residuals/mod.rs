@@ -12,6 +12,7 @@ mod clusters;
 mod data;
 mod drive_filter;
 mod likelihood;
+mod path_error;
 mod predict;
 mod sensors;
 

@@ -2,6 +2,7 @@
 
 use super::data::{Context, Predictive, Queries, SensorData};
 use super::drive_filter::drive_predictions;
+use super::path_error::along_estimated_path;
 use crate::physics::{Hypothesis, LidarQuery};
 use crate::trajectory::Trajectory;
 use smallvec::smallvec;
@@ -9,6 +10,35 @@ use smallvec::smallvec;
 impl Context<'_> {
     /// The predictive distributions of `rows` of `data` under `h`.
     pub fn predict(&self, data: &SensorData, h: &Hypothesis, rows: &[usize]) -> Vec<Predictive> {
+        self.predict_as(data, h, rows, true)
+    }
+
+    /// Whether [`Context::predict`] conditions `data`'s readings on those before them for an
+    /// error it shares between them (the encoders along a path estimated from the lidar): its
+    /// predictive means then follow the readings, and an effect's size is the change of
+    /// [`Context::predict_unconditioned`]'s instead.
+    pub fn conditions(&self, data: &SensorData) -> bool {
+        self.estimated && matches!(data.queries, Queries::Odometer(_))
+    }
+
+    /// As [`Context::predict`], the shared error left independent in every reading: what the
+    /// physics predicts of each reading on its own.
+    pub fn predict_unconditioned(
+        &self,
+        data: &SensorData,
+        h: &Hypothesis,
+        rows: &[usize],
+    ) -> Vec<Predictive> {
+        self.predict_as(data, h, rows, false)
+    }
+
+    fn predict_as(
+        &self,
+        data: &SensorData,
+        h: &Hypothesis,
+        rows: &[usize],
+        conditioned: bool,
+    ) -> Vec<Predictive> {
         match &data.queries {
             Queries::Lidar(q) => {
                 let qs: Vec<LidarQuery> = rows.iter().map(|&i| q[i]).collect();
@@ -28,13 +58,25 @@ impl Context<'_> {
                     .collect()
             }
             Queries::Odometer(times) => {
-                let ts: Vec<f64> = rows.iter().map(|&i| times[i / 2]).collect();
                 let moved = self.robot_path(h);
-                let preds =
-                    self.physics
-                        .odometry(moved.as_ref().unwrap_or(self.trajectory), &ts, h);
-                // The trajectory's own position noise enters each wheel's travel.
+                let path = moved.as_ref().unwrap_or(self.trajectory);
+                // The trajectory's own position noise enters each wheel's travel: independent
+                // errors for a recorded one; for one estimated from the lidar, an error shared
+                // by neighbouring readings, so every reading is predicted given those before it.
                 let extra = self.position_sd_m * self.position_sd_m;
+                if conditioned && self.conditions(data) {
+                    let preds = self.physics.odometry(path, times, h);
+                    let physics: Vec<_> = (0..data.len())
+                        .map(|i| preds[i / 2].wheels[i % 2])
+                        .collect();
+                    let t: Vec<f64> = (0..data.len()).map(|i| times[i / 2]).collect();
+                    let train: Vec<bool> = data.heldout.iter().map(|h| !h).collect();
+                    let all =
+                        along_estimated_path(&physics, &data.y, &t, &train, self.position_sd_m);
+                    return rows.iter().map(|&i| smallvec![all[i]]).collect();
+                }
+                let ts: Vec<f64> = rows.iter().map(|&i| times[i / 2]).collect();
+                let preds = self.physics.odometry(path, &ts, h);
                 rows.iter()
                     .zip(preds)
                     .map(|(&i, p)| {

@@ -265,7 +265,8 @@ fn a_collimated_beams_incidence_is_named_with_its_own_term() {
 
 /// A sparse world: five thin cylinders, walls up to 6 m away, the robot stopping every 0.3 m
 /// along a line (the `landmarks-5` scenario, cut to five moves).
-const SPARSE: &str = r#"
+fn sparse_stops() -> Scenario {
+    const WORLD: &str = r#"
 name = "sparse-stops"
 seed = 5
 
@@ -288,34 +289,6 @@ walls = [
 start = { x = 0.0, y = 0.0, yaw_deg = 0.0 }
 wheel_base_m = 0.23
 
-[[drive]]
-stop_s = 2.0
-[[drive]]
-speed_mps = 0.1
-distance_m = 0.3
-[[drive]]
-stop_s = 2.0
-[[drive]]
-speed_mps = 0.1
-distance_m = 0.3
-[[drive]]
-stop_s = 2.0
-[[drive]]
-speed_mps = 0.1
-distance_m = 0.3
-[[drive]]
-stop_s = 2.0
-[[drive]]
-speed_mps = 0.1
-distance_m = 0.3
-[[drive]]
-stop_s = 2.0
-[[drive]]
-speed_mps = 0.1
-distance_m = 0.3
-[[drive]]
-stop_s = 2.0
-
 [sensors.lidar]
 bias = [0.0525, 0.8838, 0.0584]
 noise = [0.002625, 0.04419, 0.00292]
@@ -324,6 +297,13 @@ angle_noise_deg = 0.5
 slip = 0.0
 noise_m = 0.002
 "#;
+    let stop = "[[drive]]\nstop_s = 2.0\n";
+    let stops = format!(
+        "{WORLD}{stop}{}",
+        format!("[[drive]]\nspeed_mps = 0.1\ndistance_m = 0.3\n{stop}").repeat(5)
+    );
+    Scenario::from_toml(&stops, Path::new("sparse-stops.toml")).expect("the test's scenario")
+}
 
 /// Without truth, a faithful run in a sparse world names nothing in the encoders. There one
 /// revolution pins the pose poorly and the path estimated from the lidar errs by about a
@@ -332,8 +312,7 @@ noise_m = 0.002
 /// the path's error was modelled as one process shared by neighbouring readings).
 #[test]
 fn a_faithful_sparse_run_without_truth_names_nothing_in_the_encoders() {
-    let scenario =
-        Scenario::from_toml(SPARSE, Path::new("sparse-stops.toml")).expect("the test's scenario");
+    let scenario = sparse_stops();
     let physics = SimPhysics::new(&scenario).expect("the physics");
     let options = Options {
         effects: vec![

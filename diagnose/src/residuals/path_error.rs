@@ -110,6 +110,18 @@ mod tests {
     use rand::Rng;
     use rand_distr::StandardNormal;
 
+    /// The Gaussian log-likelihood of readings `y` under `preds`, less its constant.
+    fn log_likelihood(preds: &[Gaussian], y: &[f64]) -> f64 {
+        preds
+            .iter()
+            .zip(y)
+            .map(|(g, y)| {
+                let z = (y - g.mean_m) / g.sd_m;
+                -g.sd_m.ln() - 0.5 * z * z
+            })
+            .sum()
+    }
+
     /// Readings of a path whose error wanders (OU, 8 mm, τ = 10 s) with 2 mm encoder noise,
     /// 20 Hz for 200 s. Against the physics alone every reading is off by the wander; the
     /// filter's innovations, standardised, have mean ≈ 0 and mean square ≈ 1, and a
@@ -143,16 +155,7 @@ mod tests {
                 .map(|d| Gaussian::new(1.0, d * scale, enc))
                 .collect()
         };
-        let ll = |preds: &[Gaussian]| -> f64 {
-            preds
-                .iter()
-                .zip(&y)
-                .map(|(g, y)| {
-                    let z = (y - g.mean_m) / g.sd_m;
-                    -g.sd_m.ln() - 0.5 * z * z
-                })
-                .sum()
-        };
+        let ll = |preds: &[Gaussian]| log_likelihood(preds, &y);
         let right = along_estimated_path(&physics(1.0), &y, &t, &train, sd);
         let z: Vec<f64> = right
             .iter()
@@ -198,14 +201,7 @@ mod tests {
                 .iter()
                 .map(|d| Gaussian::new(1.0, d * scale, enc))
                 .collect();
-            along_estimated_path(&physics, &y, &t, &train, sd)
-                .iter()
-                .zip(&y)
-                .map(|(g, y)| {
-                    let z = (y - g.mean_m) / g.sd_m;
-                    -g.sd_m.ln() - 0.5 * z * z
-                })
-                .sum()
+            log_likelihood(&along_estimated_path(&physics, &y, &t, &train, sd), &y)
         };
         let gain = ll(0.97) - ll(1.0);
         assert!(gain > 100.0, "a 3 % scale gains {gain} nats");

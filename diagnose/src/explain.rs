@@ -37,6 +37,10 @@ pub struct CandidateFit {
     pub noise_floor: f64,
     /// Held-out readings the RMSEs are over.
     pub heldout_n: usize,
+    /// Whether the RMSEs are of each reading predicted given the readings before it (the
+    /// encoders along a path estimated from the lidar, whose error they share), not of the
+    /// physics' prediction alone: what the report's residual plots show.
+    pub rmse_given_past: bool,
     /// The mean log-likelihood of every held-out reading under the fit, nats a reading: how
     /// fits along different estimated paths (which may keep a few readings near a range limit
     /// in one and not another) compare on the same readings.
@@ -189,6 +193,7 @@ pub(crate) fn score(
         rmse_after,
         noise_floor,
         heldout_n,
+        rmse_given_past: ctx.conditions(data),
         heldout_ll_per_reading: heldout_ll / after.len().max(1) as f64,
         size_m,
         size_noise_m,

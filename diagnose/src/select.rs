@@ -242,6 +242,7 @@ mod tests {
             rmse_after: 0.02,
             noise_floor: 0.02,
             heldout_n: 10_000,
+            rmse_given_past: false,
             heldout_ll_per_reading: 2.0,
             size_m: 0.02,
             size_noise_m: 0.01,

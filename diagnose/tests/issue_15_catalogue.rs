@@ -307,7 +307,7 @@ noise_m = 0.002
 
 /// Without truth, a faithful run in a sparse world names nothing in the encoders. There one
 /// revolution pins the pose poorly and the path estimated from the lidar errs by about a
-/// centimetre for many seconds; read as independent errors, the encoders' 500 readings took
+/// centimetre for many seconds; read as independent errors, the encoders' 540 readings took
 /// that wander for wheels of 99.6 % of their radius or a slip (seeds 5 and 6 named them before
 /// the path's error was modelled as one process shared by neighbouring readings).
 #[test]

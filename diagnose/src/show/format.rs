@@ -10,3 +10,13 @@ pub(super) fn mm(v: f64) -> String {
         "—".to_string()
     }
 }
+
+/// What a fit's RMSEs are of, when it is not the plain residual: " (each reading given the
+/// readings before)" for the encoders along an estimated path.
+pub(super) fn given_past(f: &crate::explain::CandidateFit) -> &'static str {
+    if f.rmse_given_past {
+        " (each reading given the readings before)"
+    } else {
+        ""
+    }
+}

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{escape, fmt_sig, mm};
+use super::format::{escape, fmt_sig, given_past, mm};
 use crate::outcome::{Diagnosis, Verdict};
 
 /// The report page: the verdict, the evidence, the map, the fit and the plots (`plot_files[i]`
@@ -146,8 +146,9 @@ fn fix(s: &mut String, d: &Diagnosis) {
         }
         let _ = writeln!(
             s,
-            "</table><p>Held-out {} RMSE: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
+            "</table><p>Held-out {} RMSE{}: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
             f.sensor,
+            given_past(f),
             mm(f.rmse_before),
             mm(f.rmse_after),
             mm(f.noise_floor),

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{fmt_sig, mm};
+use super::format::{fmt_sig, given_past, mm};
 use crate::outcome::Diagnosis;
 
 /// The diagnosis for people: a few lines.
@@ -45,9 +45,10 @@ pub fn summary(d: &Diagnosis) -> String {
         }
         let _ = writeln!(
             s,
-            "  held-out {} RMSE: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
+            "  held-out {} RMSE{}: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
              changes the readings by {})",
             f.sensor,
+            given_past(f),
             mm(f.rmse_before),
             mm(f.rmse_after),
             mm(f.noise_floor),

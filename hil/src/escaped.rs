@@ -118,12 +118,15 @@ mod tests {
         std::io::Read::read_to_string(child.stdout.as_mut().unwrap(), &mut out).unwrap();
         child.wait().unwrap();
         let escaped: u32 = out.trim().parse().unwrap();
-        // Until the forked shell has become `sleep`, its environment may read empty (the
-        // kernel swaps its memory during exec): wait for the exec, as a firmware's daemon
-        // would have long done by the time its run ends.
+        // Until the forked shell has become `sleep` and the new image's stack is laid out, its
+        // environment may read empty: the kernel names the process (`comm`) before it places
+        // the environment, so `comm` alone was seen as `sleep` with nothing to read (failed
+        // once in `.ci/run`). Wait for both, as a firmware's daemon would have long done by
+        // the time its run ends.
         for _ in 0..500 {
             let comm = std::fs::read_to_string(format!("/proc/{escaped}/comm"));
-            if comm.is_ok_and(|c| c.trim_end() == "sleep") {
+            let environ = std::fs::read(format!("/proc/{escaped}/environ"));
+            if comm.is_ok_and(|c| c.trim_end() == "sleep") && environ.is_ok_and(|e| !e.is_empty()) {
                 break;
             }
             std::thread::sleep(Duration::from_millis(10));

@@ -56,6 +56,9 @@ pub struct Drawn {
     pub outside: bool,
     /// Every effect concealed, as the independent reality takes it.
     pub concealed: Vec<Concealed>,
+    /// Draws of the trial discarded before this one: their robot would have passed through an
+    /// obstacle (the independent reality only).
+    pub redrawn: usize,
 }
 
 impl Drawn {
@@ -163,17 +166,19 @@ fn entry_effect(k: usize, d: &mut Draws, nominal: &Scenario) -> Option<Effect> {
     effects.first().copied()
 }
 
-/// Trial `i`'s concealment in the independent reality: with probability 1/5 two different
+/// What a trial of the independent reality conceals, before its parameters are drawn.
+pub(crate) struct Classes {
+    /// The catalogued effects (none, one or two).
+    effects: Vec<Effect>,
+    /// A periodic range error outside the catalogue.
+    outside: bool,
+}
+
+/// Trial `i`'s classes in the independent reality: with probability 1/5 two different
 /// catalogued entries, else one of fifteen classes (none, the thirteen entries, a periodic
-/// range error outside the catalogue: amplitude ±[1, 4] cm × strength, period [0.3, 1] m), or
-/// the `only` one (0 none, 1..=13 the catalogue's entries, 14 outside); and the run's
-/// nuisances.
-pub(crate) fn draw_independent(
-    d: &mut Draws,
-    strength: f64,
-    nominal: &Scenario,
-    only: Option<usize>,
-) -> (Drawn, Nuisances) {
+/// range error outside the catalogue), or the `only` one (0 none, 1..=13 the catalogue's
+/// entries, 14 outside).
+pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize>) -> Classes {
     let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
     let class = only.unwrap_or_else(|| (d.unit() * (entries + 2) as f64).floor() as usize);
@@ -189,16 +194,32 @@ pub(crate) fn draw_independent(
     {
         effects.push(e);
     }
+    Classes {
+        effects,
+        outside: !two && class == entries + 1,
+    }
+}
+
+/// The concealment of `classes` in the independent reality: each effect's parameters (the
+/// periodic range error outside the catalogue: amplitude ±[1, 4] cm × strength, period
+/// [0.3, 1] m), and the run's nuisances.
+pub(crate) fn draw_independent(
+    classes: &Classes,
+    d: &mut Draws,
+    strength: f64,
+    nominal: &Scenario,
+) -> (Drawn, Nuisances) {
     let mut drawn = Drawn {
         effect: None,
         effects: nominal.effects.clone(),
         truth: None,
         params: Vec::new(),
         second: None,
-        outside: !two && class == entries + 1,
+        outside: classes.outside,
         concealed: Vec::new(),
+        redrawn: 0,
     };
-    for (k, e) in effects.iter().enumerate() {
+    for (k, e) in classes.effects.iter().enumerate() {
         let specs = e.params();
         let values = draw_values(*e, d, strength, nominal);
         let truth = e.scored(&values);
@@ -249,6 +270,7 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
             second: None,
             outside: false,
             concealed: Vec::new(),
+            redrawn: 0,
         };
     };
     let specs = effect.params();
@@ -266,6 +288,7 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
         second: None,
         outside: false,
         concealed: vec![concealed(effect, &values)],
+        redrawn: 0,
     }
 }
 

@@ -39,6 +39,7 @@ impl SelfTest {
                     "strongest_score": o.strongest.0.is_finite().then_some(o.strongest.0),
                     "threshold": o.strongest.1.is_finite().then_some(o.strongest.1),
                     "seconds": o.seconds,
+                    "redrawn": o.redrawn,
                 })
             })
             .collect();
@@ -79,6 +80,19 @@ impl SelfTest {
             self.seed,
             self.strength
         )?;
+        let redrawn: Vec<String> = self
+            .outcomes
+            .iter()
+            .filter(|o| o.redrawn > 0)
+            .map(|o| format!("{} ({}×)", o.index, o.redrawn))
+            .collect();
+        if !redrawn.is_empty() {
+            writeln!(
+                out,
+                "redrawn: trials {}: their parameters would have driven the robot through an obstacle",
+                redrawn.join(", ")
+            )?;
+        }
         self.write_confusion(out)?;
         self.write_goals(out)?;
         let misses: Vec<String> = self

@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::Recording;
+use hilsim_sim::replay::replay_contacts;
 use hilsim_sim::Scenario;
 
-use super::draw::{draw_independent, real_scenario, Drawn, Draws};
+use super::draw::{draw_classes, draw_independent, real_scenario, Drawn, Draws};
 use super::plan::{Plan, Reality};
 use crate::{Diagnosis, Effect, Options, SimPhysics, Verdict};
 
@@ -41,6 +42,8 @@ pub struct Outcome {
     /// The strongest test's score under the nominal model, and the threshold.
     pub strongest: (f64, f64),
     pub seconds: f64,
+    /// Draws discarded before this one because their robot would pass through an obstacle.
+    pub redrawn: usize,
 }
 
 impl Outcome {
@@ -80,12 +83,43 @@ fn concealing(nominal: &Scenario, plan: Plan, i: u64) -> (Drawn, Result<Recordin
         }
         Reality::Independent => {
             let mut d = Draws::new(plan.seed, i);
-            let (drawn, nuisances) = draw_independent(&mut d, plan.strength, nominal, plan.only);
-            let seed = d.next() >> 1;
-            let recording = hilsim_reality::record(nominal, &drawn.concealed, nuisances, seed);
-            (drawn, Ok(recording))
+            let classes = draw_classes(&mut d, nominal, plan.only);
+            let mut redrawn = 0;
+            loop {
+                let (mut drawn, nuisances) =
+                    draw_independent(&classes, &mut d, plan.strength, nominal);
+                let seed = d.next() >> 1;
+                let recording = hilsim_reality::record(nominal, &drawn.concealed, nuisances, seed);
+                if redrawn < MAX_REDRAWS && drives_through_obstacle(nominal, &recording) {
+                    redrawn += 1;
+                    continue;
+                }
+                drawn.redrawn = redrawn;
+                return (drawn, Ok(recording));
+            }
         }
     }
+}
+
+/// Draws discarded at most per trial before one is kept whatever it does.
+const MAX_REDRAWS: usize = 8;
+
+/// Whether the independent reality's robot passes through an obstacle in `recording`, where the
+/// nominal robot replaying the same commands touches none. That reality has no contacts, so a
+/// draw that steers its robot into a wall (two wheels' radii 3 % apart turn it 0.5 rad over the
+/// room's 3.9 m run) records a run no robot could make: seen from behind the wall, the room
+/// is gone. Such a draw's parameters (and nuisances) are drawn again from the trial's own
+/// stream, its effects kept, so the other trials keep theirs. A scenario whose nominal run touches something by design is not checked.
+fn drives_through_obstacle(nominal: &Scenario, recording: &Recording) -> bool {
+    let Some(truth) = recording.truth.as_ref() else {
+        return false;
+    };
+    let end_s = truth.last().map_or(0.0, |s| s.t_s);
+    let by_design = !replay_contacts(nominal, &recording.commands, end_s).is_empty();
+    !by_design
+        && truth
+            .iter()
+            .any(|s| nominal.robot_overlap([s.x_m, s.y_m]).is_some())
 }
 
 impl Outcome {
@@ -107,6 +141,7 @@ impl Outcome {
             heldout: None,
             strongest: (f64::NAN, f64::NAN),
             seconds: 0.0,
+            redrawn: drawn.redrawn,
         }
     }
 }

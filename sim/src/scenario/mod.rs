@@ -22,6 +22,7 @@
 //! ```
 
 mod check;
+mod clearance;
 mod effects;
 mod error;
 mod link;
@@ -32,6 +33,7 @@ mod schema;
 mod validate;
 mod validate_effects;
 
+pub use clearance::Overlap;
 pub use effects::*;
 pub use error::ScenarioError;
 pub use link::{Link, LinkFaults, SPARSE_BELOW_RPM, SPIN_UP_FROM_RPM, XV11_CAPTURE};

@@ -6,6 +6,7 @@ use super::locate::{key_path, Key};
 use super::metrics;
 use super::schema::{DriveStep, Scenario};
 use super::validate_effects;
+use crate::world::Obstacle;
 
 /// The longest run a scenario may describe, seconds: a day. A recording of a day at the default
 /// rates is a few GB; a longer one is a mistake (`duration_s = 1e9`), not an experiment.
@@ -427,40 +428,18 @@ fn mount(path: Vec<Key>, m: super::schema::Mount) -> Check {
 /// The robot's disc must not overlap any obstacle at t = 0.
 fn start_is_free(s: &Scenario) -> Check {
     let (x, y, r) = (s.robot.start.x, s.robot.start.y, s.robot.radius_m);
-    let here = key_path!["robot", "start"];
-    for (i, w) in s.world.walls.iter().enumerate() {
-        let d = segment_distance([x, y], w.from, w.to);
-        if d < r {
-            return fail(
-                here,
-                format!("the robot (radius {r} m) starts inside wall {i} ({d:.3} m from it)"),
-            );
-        }
-    }
-    for (i, c) in s.world.cylinders.iter().enumerate() {
-        let d = (x - c.center[0]).hypot(y - c.center[1]);
-        if d < r + c.radius {
-            return fail(
-                here,
-                format!("the robot (radius {r} m) starts inside or touching cylinder {i}"),
-            );
-        }
-    }
-    for (i, b) in s.world.boards.iter().enumerate() {
-        // Distance from the start to the board's rectangle.
-        let (sin, cos) = b.yaw_deg.to_radians().sin_cos();
-        let (dx, dy) = (x - b.center[0], y - b.center[1]);
-        let along = (dx * cos + dy * sin).abs() - b.length / 2.0;
-        let across = (-dx * sin + dy * cos).abs() - b.thickness / 2.0;
-        let d = along.max(0.0).hypot(across.max(0.0));
-        if d < r {
-            return fail(
-                here,
-                format!("the robot (radius {r} m) starts inside or touching board {i}"),
-            );
-        }
-    }
-    Ok(())
+    let Some(overlap) = s.robot_overlap([x, y]) else {
+        return Ok(());
+    };
+    let what = match overlap.obstacle {
+        Obstacle::Wall(i) => format!("inside wall {i} ({:.3} m from it)", overlap.clearance_m),
+        Obstacle::Cylinder(i) => format!("inside or touching cylinder {i}"),
+        Obstacle::Board(i) => format!("inside or touching board {i}"),
+    };
+    fail(
+        key_path!["robot", "start"],
+        format!("the robot (radius {r} m) starts {what}"),
+    )
 }
 
 /// Distance from point `p` to segment `a`–`b`.

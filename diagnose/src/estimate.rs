@@ -367,7 +367,9 @@ impl Matcher<'_> {
                 .iter()
                 .zip(&there)
                 .filter_map(|(a, b)| a.zip(*b))
-                .fold((0.0, 0.0), |(sa, sb), (a, b)| (sa + huber(a), sb + huber(b)));
+                .fold((0.0, 0.0), |(sa, sb), (a, b)| {
+                    (sa + huber(a), sb + huber(b))
+                });
             if after < before {
                 return Some(next);
             }

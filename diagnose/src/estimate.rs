@@ -342,6 +342,18 @@ impl Matcher<'_> {
         Some(((knot, *correction), [inv[(0, 0)], inv[(1, 1)], inv[(2, 2)]]))
     }
 
+    /// The normalised residuals of `scan`'s readings with `correction` added to its piece of
+    /// the dead reckoning.
+    fn scan_residuals(&self, scan: &Scan, correction: [f64; 3]) -> Vec<Option<f64>> {
+        residuals(
+            self.physics,
+            &shifted(self.base, scan.t0, scan.t1, correction),
+            &scan.queries,
+            &scan.y,
+            self.hypothesis,
+        )
+    }
+
     /// `correction` moved along `step`, halved until the move lowers the Huber loss of the
     /// readings predicted at both ends (at most [`HALVINGS`] times); `None` when no such move
     /// lowers it. The nearest component of a reading's prediction switches as the pose moves
@@ -349,15 +361,7 @@ impl Matcher<'_> {
     /// differences taken at one point can climb it: measured on the other simulator's
     /// `board-d` run, unchecked steps slid the path 0.69 m sideways within 3 s.
     fn descent(&self, scan: &Scan, correction: [f64; 3], step: [f64; 3]) -> Option<[f64; 3]> {
-        let residuals_at = |c: [f64; 3]| {
-            residuals(
-                self.physics,
-                &shifted(self.base, scan.t0, scan.t1, c),
-                &scan.queries,
-                &scan.y,
-                self.hypothesis,
-            )
-        };
+        let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
         let here = residuals_at(correction);
         let mut size = 1.0;
         for _ in 0..=HALVINGS {
@@ -381,15 +385,7 @@ impl Matcher<'_> {
     /// The Huber-weighted normal equations `J'WJ δ = −J'W r` of `scan` at `correction`: the
     /// matrix `J'WJ` and the right-hand side, the Jacobian by central differences.
     fn normal_equations(&self, scan: &Scan, correction: [f64; 3]) -> ([[f64; 3]; 3], [f64; 3]) {
-        let residuals_at = |c: [f64; 3]| {
-            residuals(
-                self.physics,
-                &shifted(self.base, scan.t0, scan.t1, c),
-                &scan.queries,
-                &scan.y,
-                self.hypothesis,
-            )
-        };
+        let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
         let n = scan.y.len();
         let steps = [0.001, 0.001, 0.001];
         let r0 = residuals_at(correction);

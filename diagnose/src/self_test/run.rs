@@ -125,6 +125,7 @@ impl TrialRun {
             "index": self.index,
             "truth": self.drawn.label(),
             "drawn": self.drawn.params.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "redrawn": self.drawn.redrawn,
         });
         j
     }
@@ -145,6 +146,13 @@ impl TrialRun {
             self.drawn.label(),
             drawn_text.join(", ")
         );
+        if self.drawn.redrawn > 0 {
+            let _ = writeln!(
+                out,
+                "redrawn {} times: the draws before would have driven the robot through an obstacle",
+                self.drawn.redrawn
+            );
+        }
         out.push_str(&show::summary(&self.diagnosis));
         for e in self.diagnosis.evidence.iter().take(8) {
             let _ = writeln!(

@@ -221,3 +221,86 @@ pub(crate) fn verdict_label(v: &Result<Verdict, String>) -> &'static str {
         Err(_) => "refused",
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use hilsim_recording::{CommandSample, TruthSample};
+
+    use super::*;
+
+    /// A 4 m × 3 m room, the robot starting at (1, 1) facing +x.
+    fn room() -> Scenario {
+        Scenario::from_toml(
+            r#"
+            name = "through-a-wall"
+            duration_s = 4.0
+            [world]
+            walls = [
+                { from = [0.0, 0.0], to = [4.0, 0.0] },
+                { from = [4.0, 0.0], to = [4.0, 3.0] },
+                { from = [4.0, 3.0], to = [0.0, 3.0] },
+                { from = [0.0, 3.0], to = [0.0, 0.0] },
+            ]
+            [robot]
+            start = { x = 1.0, y = 1.0 }
+            wheel_base_m = 0.23
+            "#,
+            Path::new("through-a-wall.toml"),
+        )
+        .expect("the test's scenario")
+    }
+
+    /// A recording of commands `(left, right)` in force from t = 0 whose truth runs along
+    /// `path` (one pose a second).
+    fn recording(command: (f64, f64), path: &[(f64, f64)]) -> Recording {
+        Recording {
+            commands: vec![CommandSample {
+                t_s: 0.0,
+                left_mps: command.0,
+                right_mps: command.1,
+            }],
+            truth: Some(
+                path.iter()
+                    .enumerate()
+                    .map(|(i, &(x, y))| TruthSample {
+                        t_s: i as f64,
+                        x_m: x,
+                        y_m: y,
+                        yaw_rad: 0.0,
+                    })
+                    .collect(),
+            ),
+            ..Recording::default()
+        }
+    }
+
+    #[test]
+    fn a_run_through_a_wall_is_told_from_one_that_touches_by_design() {
+        let room = room();
+        // Commanded 0.5 m/s east for 4 s: the nominal robot stays clear (to x = 3).
+        let clear = [(1.0, 1.0), (1.5, 1.0), (2.0, 1.0), (2.5, 1.0), (3.0, 1.0)];
+        assert!(!drives_through_obstacle(
+            &room,
+            &recording((0.5, 0.5), &clear)
+        ));
+        // The same commands, but the real robot veered south through the wall.
+        let veered = [(1.0, 1.0), (1.5, 0.7), (2.0, 0.3), (2.5, -0.1), (3.0, -0.5)];
+        assert!(drives_through_obstacle(
+            &room,
+            &recording((0.5, 0.5), &veered)
+        ));
+        // Commanded at 1 m/s east, the nominal robot itself reaches the east wall: touching is
+        // the scenario's doing, and nothing is redrawn.
+        let into_the_wall = [(1.0, 1.0), (2.0, 1.0), (3.0, 1.0), (3.8, 1.0), (3.9, 1.0)];
+        assert!(!drives_through_obstacle(
+            &room,
+            &recording((1.0, 1.0), &into_the_wall)
+        ));
+        // Without truth there is nothing to check.
+        let mut blind = recording((0.5, 0.5), &veered);
+        blind.truth = None;
+        assert!(!drives_through_obstacle(&room, &blind));
+    }
+}

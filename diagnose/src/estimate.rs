@@ -200,19 +200,14 @@ pub(crate) fn estimate_trajectory(
         ));
     };
     let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
+    let declared = physics.declared().lidar;
     let matcher = Matcher {
         physics,
         base: &base,
         hypothesis,
-        period: physics
-            .declared()
-            .lidar
-            .map_or(1.0 / 1800.0, |l| 60.0 / (l.rpm * 360.0)),
-        snapshot: physics.declared().lidar.is_some_and(|l| l.snapshot),
-        ranges: physics
-            .declared()
-            .lidar
-            .map_or(0.0..=f64::INFINITY, |l| l.min_range_m..=l.max_range_m),
+        period: declared.map_or(1.0 / 1800.0, |l| 60.0 / (l.rpm * 360.0)),
+        snapshot: declared.is_some_and(|l| l.snapshot),
+        ranges: declared.map_or(0.0..=f64::INFINITY, |l| l.min_range_m..=l.max_range_m),
     };
     let revs = revolutions(lidar);
     let mut knots: Vec<Knot> = Vec::with_capacity(revs.len());
@@ -314,7 +309,7 @@ impl Matcher<'_> {
         let scan = Scan { queries, y, t0, t1 };
         let mut info = [[0.0; 3]; 3];
         for _ in 0..ITERATIONS {
-            let (a, g) = self.normal_equations(&scan, *correction);
+            let (a, g, here) = self.normal_equations(&scan, *correction);
             info = a;
             let Some(delta) = solve3(a, g) else {
                 break;
@@ -323,7 +318,8 @@ impl Matcher<'_> {
             let scale = (delta[0].hypot(delta[1]) / 0.05)
                 .max(delta[2].abs() / 0.05)
                 .max(1.0);
-            let Some(next) = self.descent(&scan, *correction, delta.map(|d| d / scale)) else {
+            let step = delta.map(|d| d / scale);
+            let Some(next) = self.descent(&scan, *correction, &here, step) else {
                 break;
             };
             *correction = next;
@@ -354,19 +350,23 @@ impl Matcher<'_> {
         )
     }
 
-    /// `correction` moved along `step`, halved until the move lowers the Huber loss of the
-    /// readings predicted at both ends (at most [`HALVINGS`] times); `None` when no such move
-    /// lowers it. The nearest component of a reading's prediction switches as the pose moves
+    /// `correction` (where the residuals are `here`) moved along `step`, halved until the move
+    /// lowers the Huber loss of the readings predicted at both ends (at most [`HALVINGS`]
+    /// times); `None` when no such move lowers it. The nearest component of a reading's prediction switches as the pose moves
     /// (a board's edge, the wall behind it), so the loss is rugged and a Gauss–Newton step on
     /// differences taken at one point can climb it: measured on the other simulator's
     /// `board-d` run, unchecked steps slid the path 0.69 m sideways within 3 s.
-    fn descent(&self, scan: &Scan, correction: [f64; 3], step: [f64; 3]) -> Option<[f64; 3]> {
-        let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
-        let here = residuals_at(correction);
+    fn descent(
+        &self,
+        scan: &Scan,
+        correction: [f64; 3],
+        here: &[Option<f64>],
+        step: [f64; 3],
+    ) -> Option<[f64; 3]> {
         let mut size = 1.0;
         for _ in 0..=HALVINGS {
             let next = [0, 1, 2].map(|k| correction[k] + size * step[k]);
-            let there = residuals_at(next);
+            let there = self.scan_residuals(scan, next);
             let (before, after) = here
                 .iter()
                 .zip(&there)
@@ -383,8 +383,13 @@ impl Matcher<'_> {
     }
 
     /// The Huber-weighted normal equations `J'WJ δ = −J'W r` of `scan` at `correction`: the
-    /// matrix `J'WJ` and the right-hand side, the Jacobian by central differences.
-    fn normal_equations(&self, scan: &Scan, correction: [f64; 3]) -> ([[f64; 3]; 3], [f64; 3]) {
+    /// matrix `J'WJ` and the right-hand side, the Jacobian by central differences; and the
+    /// residuals `r` there.
+    fn normal_equations(
+        &self,
+        scan: &Scan,
+        correction: [f64; 3],
+    ) -> ([[f64; 3]; 3], [f64; 3], Vec<Option<f64>>) {
         let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
         let n = scan.y.len();
         let steps = [0.001, 0.001, 0.001];
@@ -425,7 +430,7 @@ impl Matcher<'_> {
                 }
             }
         }
-        (a, g)
+        (a, g, r0)
     }
 }
 

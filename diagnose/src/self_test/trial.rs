@@ -109,17 +109,18 @@ const MAX_REDRAWS: usize = 8;
 /// draw that steers its robot into a wall (two wheels' radii 3 % apart turn it 0.5 rad over the
 /// room's 3.9 m run) records a run no robot could make: seen from behind the wall, the room
 /// is gone. Such a draw's parameters (and nuisances) are drawn again from the trial's own
-/// stream, its effects kept, so the other trials keep theirs. A scenario whose nominal run touches something by design is not checked.
+/// stream, its effects kept, so the other trials keep theirs. A scenario whose nominal run
+/// touches something by design is not checked (the nominal replay, a physics run, is made only
+/// for a path that overlaps something).
 fn drives_through_obstacle(nominal: &Scenario, recording: &Recording) -> bool {
     let Some(truth) = recording.truth.as_ref() else {
         return false;
     };
+    let overlaps = truth
+        .iter()
+        .any(|s| nominal.robot_overlap([s.x_m, s.y_m]).is_some());
     let end_s = truth.last().map_or(0.0, |s| s.t_s);
-    let by_design = !replay_contacts(nominal, &recording.commands, end_s).is_empty();
-    !by_design
-        && truth
-            .iter()
-            .any(|s| nominal.robot_overlap([s.x_m, s.y_m]).is_some())
+    overlaps && replay_contacts(nominal, &recording.commands, end_s).is_empty()
 }
 
 impl Outcome {

@@ -26,6 +26,7 @@ mod input;
 mod meta;
 mod names;
 pub mod pose;
+mod printable;
 mod read;
 mod samples;
 mod stream;
@@ -40,6 +41,7 @@ pub use error::{Error, ErrorKind};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
+pub use printable::{printable, printable_cut, MAX_NAME_CHARS};
 pub use samples::{
     CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
 };

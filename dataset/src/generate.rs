@@ -11,7 +11,9 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::{write_file_atomically, Recording, RecordingStream};
+use hilsim_recording::{
+    write_file_atomically, write_owned_file_atomically, Recording, RecordingStream,
+};
 use rayon::prelude::*;
 
 use crate::content::{scan_run, RunContent};
@@ -125,7 +127,7 @@ impl Dataset {
         }
         let keys: Vec<&str> = p.varies.iter().map(|v| v.key()).collect();
         let write_manifest = |rows: &BTreeMap<u64, Row>| {
-            write_file_atomically(&manifest_path, manifest::render(&keys, rows).as_bytes())
+            write_owned_file_atomically(&manifest_path, manifest::render(&keys, rows).as_bytes())
                 .map_err(Error::from)
         };
         write_manifest(&rows)?;

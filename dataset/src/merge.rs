@@ -6,7 +6,7 @@ use std::fs;
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
-use hilsim_recording::{replace_dir_atomically, write_file_atomically};
+use hilsim_recording::{replace_dir_atomically, write_owned_file_atomically};
 use rayon::prelude::*;
 
 use crate::content::{scan_run, RunContent};
@@ -127,7 +127,7 @@ pub fn merge(
     })?;
     let keys: Vec<&str> = params.varies.iter().map(|v| v.key()).collect();
     let manifest_path = out.join(MANIFEST_FILE);
-    write_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
+    write_owned_file_atomically(&manifest_path, manifest::render(&keys, &rows).as_bytes())?;
     for (name, path) in entries(out)? {
         if is_shard_manifest(&name) {
             fs::remove_file(&path).map_err(|err| Error::io(&path, err))?;
@@ -212,7 +212,7 @@ fn check_output(out: &Path) -> Result<(), Error> {
 fn start_output(out: &Path, reference_file: &Path) -> Result<(), Error> {
     fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
     let bytes = fs::read(reference_file).map_err(|err| Error::io(reference_file, err))?;
-    write_file_atomically(&out.join(DATASET_FILE), &bytes)?;
+    write_owned_file_atomically(&out.join(DATASET_FILE), &bytes)?;
     Ok(())
 }
 

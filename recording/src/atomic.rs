@@ -5,9 +5,9 @@
 //! recognises as leftovers of an interrupted write and removes.
 
 use std::fs;
-use std::io::{self, Write};
+use std::io::{self, Read, Write};
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use crate::{Error, FORMAT};
 
@@ -18,9 +18,13 @@ pub enum OutputTarget {
     /// A regular file (or nothing yet) at this path, symbolic links followed: written to a
     /// temporary sibling and renamed over it.
     Replace(PathBuf),
-    /// A character device or a FIFO (`/dev/null`, `/dev/stdout`, a pipe): written through, as a
-    /// shell's `>` would, never replaced.
+    /// A character device or a FIFO (`/dev/null`, a named pipe): written through, as a shell's
+    /// `>` would, never replaced.
     WriteThrough(PathBuf),
+    /// This process's standard output (`/dev/stdout`, `/dev/fd/1`, or the very file the shell
+    /// redirected it to): written through the descriptor the shell opened, so that `>> log`
+    /// appends and a pipe is fed, and nothing is renamed over the shell's file.
+    Stdout,
 }
 
 impl OutputTarget {
@@ -42,25 +46,105 @@ impl OutputTarget {
             Err(err) => return Err(Error::io(path, err)),
             Ok(meta) => meta.file_type().is_symlink(),
         };
-        // Follow a link: the file the user names is the one they mean. (Otherwise keep the path
-        // as given, so that messages name it as the user wrote it.)
-        let target = if is_link {
-            fs::canonicalize(path).map_err(|_| refuse("is a symbolic link that leads nowhere"))?
-        } else {
-            path.to_path_buf()
+        // `stat` follows the links, `/proc/self/fd/1`'s magic one too (to a pipe, which has no
+        // path to canonicalize).
+        let meta = match fs::metadata(path) {
+            Ok(meta) => meta,
+            Err(err) if is_link && err.kind() == io::ErrorKind::NotFound => {
+                return Err(refuse("is a symbolic link that leads nowhere"))
+            }
+            Err(err) => return Err(Error::io(path, err)),
         };
-        let kind = fs::metadata(&target)
-            .map_err(|err| Error::io(path, err))?
-            .file_type();
+        if is_stdout(&meta) {
+            return Ok(Self::Stdout);
+        }
+        let kind = meta.file_type();
         if kind.is_file() {
+            // Follow a link: the file the user names is the one they mean. (Otherwise keep the
+            // path as given, so that messages name it as the user wrote it.)
+            let target = if is_link {
+                fs::canonicalize(path).map_err(|err| Error::io(path, err))?
+            } else {
+                path.to_path_buf()
+            };
             Ok(Self::Replace(target))
         } else if kind.is_char_device() || kind.is_fifo() {
-            Ok(Self::WriteThrough(target))
+            Ok(Self::WriteThrough(path.to_path_buf()))
         } else if kind.is_dir() {
             Err(refuse("is a directory"))
         } else {
             Err(refuse("is not a regular file"))
         }
+    }
+}
+
+/// Whether `meta` is the file (or pipe, or terminal) this process's standard output is.
+fn is_stdout(meta: &fs::Metadata) -> bool {
+    let Ok(stdout) = stdout_file() else {
+        return false;
+    };
+    stdout
+        .metadata()
+        .is_ok_and(|out| out.dev() == meta.dev() && out.ino() == meta.ino())
+}
+
+/// A second descriptor of standard output, sharing the shell's open file (its offset and its
+/// append mode).
+fn stdout_file() -> io::Result<fs::File> {
+    use std::os::fd::AsFd;
+    Ok(fs::File::from(io::stdout().as_fd().try_clone_to_owned()?))
+}
+
+/// What a single-file output is, so that a previous output of its kind can be told from a
+/// user's file at its path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileKind {
+    /// What it is, for messages ("an MCAP file").
+    pub name: &'static str,
+    /// The bytes every file of this kind starts with.
+    pub starts_with: &'static [u8],
+}
+
+/// Checks, before any work, that a command may write its single-file output at `path`: a
+/// device, a FIFO or standard output is written through; a regular file (links followed) is
+/// replaced only when it is empty or a previous output of `kind`, and never when it is one of
+/// the command's `inputs`. What killed writers of `path` left beside it is tidied.
+///
+/// # Errors
+/// `path` is an input, a file of another kind, or refused by [`OutputTarget::of`].
+pub fn check_output_file(path: &Path, kind: FileKind, inputs: &[&Path]) -> Result<(), Error> {
+    let refuse = |what: String| Error::io(path, io::Error::other(what));
+    if let Some(input) = inputs.iter().find(|input| is_same_file(path, input)) {
+        return Err(refuse(if input == &path {
+            "is an input of this command; refusing to write over it".to_string()
+        } else {
+            format!(
+                "is the same file as the input {}; refusing to write over it",
+                input.display()
+            )
+        }));
+    }
+    let OutputTarget::Replace(target) = OutputTarget::of(path)? else {
+        return Ok(());
+    };
+    tidy_after_killed_writers(&target)?;
+    let mut head = Vec::with_capacity(kind.starts_with.len());
+    match fs::File::open(&target) {
+        Err(err) if err.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(err) => return Err(Error::io(path, err)),
+        Ok(file) => {
+            file.take(kind.starts_with.len() as u64)
+                .read_to_end(&mut head)
+                .map_err(|err| Error::io(path, err))?;
+        }
+    }
+    if head.is_empty() || head == kind.starts_with {
+        Ok(())
+    } else {
+        Err(refuse(format!(
+            "exists and is not {}; refusing to replace it (choose another name, or remove it)",
+            kind.name
+        )))
     }
 }
 
@@ -86,6 +170,25 @@ pub fn write_file_atomically(path: &Path, contents: &[u8]) -> Result<(), Error> 
     file.commit()
 }
 
+/// [`write_file_atomically`] for a file inside an output directory the command owns (a report's
+/// page, a dataset's manifest): a symbolic link there leads to a file that is not the
+/// directory's, such as another report's page, so it is refused, never followed.
+///
+/// # Errors
+/// `path` is a symbolic link, or as [`write_file_atomically`].
+pub fn write_owned_file_atomically(path: &Path, contents: &[u8]) -> Result<(), Error> {
+    if fs::symlink_metadata(path).is_ok_and(|meta| meta.file_type().is_symlink()) {
+        return Err(Error::io(
+            path,
+            io::Error::other(
+                "is a symbolic link to a file outside this output; refusing to write through it \
+                 (remove the link)",
+            ),
+        ));
+    }
+    write_file_atomically(path, contents)
+}
+
 /// A file written as [`write_file_atomically`] writes one, for contents that arrive in pieces
 /// (buffered): through a temporary sibling (`.NAME.tmp.PID`) that [`AtomicFile::commit`] syncs
 /// and renames over the target, or straight to a device or FIFO. Dropped uncommitted, it removes
@@ -104,18 +207,19 @@ impl AtomicFile {
     /// # Errors
     /// `path` is refused, or the file cannot be created.
     pub fn create(path: &Path) -> Result<Self, Error> {
-        let (target, tmp) = match OutputTarget::of(path)? {
+        let open = |result: io::Result<fs::File>| result.map_err(|err| Error::io(path, err));
+        let (target, tmp, file) = match OutputTarget::of(path)? {
             OutputTarget::Replace(target) => {
                 let tmp = sibling(&target, "tmp");
-                (target, Some(tmp))
+                let file = open(fs::File::create(&tmp))?;
+                (target, Some(tmp), file)
             }
-            OutputTarget::WriteThrough(device) => (device, None),
+            OutputTarget::WriteThrough(device) => {
+                let file = open(fs::OpenOptions::new().write(true).open(&device))?;
+                (device, None, file)
+            }
+            OutputTarget::Stdout => (path.to_path_buf(), None, open(stdout_file())?),
         };
-        let file = match &tmp {
-            Some(tmp) => fs::File::create(tmp),
-            None => fs::OpenOptions::new().write(true).open(&target),
-        }
-        .map_err(|err| Error::io(path, err))?;
         Ok(Self {
             target,
             tmp,
@@ -223,6 +327,114 @@ pub(crate) fn put_in_place(tmp: &Path, dir: &Path) -> Result<(), Error> {
     Ok(())
 }
 
+/// The directory a recording output named `dir` is put at: a symbolic link to a directory is
+/// followed (the user means the directory it leads to), and a path without a last name (`.`,
+/// `..`, `/`) or one that holds the working directory is refused, since replacing it would pull
+/// the directory out from under the shell that runs the command.
+///
+/// # Errors
+/// `dir` names no directory of its own, or holds the working directory.
+pub fn resolve_output_dir(dir: &Path) -> Result<PathBuf, Error> {
+    let refuse = |what: &str| Error::io(dir, io::Error::other(what.to_string()));
+    let meta = match fs::symlink_metadata(dir) {
+        Err(err) if err.kind() == io::ErrorKind::NotFound => None,
+        Err(err) => return Err(Error::io(dir, err)),
+        Ok(meta) => Some(meta),
+    };
+    let resolved = match &meta {
+        Some(meta) if meta.is_dir() || (meta.is_symlink() && dir.is_dir()) => {
+            fs::canonicalize(dir).map_err(|err| Error::io(dir, err))?
+        }
+        _ => dir.to_path_buf(),
+    };
+    let cwd = std::env::current_dir().and_then(fs::canonicalize);
+    if meta.is_some() && cwd.is_ok_and(|cwd| cwd.starts_with(&resolved)) {
+        return Err(refuse(
+            "is the working directory or holds it, and an output directory is replaced whole; \
+             name a new directory (for example --out run1)",
+        ));
+    }
+    if matches!(
+        dir.components().next_back(),
+        None | Some(Component::CurDir | Component::ParentDir | Component::RootDir)
+    ) {
+        return Err(refuse(
+            "names no directory of its own; name a new directory (for example --out run1)",
+        ));
+    }
+    Ok(if meta.as_ref().is_some_and(fs::Metadata::is_symlink) {
+        resolved
+    } else {
+        dir.to_path_buf()
+    })
+}
+
+/// Refuses an `input` that lies inside the output directory `dir` (which the command replaces
+/// whole), before any work: the command would delete what it reads.
+///
+/// # Errors
+/// `input` is `dir` or inside it.
+pub fn check_input_outside(input: &Path, dir: &Path) -> Result<(), Error> {
+    let (Ok(input_real), Ok(dir_real)) = (fs::canonicalize(input), fs::canonicalize(dir)) else {
+        return Ok(());
+    };
+    if input_real.starts_with(&dir_real) {
+        return Err(Error::io(
+            input,
+            io::Error::other(format!(
+                "lies inside the output directory {}, which is replaced whole; \
+                 write the output to another directory",
+                dir.display()
+            )),
+        ));
+    }
+    Ok(())
+}
+
+/// The names a hilsim recording directory's own files have: what a new recording replaces.
+/// Anything else in the directory (a user's notes, plots) is the user's and is kept.
+const RECORDING_OWN_NAMES: [&str; 7] = [
+    "meta.toml",
+    "commands.csv",
+    "odometry.csv",
+    "lidar.csv",
+    "sonar.csv",
+    "truth.csv",
+    // `hilsim run --out`'s calibrations and metrics.
+    "results.json",
+];
+
+/// Moves what the user keeps in the recording directory `dir` (every entry that is not a
+/// recording's own file, nor written anew in `tmp`) into `tmp`, which is about to replace it.
+fn carry_over_user_files(dir: &Path, tmp: &Path) -> Result<(), Error> {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for entry in entries {
+        let entry = entry.map_err(|err| Error::io(dir, err))?;
+        let name = entry.file_name();
+        let own = name
+            .to_str()
+            .is_some_and(|name| RECORDING_OWN_NAMES.contains(&name));
+        let to = tmp.join(&name);
+        if own || fs::symlink_metadata(&to).is_ok() {
+            continue;
+        }
+        fs::rename(entry.path(), &to).map_err(|err| Error::io(&entry.path(), err))?;
+    }
+    Ok(())
+}
+
+/// Puts the complete recording `tmp` in place of `dir`, carrying over the user's files that
+/// `dir` holds beside a previous recording.
+pub(crate) fn put_recording_in_place(tmp: &Path, dir: &Path) -> Result<(), Error> {
+    if let Err(err) = carry_over_user_files(dir, tmp) {
+        let _ = fs::remove_dir_all(tmp);
+        return Err(err);
+    }
+    put_in_place(tmp, dir)
+}
+
 /// Whether `dir` may be replaced by a recording: it is absent, an empty directory, or a hilsim
 /// recording (a directory whose `meta.toml` names the format). Anything else is the user's.
 ///
@@ -286,9 +498,15 @@ pub fn replace_recording_dir<E>(
 where
     E: From<Error>,
 {
-    tidy_after_killed_writers(dir)?;
-    check_replaceable_recording(dir)?;
-    replace_dir_atomically(dir, fill)
+    let dir = resolve_output_dir(dir)?;
+    tidy_after_killed_writers(&dir)?;
+    check_replaceable_recording(&dir)?;
+    let tmp = new_sibling_dir(&dir)?;
+    if let Err(err) = fill(&tmp) {
+        let _ = fs::remove_dir_all(&tmp);
+        return Err(err);
+    }
+    put_recording_in_place(&tmp, &dir).map_err(E::from)
 }
 
 /// Tidies what writers of `dir` that were killed left beside it: an unfinished new recording

@@ -33,8 +33,9 @@ mod stream;
 mod write;
 
 pub use atomic::{
-    check_replaceable_recording, is_same_file, replace_dir_atomically, replace_recording_dir,
-    tidy_after_killed_writers, write_file_atomically, AtomicFile, OutputTarget,
+    check_input_outside, check_output_file, check_replaceable_recording, is_same_file,
+    replace_dir_atomically, replace_recording_dir, resolve_output_dir, tidy_after_killed_writers,
+    write_file_atomically, write_owned_file_atomically, AtomicFile, FileKind, OutputTarget,
 };
 pub use background::BackgroundStream;
 pub use error::{Error, ErrorKind};
@@ -77,6 +78,13 @@ impl Recording {
         "sonar.csv",
         "truth.csv",
     ];
+
+    /// The paths of the files a recording directory `dir` may hold: a command that reads the
+    /// recording must not write over any of them.
+    #[must_use]
+    pub fn files_in(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+        Self::FILES.iter().map(|name| dir.join(name)).collect()
+    }
 
     /// An empty recording with the given metadata.
     #[must_use]

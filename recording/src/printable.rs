@@ -67,7 +67,10 @@ mod tests {
 
     #[test]
     fn plain_names_are_borrowed_unchanged() {
-        assert!(matches!(printable("/scan_front"), Cow::Borrowed("/scan_front")));
+        assert!(matches!(
+            printable("/scan_front"),
+            Cow::Borrowed("/scan_front")
+        ));
         assert_eq!(printable("bière à 4 m"), "bière à 4 m");
     }
 

@@ -8,7 +8,9 @@ use std::fs::{self, File};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::atomic::{check_replaceable_recording, new_sibling_dir, put_in_place};
+use crate::atomic::{
+    check_replaceable_recording, new_sibling_dir, put_recording_in_place, resolve_output_dir,
+};
 use crate::write::rows;
 use crate::{
     CommandSample, Error, LidarDecimals, LidarSample, Meta, OdometrySample, Recording, SonarSample,
@@ -206,10 +208,11 @@ impl RecordingStream {
     /// # Errors
     /// `dir` holds something other than a recording, or a file cannot be created.
     pub fn create(dir: &Path, meta: Meta, tables: Tables) -> Result<Self, Error> {
-        check_replaceable_recording(dir)?;
-        let tmp = new_sibling_dir(dir)?;
+        let dir = resolve_output_dir(dir)?;
+        check_replaceable_recording(&dir)?;
+        let tmp = new_sibling_dir(&dir)?;
         let mut stream = Self {
-            dir: dir.to_path_buf(),
+            dir,
             tmp: tmp.clone(),
             meta,
             commands: None,
@@ -300,7 +303,7 @@ impl RecordingStream {
         files.push((meta_path, meta_file));
         sync_together(&files)?;
         extra(&self.tmp)?;
-        put_in_place(&self.tmp, &self.dir)?;
+        put_recording_in_place(&self.tmp, &self.dir)?;
         // In place: nothing for `drop` to remove.
         self.tmp = PathBuf::new();
         Ok(())

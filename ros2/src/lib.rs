@@ -31,6 +31,12 @@ pub mod msgs;
 pub mod topics;
 
 pub use error::Error;
+
+/// An MCAP file, as a single-file output recognises a previous one: by the format's magic.
+pub const MCAP_FILE: hilsim_recording::FileKind = hilsim_recording::FileKind {
+    name: "an MCAP file",
+    starts_with: b"\x89MCAP0\r\n",
+};
 pub use export::{export, export_with, ExportOptions, ExportReport, World, START_NS};
 pub use import::{
     angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,

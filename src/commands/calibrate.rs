@@ -3,14 +3,16 @@
 
 use std::fmt::Write as _;
 use std::io::Write;
-
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
 use hilsim_calibrator::smoothing;
 use hilsim_calibrator::{em, Method, SampleOptions, Settings};
-use hilsim_recording::{is_same_file, write_file_atomically, Recording};
+use hilsim_recording::{
+    check_output_file, write_file_atomically, FileKind, OutputTarget, Recording,
+};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
@@ -94,33 +96,31 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions
     })
 }
 
+/// The header of `smooth --csv`'s table.
+const SMOOTHED_CSV_HEADER: &str = "t_s,distance_m,sd_m\n";
+
+/// `smooth --csv`'s table, as a previous one is recognised.
+const SMOOTHED_CSV: FileKind = FileKind {
+    name: "a table of smoothed distances",
+    starts_with: SMOOTHED_CSV_HEADER.as_bytes(),
+};
+
 /// Writes the smoothed distances; exit 1 when the recording fails a check against the
 /// calibration (the distances are still written; the failed checks go to stderr).
 pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let target = target_options(args.beam, args.start_distance)?;
     if let Some(csv) = &args.csv {
-        // The inputs: the calibration and the recording's own files.
-        let inputs = std::iter::once(args.calibration.clone()).chain(
-            Recording::FILES
-                .iter()
-                .map(|name| args.recording.join(name)),
-        );
-        for input in inputs {
-            if is_same_file(csv, &input) {
-                bail!(
-                    "{}: is an input ({}); refusing to write the CSV over it",
-                    csv.display(),
-                    input.display()
-                );
-            }
-        }
+        let mut inputs = Recording::files_in(&args.recording);
+        inputs.push(args.calibration.clone());
+        let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+        check_output_file(csv, SMOOTHED_CSV, &inputs)?;
     }
     let trained = super::read_calibration(&args.calibration)?;
     let rec = Recording::read_dir(&args.recording)?;
     let (estimates, checks) =
         smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))
             .with_context(|| format!("{}: smoothing", args.recording.display()))?;
-    let mut csv = String::from("t_s,distance_m,sd_m\n");
+    let mut csv = String::from(SMOOTHED_CSV_HEADER);
     for e in &estimates {
         let _ = writeln!(
             csv,
@@ -133,6 +133,10 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
     match &args.csv {
         Some(path) => {
             write_file_atomically(path, csv.as_bytes())?;
+            // With the table on standard output, the line saying so goes beside it.
+            let on_stdout = OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout);
+            let mut stderr = std::io::stderr();
+            let out: &mut dyn Write = if on_stdout { &mut stderr } else { out };
             writeln!(
                 out,
                 "smoothed {} samples of {} into {}",

@@ -31,7 +31,13 @@ use anyhow::{anyhow, bail, Context};
 use hilsim_hil::decode::{
     decode_stream, decoded_csv_rows, DecodeCounts, DecodeError, DECODED_CSV_HEADER,
 };
-use hilsim_recording::{is_same_file, AtomicFile};
+use hilsim_recording::{check_output_file, AtomicFile, FileKind, OutputTarget};
+
+/// `decode --csv`'s table, as a previous one is recognised: by its header.
+const DECODED_CSV: FileKind = FileKind {
+    name: "a table of decoded readings",
+    starts_with: DECODED_CSV_HEADER.as_bytes(),
+};
 
 /// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
 /// (one JSON object with `json`, else a short human summary).
@@ -68,18 +74,18 @@ pub fn run(
             counts
         }
     };
+    // With the table on standard output, the counts go beside it, not into it.
+    if csv.is_some_and(|path| OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout)) {
+        return report(input, &counts, json, &mut std::io::stderr())
+            .context("stderr: cannot write");
+    }
     report(input, &counts, json, stdout).context("stdout: cannot write")
 }
 
 /// The CSV at `path`, its header written: replaced atomically when complete, or written through
 /// a device (see [`AtomicFile`]); never over the `input`.
 fn create_csv(path: &Path, input: &Path) -> anyhow::Result<AtomicFile> {
-    if is_same_file(path, input) {
-        bail!(
-            "{}: is the input; refusing to write the CSV over it",
-            path.display()
-        );
-    }
+    check_output_file(path, DECODED_CSV, &[input])?;
     let mut out = AtomicFile::create(path)?;
     writeln!(out, "{DECODED_CSV_HEADER}")
         .with_context(|| format!("{}: cannot write", path.display()))?;

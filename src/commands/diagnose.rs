@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::{bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan, Reality};
 use hilsim_diagnose::{show, Effect, Floors, Options, SimPhysics, Stage};
-use hilsim_recording::{write_file_atomically, Recording};
+use hilsim_recording::{write_owned_file_atomically, Recording};
 use hilsim_sim::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -217,6 +217,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
     };
     let options = options(args)?;
+    if let Some(dir) = &args.report {
+        super::report::check_report_dir(dir, &[MAP_FILE])?;
+    }
     let scenario = super::load_scenario(Some(sim), None)?;
     let recording = Recording::read_dir(real)?;
     let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
@@ -246,6 +249,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The map's file beside a diagnosis's page.
+const MAP_FILE: &str = "map.svg";
+
 /// Writes `index.html`, its plots and the map into `dir` (created if needed), each file
 /// atomically.
 fn write_report(
@@ -254,16 +260,24 @@ fn write_report(
     (sim, scenario): (&Path, &Scenario),
     (real, recording): (&Path, &Recording),
 ) -> Result<()> {
+    let files: Vec<String> = d
+        .plots
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            format!(
+                "residuals-{}-{}.svg",
+                i + 1,
+                p.variable.name().replace(' ', "-")
+            )
+        })
+        .collect();
+    let mut own: Vec<&str> = files.iter().map(String::as_str).collect();
+    own.push(MAP_FILE);
+    super::report::check_report_dir(dir, &own)?;
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    let mut files = Vec::new();
-    for (i, p) in d.plots.iter().enumerate() {
-        let name = format!(
-            "residuals-{}-{}.svg",
-            i + 1,
-            p.variable.name().replace(' ', "-")
-        );
-        write_file_atomically(&dir.join(&name), show::svg(p).as_bytes())?;
-        files.push(name);
+    for (name, p) in files.iter().zip(&d.plots) {
+        write_owned_file_atomically(&dir.join(name), show::svg(p).as_bytes())?;
     }
     let title = format!(
         "hilsim diagnose: {} against {}",
@@ -288,10 +302,10 @@ fn write_report(
         },
         located_overlay(d).as_ref(),
     );
-    write_file_atomically(&dir.join("map.svg"), map.as_bytes())?;
-    write_file_atomically(
+    write_owned_file_atomically(&dir.join(MAP_FILE), map.as_bytes())?;
+    write_owned_file_atomically(
         &dir.join("index.html"),
-        show::html(d, &title, &files, Some("map.svg")).as_bytes(),
+        show::html(d, &title, &files, Some(MAP_FILE)).as_bytes(),
     )?;
     Ok(())
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use hilsim_calibrator::landmarks::Inverse;
 use hilsim_calibrator::Sensor;
-use hilsim_recording::Recording;
+use hilsim_recording::{check_output_file, Recording};
 use hilsim_sim::Scenario;
 
 #[derive(Debug, clap::Args)]
@@ -27,6 +27,9 @@ pub struct ExportArgs {
 }
 
 pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
+    let mut inputs = Recording::files_in(&args.recording);
+    inputs.extend(args.scenario.iter().chain(&args.calibration).cloned());
+    check_mcap_output(&args.mcap, &inputs)?;
     // Both inputs are read before the output is opened.
     let world = match &args.scenario {
         Some(path) => Some(world(&super::load_scenario(Some(path), None)?)),
@@ -78,6 +81,14 @@ fn calibrated_ranges(
             }
         })
         .collect())
+}
+
+/// Checks, before any work, that `path` may take an MCAP file: nothing there, a previous MCAP
+/// file, or a device or standard output written through; never one of `inputs`.
+pub fn check_mcap_output(path: &Path, inputs: &[PathBuf]) -> Result<()> {
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    check_output_file(path, hilsim_ros2::MCAP_FILE, &inputs)?;
+    Ok(())
 }
 
 /// Writes `recording` as MCAP at `path`.

@@ -86,6 +86,8 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
         wheel_radius_m: args.wheel_radius_m,
         wheel_joints,
     };
+    // The bag is read while the recording is written: it must not be inside what is replaced.
+    hilsim_recording::check_input_outside(&args.bag, &args.out)?;
     hilsim_recording::tidy_after_killed_writers(&args.out)?;
     let report = hilsim_ros2::import(&args.bag, &args.out, &options)?;
     for (role, (topic, kind)) in &report.chosen {

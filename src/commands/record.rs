@@ -8,6 +8,9 @@ use hilsim_recording::{BackgroundStream, RecordingStream};
 use crate::cli::RecordArgs;
 
 pub fn record(args: &RecordArgs) -> Result<()> {
+    if let Some(mcap) = &args.mcap {
+        super::export::check_mcap_output(mcap, std::slice::from_ref(&args.scenario))?;
+    }
     let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;

@@ -14,8 +14,15 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         || builtin::STRAIGHT_BOARD_ORIGIN.to_string(),
         |p| p.display().to_string(),
     );
+    // Every output is checked before the run, so that a refused one costs nothing.
     if let Some(dir) = &args.report {
-        super::report::check_report_dir(dir)?;
+        super::report::check_report_dir(dir, &[])?;
+    }
+    if let Some(dir) = &args.out {
+        hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
+    }
+    if let Some(mcap) = &args.mcap {
+        super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
     }
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
     let via = match args.via {

@@ -14,7 +14,7 @@ pub fn html(d: &Diagnosis, title: &str, plot_files: &[String], map_file: Option<
     let _ = write!(
         s,
         r##"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{t}</title>
+<html lang="en"><head><meta charset="utf-8"><meta name="generator" content="{generator}"><title>{t}</title>
 <style>
 body {{ font-family: sans-serif; max-width: 62em; margin: 2em auto; color: #222; line-height: 1.45; }}
 h1 {{ font-size: 1.5em; }} .verdict {{ font-size: 1.3em; padding: .6em 1em; border-radius: 6px; }}
@@ -24,7 +24,8 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
 </style></head><body>
 <h1>{t}</h1>
 "##,
-        t = escape(title)
+        t = escape(title),
+        generator = hilsim_report::GENERATOR
     );
     let class = match d.verdict {
         Verdict::None => "none",

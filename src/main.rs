@@ -58,9 +58,11 @@ fn main() -> ExitCode {
 
 /// Whether `err` comes from writing to a pipe whose reader has gone.
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    let broken = |io: &std::io::Error| io.kind() == std::io::ErrorKind::BrokenPipe;
     err.chain().any(|cause| {
-        cause
-            .downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        cause.downcast_ref::<std::io::Error>().is_some_and(broken)
+            || cause.downcast_ref::<hilsim_recording::Error>().is_some_and(
+                |err| matches!(&err.kind, hilsim_recording::ErrorKind::Io(io) if broken(io)),
+            )
     })
 }

@@ -105,6 +105,7 @@ pub(crate) fn conclude(
     nominal: &Nominal,
     named: Vec<CandidateFit>,
     left: &[Left],
+    dead: &[Evidence],
     options: &Options,
 ) -> Conclusion {
     let threshold = nominal.threshold;
@@ -116,8 +117,12 @@ pub(crate) fn conclude(
             fit,
         })
         .collect();
-    let mut unexplained: Vec<Evidence> = Vec::new();
-    for l in left {
+    // A dead or stuck sensor first: no effect explains a sensor that reads nothing.
+    let mut unexplained: Vec<Evidence> = dead.to_vec();
+    for l in left
+        .iter()
+        .filter(|l| dead.iter().all(|d| d.sensor != l.sensor))
+    {
         let explained = effects.iter().any(|e| e.fit.effect.shows_in(l.sensor));
         // Most readings far from every prediction and no effect of the sensor named: the
         // recording is not a run of this scenario (or its trajectory is wrong).
@@ -175,7 +180,17 @@ pub(crate) fn conclude(
         Verdict::Effect(_) => {}
         Verdict::Unexplained => {
             let first = &unexplained[0];
-            explanation = if first.score.is_infinite() {
+            // (Compared by sensor and place: a dead sensor's size is NaN, which equals nothing.)
+            explanation = if dead
+                .iter()
+                .any(|d| d.sensor == first.sensor && d.place == first.place)
+            {
+                format!(
+                    "The {} reports nothing the simulation could give: {}. No catalogued \
+                     effect explains it.",
+                    first.sensor, first.detail
+                )
+            } else if first.score.is_infinite() {
                 format!(
                     "Nothing aligns: {}. No catalogued effect explains it.",
                     first.detail

@@ -9,6 +9,7 @@ use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};
+use crate::health;
 use crate::locate::{self, Evidence, TestKind};
 use crate::outcome::{
     Diagnosis, Options, SensorSummary, ESTIMATED_MOUNT_MIN_M, ESTIMATED_PATH_TIMING_S,
@@ -98,6 +99,7 @@ pub fn diagnose_with_progress(
     let mut notes = aligned.notes.clone();
     let drive_ctx = along_encoders.as_ref().map(|a| along(&ctx, a));
     progress(Stage::Gathering);
+    let dead = health::dead_or_stuck(&ctx);
     let mut data = gather(&ctx, drive_ctx.as_ref(), &aligned, &mut notes)?;
     progress(Stage::Locating);
     let mut nominal = nominal_evidence(&ctx, &aligned, &data, options);
@@ -188,7 +190,7 @@ pub fn diagnose_with_progress(
         effects,
         unexplained,
         explanation,
-    } = conclude(&ctx, &nominal, named, &left, options);
+    } = conclude(&ctx, &nominal, named, &left, &dead, options);
     let significant: Vec<Evidence> = nominal
         .evidence
         .iter()
@@ -587,9 +589,10 @@ fn gather(
                 d.clusters = Some(residuals::shared_error_clusters(along, &d.t));
             }
             data.push(d);
-        } else if !d.y.is_empty() {
+        } else {
+            // Never left out quietly: a sensor whose readings all fell out says so.
             notes.push(format!(
-                "only {} {} readings: too few to test",
+                "only {} {} readings could be compared: too few to test",
                 d.len(),
                 d.sensor
             ));

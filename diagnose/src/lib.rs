@@ -24,6 +24,7 @@ mod diagnosis;
 mod error;
 mod estimate;
 pub mod explain;
+mod health;
 pub mod locate;
 mod optimize;
 mod outcome;

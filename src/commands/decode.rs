@@ -68,7 +68,9 @@ pub fn run(
             };
             let counts = decode_stream(&mut source, Some(&mut write)).map_err(|err| match err {
                 DecodeError::Read(err) => cannot_read(err),
-                DecodeError::Sink(err) => anyhow!("{}: cannot write: {err}", path.display()),
+                DecodeError::Sink(err) => {
+                    anyhow::Error::new(err).context(format!("{}: cannot write", path.display()))
+                }
             })?;
             out.commit()?;
             counts

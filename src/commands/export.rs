@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use hilsim_calibrator::landmarks::Inverse;
 use hilsim_calibrator::Sensor;
-use hilsim_recording::{check_output_file, Recording};
+use hilsim_recording::{check_output_file, OutputTarget, Recording};
 use hilsim_sim::Scenario;
 
 #[derive(Debug, clap::Args)]
@@ -51,7 +51,12 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
         ..hilsim_ros2::ExportOptions::default()
     };
     hilsim_ros2::export_with(&recording, &options, &args.mcap)?;
-    writeln!(out, "wrote {}", args.mcap.display())?;
+    // Written to standard output, the file is the output: the line saying so goes beside it.
+    if OutputTarget::of(&args.mcap).is_ok_and(|t| t == OutputTarget::Stdout) {
+        eprintln!("wrote {}", args.mcap.display());
+    } else {
+        writeln!(out, "wrote {}", args.mcap.display())?;
+    }
     Ok(())
 }
 

@@ -11,8 +11,7 @@
 # Needs only the release binary (built here) and python3 for reading the JSON.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet
-hilsim=target/release/hilsim
+hilsim="$(bash .ci/hilsim-binary --release)"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 room=scenarios/diagnose-room.toml

@@ -10,8 +10,7 @@ if [ -z "$chromium" ]; then
     echo "make-pictures.sh: needs Chromium (Debian: apt-get install chromium)" >&2
     exit 1
 fi
-(cd "$root" && cargo build --quiet)
-hilsim="$root/target/debug/hilsim"
+hilsim="$(bash "$root/.ci/hilsim-binary")"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cd "$work"

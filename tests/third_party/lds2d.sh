@@ -10,8 +10,7 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/pip" install --quiet --disable-pip-version-check "lds2d==0.7.0" "pyserial>=3.4"
 
-cargo build --quiet
-hilsim="$root/target/debug/hilsim"
+hilsim="$(bash "$root/.ci/hilsim-binary")"
 tmp="$(mktemp -d)"
 trap 'kill "${serve_pid:-}" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 scenario=scenarios/room-tour.toml

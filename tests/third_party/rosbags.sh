@@ -12,8 +12,7 @@ fi
 "$venv/bin/pip" install --quiet --disable-pip-version-check \
     "rosbags==0.11.9" "mcap==1.6.0" "mcap-ros2-support==0.6.0"
 
-cargo build --quiet
-hilsim="$root/target/debug/hilsim"
+hilsim="$(bash "$root/.ci/hilsim-binary")"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 check="tests/third_party/rosbags_check.py"

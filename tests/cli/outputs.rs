@@ -85,7 +85,7 @@ fn issue_18_decode_refuses_to_write_over_its_input_or_a_directory() {
         tmp.path(),
         &["decode", "capture.bin", "--csv", "capture.bin"],
     ));
-    assert!(err.contains("is the input"), "{err}");
+    assert!(err.contains("is an input"), "{err}");
     assert_eq!(fs::read(&input).unwrap(), before);
     // Through a link to it, too.
     std::os::unix::fs::symlink("capture.bin", tmp.path().join("link.csv")).unwrap();
@@ -103,9 +103,13 @@ fn issue_18_decode_refuses_to_write_over_its_input_or_a_directory() {
 }
 
 #[test]
-fn issue_18_a_csv_through_a_link_replaces_the_linked_file_and_keeps_the_link() {
+fn a_csv_through_a_link_replaces_the_linked_previous_csv_and_keeps_the_link() {
     let tmp = tempfile::tempdir().unwrap();
-    fs::write(tmp.path().join("target.csv"), "old").unwrap();
+    fs::write(
+        tmp.path().join("target.csv"),
+        "rev,packet_index,angle_deg,distance_mm,range_m,strength,invalid,warning,error_code,rpm\n",
+    )
+    .unwrap();
     std::os::unix::fs::symlink("target.csv", tmp.path().join("link.csv")).unwrap();
     let o = hilsim(
         tmp.path(),
@@ -178,4 +182,241 @@ fn issue_18_what_a_killed_writer_left_is_tidied_and_an_orphaned_recording_restor
     left.sort();
     assert_eq!(left, [".rec.notes", "rec"]);
     assert!(tmp.path().join("rec/meta.toml").is_file());
+}
+
+/// A recording `R` made by `record`, with the user's own notes and plots beside it.
+fn recording_with_user_files(cwd: &Path) {
+    let o = record(cwd, "R");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    fs::write(cwd.join("R/NOTES.txt"), "calibrated on Tuesday").unwrap();
+    fs::create_dir(cwd.join("R/plots")).unwrap();
+    fs::write(cwd.join("R/plots/fit.json"), "{}").unwrap();
+}
+
+#[test]
+fn a_recording_replaced_by_record_run_or_import_keeps_the_users_files_beside_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    recording_with_user_files(tmp.path());
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let scenario = scenario.to_str().unwrap();
+    let o = hilsim(tmp.path(), &["export", "R", "--mcap", "robot.mcap"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for args in [
+        vec!["record", scenario, "--out", "R"],
+        vec!["run", scenario, "--out", "R"],
+        vec!["import", "robot.mcap", "--out", "R"],
+    ] {
+        let o = hilsim(tmp.path(), &args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        let notes = fs::read_to_string(tmp.path().join("R/NOTES.txt"));
+        assert_eq!(notes.unwrap(), "calibrated on Tuesday", "{args:?}");
+        assert!(tmp.path().join("R/plots/fit.json").is_file(), "{args:?}");
+        assert!(tmp.path().join("R/lidar.csv").is_file(), "{args:?}");
+    }
+    // What was the previous run's own is not kept beside a recording that is not a run's.
+    assert!(!tmp.path().join("R/results.json").exists());
+}
+
+#[test]
+fn import_refuses_a_bag_inside_the_directory_it_would_replace() {
+    let tmp = tempfile::tempdir().unwrap();
+    recording_with_user_files(tmp.path());
+    let o = hilsim(tmp.path(), &["export", "R", "--mcap", "R/robot.mcap"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let bag = fs::read(tmp.path().join("R/robot.mcap")).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["import", "R/robot.mcap", "--out", "R"],
+    ));
+    assert!(err.contains("inside the output directory"), "{err}");
+    assert_eq!(fs::read(tmp.path().join("R/robot.mcap")).unwrap(), bag);
+    // Through a link to the directory, too.
+    std::os::unix::fs::symlink("R", tmp.path().join("linkR")).unwrap();
+    assert_bad_input(&hilsim(
+        tmp.path(),
+        &["import", "R/robot.mcap", "--out", "linkR"],
+    ));
+    assert_eq!(fs::read(tmp.path().join("R/robot.mcap")).unwrap(), bag);
+}
+
+#[test]
+fn an_output_directory_that_holds_the_working_directory_is_refused_and_nothing_is_left() {
+    let tmp = tempfile::tempdir().unwrap();
+    let inner = tmp.path().join("inner");
+    fs::create_dir(&inner).unwrap();
+    let scenario = repo_file("scenarios/straight-board.toml");
+    for command in ["record", "run"] {
+        for out in [".", ".."] {
+            let args = [command, scenario.to_str().unwrap(), "--out", out];
+            let err = assert_bad_input(&hilsim(&inner, &args));
+            assert!(err.contains("working directory"), "{err}");
+        }
+    }
+    assert_eq!(
+        fs::read_dir(&inner).unwrap().count(),
+        0,
+        "a leftover in the cwd"
+    );
+    assert_eq!(
+        fs::read_dir(tmp.path()).unwrap().count(),
+        1,
+        "a leftover beside it"
+    );
+}
+
+#[test]
+fn a_single_file_output_never_replaces_an_input_or_a_file_of_another_kind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    assert_eq!(record(cwd, "R").status.code(), Some(0));
+    fs::copy(
+        repo_file("scenarios/straight-board.toml"),
+        cwd.join("s.toml"),
+    )
+    .unwrap();
+    fs::write(cwd.join("thesis.txt"), "chapter one").unwrap();
+    std::os::unix::fs::symlink("thesis.txt", cwd.join("link.mcap")).unwrap();
+    let lidar = fs::read(cwd.join("R/lidar.csv")).unwrap();
+    for args in [
+        vec!["export", "R", "--mcap", "R/lidar.csv"],
+        vec!["export", "R", "--scenario", "s.toml", "--mcap", "s.toml"],
+        vec!["record", "s.toml", "--out", "R2", "--mcap", "s.toml"],
+        vec!["run", "s.toml", "--mcap", "s.toml"],
+        vec!["export", "R", "--mcap", "thesis.txt"],
+        vec!["export", "R", "--mcap", "link.mcap"],
+    ] {
+        let err = assert_bad_input(&hilsim(cwd, &args));
+        assert!(err.contains("refusing"), "{args:?}: {err}");
+    }
+    assert_eq!(fs::read(cwd.join("R/lidar.csv")).unwrap(), lidar);
+    assert_eq!(
+        fs::read_to_string(cwd.join("thesis.txt")).unwrap(),
+        "chapter one"
+    );
+    assert!(fs::read_to_string(cwd.join("s.toml"))
+        .unwrap()
+        .contains("[robot]"));
+    assert!(
+        !cwd.join("R2").exists(),
+        "record ran before refusing its --mcap"
+    );
+    // A previous MCAP is replaced, and what a killed export left beside it is tidied.
+    let leftover = cwd.join(format!(".x.mcap.tmp.{}", dead_pid()));
+    fs::write(&leftover, "half").unwrap();
+    for _ in 0..2 {
+        let o = hilsim(cwd, &["export", "R", "--mcap", "x.mcap"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    assert!(
+        !leftover.exists(),
+        "a killed export's temporary file was kept"
+    );
+}
+
+/// Runs `sh -c SCRIPT` in `cwd` with the hilsim binary as `$H`; its exit code.
+fn shell(cwd: &Path, script: &str) -> Option<i32> {
+    std::process::Command::new("bash")
+        .args(["-c", script])
+        .current_dir(cwd)
+        .env("H", env!("CARGO_BIN_EXE_hilsim"))
+        .status()
+        .unwrap()
+        .code()
+}
+
+#[test]
+fn standard_output_as_the_output_file_appends_where_the_shell_said_and_feeds_a_pipe() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    assert_eq!(record(cwd, "R").status.code(), Some(0));
+    let cap = capture();
+    let cap = cap.to_str().unwrap();
+    fs::write(cwd.join("log"), "earlier line\n").unwrap();
+    let script = format!("\"$H\" decode {cap} --csv /dev/stdout >> log");
+    assert_eq!(shell(cwd, &script), Some(0));
+    let log = fs::read_to_string(cwd.join("log")).unwrap();
+    assert!(
+        log.starts_with("earlier line\nrev,packet_index"),
+        "{}",
+        &log[..60]
+    );
+    // The counts go to stderr, not into the table.
+    assert!(!log.contains("packets"), "the summary went into the table");
+    fs::write(cwd.join("log.bin"), "earlier\n").unwrap();
+    assert_eq!(
+        shell(
+            cwd,
+            "\"$H\" export R --mcap /dev/stdout >> log.bin 2>/dev/null"
+        ),
+        Some(0)
+    );
+    let bytes = fs::read(cwd.join("log.bin")).unwrap();
+    assert!(bytes.starts_with(b"earlier\n\x89MCAP0\r\n"));
+    // Into a pipe, and into one whose reader stops early: success either way.
+    let pipe = format!(
+        "\"$H\" decode {cap} --csv /dev/stdout | wc -c >/dev/null; exit ${{PIPESTATUS[0]}}"
+    );
+    assert_eq!(shell(cwd, &pipe), Some(0));
+    let closed = format!(
+        "\"$H\" decode {cap} --csv /dev/stdout | head -c 1 >/dev/null; exit ${{PIPESTATUS[0]}}"
+    );
+    assert_eq!(shell(cwd, &closed), Some(0));
+}
+
+#[test]
+fn report_pages_and_dataset_manifests_refuse_a_link_and_a_users_page() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    assert_eq!(record(cwd, "R").status.code(), Some(0));
+    let o = hilsim(cwd, &["report", "R", "--out", "rep1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let page = fs::read(cwd.join("rep1/index.html")).unwrap();
+    fs::create_dir(cwd.join("rep2")).unwrap();
+    std::os::unix::fs::symlink("../rep1/index.html", cwd.join("rep2/index.html")).unwrap();
+    let err = assert_bad_input(&hilsim(cwd, &["report", "R", "--out", "rep2"]));
+    assert!(err.contains("symbolic link"), "{err}");
+    assert_eq!(fs::read(cwd.join("rep1/index.html")).unwrap(), page);
+    // diagnose --report: a user's page, or a user's map beside no report, stays.
+    fs::create_dir_all(cwd.join("mine")).unwrap();
+    fs::write(cwd.join("mine/index.html"), "<html>mine</html>").unwrap();
+    fs::create_dir_all(cwd.join("maps")).unwrap();
+    fs::write(cwd.join("maps/map.svg"), "<svg/>").unwrap();
+    let room = repo_file("scenarios/diagnose-room.toml");
+    for dir in ["mine", "maps"] {
+        let args = [
+            "diagnose",
+            "--sim",
+            room.to_str().unwrap(),
+            "--real",
+            "R",
+            "--report",
+            dir,
+        ];
+        let err = assert_bad_input(&hilsim(cwd, &args));
+        assert!(err.contains("not"), "{err}");
+    }
+    assert_eq!(
+        fs::read_to_string(cwd.join("mine/index.html")).unwrap(),
+        "<html>mine</html>"
+    );
+    assert_eq!(
+        fs::read_to_string(cwd.join("maps/map.svg")).unwrap(),
+        "<svg/>"
+    );
+    // A dataset's manifest that links to another dataset's is not written through.
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let scenario = scenario.to_str().unwrap();
+    for out in ["a", "b"] {
+        let o = hilsim(cwd, &["dataset", scenario, "--runs", "2", "--out", out]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let manifest_a = fs::read(cwd.join("a/manifest.csv")).unwrap();
+    fs::remove_file(cwd.join("b/manifest.csv")).unwrap();
+    std::os::unix::fs::symlink("../a/manifest.csv", cwd.join("b/manifest.csv")).unwrap();
+    let err = assert_bad_input(&hilsim(
+        cwd,
+        &["dataset", scenario, "--runs", "2", "--out", "b"],
+    ));
+    assert!(err.contains("symbolic link"), "{err}");
+    assert_eq!(fs::read(cwd.join("a/manifest.csv")).unwrap(), manifest_a);
 }

@@ -5,6 +5,8 @@
 
 use serde::Deserialize;
 
+use super::check::toml_number;
+
 /// The `[link]` table as written.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -107,11 +109,14 @@ impl Link {
     }
 
     /// Checks every value: rates in [0, 0.5] (beyond, the stream is noise), times finite and
-    /// non-negative, a reconnection only after a disconnection.
+    /// non-negative, a reconnection only after a disconnection, and the rpm wobble smaller than
+    /// the motor's speed: than the lidar's `rpm`, and during a spin-up than
+    /// [`SPIN_UP_FROM_RPM`] (a wobble as large would stop the motor or turn it backwards).
+    /// `lidar` is `[sensors.lidar]`'s `(rpm, rpm_wobble)`, when the scenario has one.
     ///
     /// # Errors
     /// The first bad key and why.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    pub fn validate(&self, lidar: Option<(f64, f64)>) -> Result<(), (&'static str, String)> {
         self.faults().map_err(|e| ("profile", e))?;
         for (key, value) in [
             ("corrupt_packet_rate", self.corrupt_packet_rate),
@@ -120,13 +125,15 @@ impl Link {
         ] {
             if let Some(v) = value {
                 if !(v.is_finite() && (0.0..=0.5).contains(&v)) {
-                    return Err((key, format!("expected a fraction in [0, 0.5], found {v}")));
+                    return Err((
+                        key,
+                        format!("expected a fraction in [0, 0.5], found {}", toml_number(v)),
+                    ));
                 }
             }
         }
         for (key, value) in [
             ("spin_up_s", self.spin_up_s),
-            ("rpm_wobble", self.rpm_wobble),
             ("disconnect_at_s", self.disconnect_at_s),
             ("reconnect_after_s", self.reconnect_after_s),
         ] {
@@ -134,9 +141,52 @@ impl Link {
                 if !(v.is_finite() && (0.0..=super::MAX_RUN_S).contains(&v)) {
                     return Err((
                         key,
-                        format!("expected 0 to {} , found {v}", super::MAX_RUN_S),
+                        format!(
+                            "expected 0 to {} s, found {}",
+                            super::MAX_RUN_S,
+                            toml_number(v)
+                        ),
                     ));
                 }
+            }
+        }
+        if let Some(v) = self.rpm_wobble {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((
+                    "rpm_wobble",
+                    format!("expected a number ≥ 0, found {}", toml_number(v)),
+                ));
+            }
+            if let Some((rpm, _)) = lidar.filter(|&(rpm, _)| v >= rpm) {
+                return Err((
+                    "rpm_wobble",
+                    format!(
+                        "the wobble must be smaller than the rpm ([sensors.lidar] rpm = {}), \
+                         found {}",
+                        toml_number(rpm),
+                        toml_number(v)
+                    ),
+                ));
+            }
+        }
+        let faults = self.faults().map_err(|e| ("profile", e))?;
+        if let Some((_, lidar_wobble)) = lidar {
+            let wobble = faults.rpm_wobble.unwrap_or(lidar_wobble);
+            if faults.spin_up_s > 0.0 && wobble >= SPIN_UP_FROM_RPM {
+                let key = match (self.rpm_wobble, self.spin_up_s) {
+                    (Some(_), _) => "rpm_wobble",
+                    (None, Some(_)) => "spin_up_s",
+                    (None, None) => "profile",
+                };
+                return Err((
+                    key,
+                    format!(
+                        "a spin-up starts at {SPIN_UP_FROM_RPM} rpm, which a wobble of {} rpm \
+                         would stop: keep the wobble below {SPIN_UP_FROM_RPM} rpm, or spin up \
+                         in no time (`spin_up_s = 0`)",
+                        toml_number(wobble)
+                    ),
+                ));
             }
         }
         if self.reconnect_after_s.is_some() && self.disconnect_at_s.is_none() {
@@ -171,11 +221,11 @@ mod tests {
             profile: Some("perfect".into()),
             ..Link::default()
         };
-        assert!(bad.validate().is_err());
+        assert!(bad.validate(None).is_err());
         let bad = Link {
             dropped_byte_rate: Some(0.9),
             ..Link::default()
         };
-        assert_eq!(bad.validate().unwrap_err().0, "dropped_byte_rate");
+        assert_eq!(bad.validate(None).unwrap_err().0, "dropped_byte_rate");
     }
 }

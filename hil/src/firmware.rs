@@ -578,6 +578,78 @@ mod tests {
         assert!(gone(escaped as i32), "{escaped}");
     }
 
+    /// A firmware in Python: no shell between hilsim and it, since a shell resets what it
+    /// inherits and would hide a blocked or ignored signal.
+    fn python(script: &str) -> Firmware {
+        Firmware::spawn(&["python3".into(), "-c".into(), script.into()], &[]).unwrap()
+    }
+
+    /// Waits for the firmware's first stderr line.
+    fn first_line(fw: &Firmware) -> String {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while fw.stderr_tail().lines.is_empty() {
+            assert!(Instant::now() < deadline, "no line from the firmware");
+            thread::sleep(POLL);
+        }
+        fw.stderr_tail().lines[0].clone()
+    }
+
+    #[test]
+    fn a_firmware_started_where_signals_are_blocked_and_ignored_starts_with_neither() {
+        // A harness that waits for these blocks them in its threads; this test thread does too.
+        let mut blocked = SigSet::empty();
+        for which in [Signal::SIGINT, Signal::SIGTERM, Signal::SIGHUP] {
+            blocked.add(which);
+        }
+        blocked.thread_block().unwrap();
+        let mut fw = python(
+            "import signal, sys, time\n\
+             blocked = sorted(int(s) for s in signal.pthread_sigmask(signal.SIG_BLOCK, []))\n\
+             sys.stderr.write(f'{blocked} {signal.getsignal(signal.SIGTERM) == signal.SIG_DFL}\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(30)",
+        );
+        blocked.thread_unblock().unwrap();
+        assert_eq!(first_line(&fw), "[] True");
+        // So the polite SIGTERM works.
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::Terminated);
+        assert!(!exit.shrugged_off_sigterm);
+        assert_eq!(describe_status(exit.status), "signal 15 (SIGTERM)");
+    }
+
+    #[test]
+    fn a_firmware_that_blocks_sigterm_and_exits_later_is_not_said_to_have_left_on_it() {
+        let mut fw = python(
+            "import signal, sys, time\n\
+             signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGTERM])\n\
+             sys.stderr.write('blocked\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(0.5)",
+        );
+        assert_eq!(first_line(&fw), "blocked");
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::ByItself);
+        assert!(exit.shrugged_off_sigterm);
+        assert_eq!(exit.status.code(), Some(0));
+    }
+
+    #[test]
+    fn a_firmware_that_ignores_sigterm_is_killed_and_said_to_have_ignored_it() {
+        let mut fw = python(
+            "import signal, sys, time\n\
+             signal.signal(signal.SIGTERM, signal.SIG_IGN)\n\
+             sys.stderr.write('ignoring\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(30)",
+        );
+        assert_eq!(first_line(&fw), "ignoring");
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::Killed);
+        assert!(exit.shrugged_off_sigterm);
+        assert_eq!(describe_status(exit.status), "signal 9 (SIGKILL)");
+    }
+
     #[test]
     fn a_program_that_does_not_exist_is_an_error() {
         let err = Firmware::spawn(&["/nonexistent/firmware".into()], &[]).unwrap_err();

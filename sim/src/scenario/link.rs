@@ -228,4 +228,71 @@ mod tests {
         };
         assert_eq!(bad.validate(None).unwrap_err().0, "dropped_byte_rate");
     }
+
+    #[test]
+    fn the_rpm_wobble_must_stay_below_the_motor_speed() {
+        let wobble = |v: f64| Link {
+            rpm_wobble: Some(v),
+            ..Link::default()
+        };
+        // `[sensors.lidar]` at 300 rpm with no wobble of its own.
+        let lidar = Some((300.0, 0.0));
+        assert_eq!(wobble(299.0).validate(lidar), Ok(()));
+        for (v, found) in [(300.0, "300"), (20_000.0, "20000"), (1e300, "1e300")] {
+            let (key, message) = wobble(v).validate(lidar).unwrap_err();
+            assert_eq!(key, "rpm_wobble");
+            assert_eq!(
+                message,
+                format!(
+                    "the wobble must be smaller than the rpm ([sensors.lidar] rpm = 300), \
+                     found {found}"
+                )
+            );
+        }
+        for (v, found) in [(-5.0, "-5"), (f64::NAN, "nan"), (f64::INFINITY, "inf")] {
+            let message = wobble(v).validate(lidar).unwrap_err().1;
+            assert_eq!(message, format!("expected a number ≥ 0, found {found}"));
+        }
+        // During a spin-up the motor starts at 50 rpm: a wobble as large, the link's or the
+        // lidar's own, would stop it.
+        let spin_up = Link {
+            spin_up_s: Some(3.0),
+            ..wobble(60.0)
+        };
+        let (key, message) = spin_up.validate(lidar).unwrap_err();
+        assert_eq!(key, "rpm_wobble");
+        assert!(
+            message.contains("a wobble of 60 rpm would stop"),
+            "{message}"
+        );
+        let profile = Link {
+            profile: Some("xv11-capture".into()),
+            ..Link::default()
+        };
+        assert_eq!(profile.validate(Some((300.0, 49.0))), Ok(()));
+        assert_eq!(
+            profile.validate(Some((300.0, 50.0))).unwrap_err().0,
+            "profile"
+        );
+        let no_spin_up = Link {
+            spin_up_s: Some(0.0),
+            ..profile
+        };
+        assert_eq!(no_spin_up.validate(Some((300.0, 250.0))), Ok(()));
+    }
+
+    #[test]
+    fn seconds_are_bounded_and_quoted_compactly() {
+        let link = Link {
+            spin_up_s: Some(1e300),
+            ..Link::default()
+        };
+        assert_eq!(
+            link.validate(None).unwrap_err(),
+            (
+                "spin_up_s",
+                "expected 0 to 86400 s, found 1e300".to_string()
+            )
+        );
+    }
 }

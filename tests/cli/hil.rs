@@ -599,9 +599,12 @@ fn the_firmware_starts_with_no_signal_blocked_and_leaves_on_sigterm() {
     }
 }
 
-/// `hilsim hil` started with piped output, its `firmware: pid N` line read; returns the child
-/// and the firmware's pid.
-fn start_hil(dir: &Path, firmware: &str) -> (std::process::Child, u32) {
+/// `hilsim hil` started with piped output, its `firmware: pid N` line read; returns the child,
+/// the firmware's pid and the rest of its output once it ends.
+fn start_hil(
+    dir: &Path,
+    firmware: &str,
+) -> (std::process::Child, u32, std::thread::JoinHandle<String>) {
     use std::io::BufRead as _;
     let scenario = repo_file("scenarios/hil-approach.toml");
     let mut child = Command::new(env!("CARGO_BIN_EXE_hilsim"))
@@ -616,9 +619,10 @@ fn start_hil(dir: &Path, firmware: &str) -> (std::process::Child, u32) {
     let line = lines
         .find_map(|l| l.ok().filter(|l| l.starts_with("firmware: pid ")))
         .expect("a firmware line");
-    // The rest of the output is drained so that hilsim never blocks on a full pipe.
-    std::thread::spawn(move || lines.for_each(drop));
-    (child, firmware_pid(&line))
+    // The rest of the output is read as it comes, so that hilsim never blocks on a full pipe.
+    let rest =
+        std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>().join("\n"));
+    (child, firmware_pid(&line), rest)
 }
 
 /// Sends `signal` (`TERM`, `INT`…) to `pid`.
@@ -649,12 +653,18 @@ fn wait_within(child: &mut std::process::Child, limit: Duration) -> std::process
 fn a_sigterm_to_hilsim_ends_the_run_and_the_firmware() {
     let tmp = tempfile::tempdir().unwrap();
     let firmware = python_firmware(tmp.path(), "import time\ntime.sleep(60)\n");
-    let (mut child, fw) = start_hil(tmp.path(), &firmware);
+    let (mut child, fw, rest) = start_hil(tmp.path(), &firmware);
     std::thread::sleep(Duration::from_millis(300));
     send("TERM", child.id());
     // The ports close, 1 s for the firmware to leave by itself, then its SIGTERM.
     let status = wait_within(&mut child, Duration::from_secs(10));
-    assert_eq!(status.code(), Some(1), "{status}");
+    let text = rest.join().unwrap();
+    assert_eq!(status.code(), Some(1), "{status}: {text}");
+    assert!(text.contains("interrupted at "), "{text}");
+    assert!(
+        text.contains("firmware: left on SIGTERM once the run was over"),
+        "{text}"
+    );
     assert!(gone(fw), "firmware {fw} still runs");
 }
 
@@ -668,7 +678,7 @@ fn a_second_signal_ends_hilsim_at_once_with_its_firmware() {
         tmp.path(),
         "import signal, time\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\ntime.sleep(60)\n",
     );
-    let (mut child, fw) = start_hil(tmp.path(), &firmware);
+    let (mut child, fw, _) = start_hil(tmp.path(), &firmware);
     std::thread::sleep(Duration::from_millis(300));
     send("INT", child.id());
     // Within the second the firmware has to leave by itself.

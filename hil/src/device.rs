@@ -2,6 +2,7 @@
 //! XV-11's line settings: 115200 baud, 8N1, no flow control.
 
 use std::io::{self, Write};
+use std::os::unix::fs::FileTypeExt as _;
 use std::os::unix::io::AsRawFd;
 use std::time::Duration;
 
@@ -22,8 +23,21 @@ impl DeviceLink {
     /// Opens `path` at 115200 8N1.
     ///
     /// # Errors
-    /// The device cannot be opened or configured.
+    /// `path` is not a terminal device (kind `InvalidInput`, saying what it is instead), or the
+    /// device cannot be opened or configured.
     pub fn open(path: &str) -> io::Result<Self> {
+        let not_a_device = |what: &str| {
+            io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("not a serial device or pseudo-terminal ({what})"),
+            )
+        };
+        // Only a character device can be a terminal; anything else is named before it is opened
+        // (opening a FIFO could wait for a reader).
+        let kind = std::fs::metadata(path)?.file_type();
+        if !kind.is_char_device() {
+            return Err(not_a_device(describe_file_type(kind)));
+        }
         let port = serialport::new(path, XV11_BAUD)
             .data_bits(DataBits::Eight)
             .parity(Parity::None)
@@ -31,9 +45,44 @@ impl DeviceLink {
             .flow_control(FlowControl::None)
             .timeout(Duration::ZERO)
             .open_native()
-            .map_err(io::Error::from)?;
+            .map_err(|err| {
+                if is_terminal(path) == Some(false) {
+                    not_a_device("a character device that is not a terminal")
+                } else {
+                    io::Error::from(err)
+                }
+            })?;
         fcntl(port.as_raw_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).map_err(io::Error::from)?;
         Ok(Self { port })
+    }
+}
+
+/// Whether the device at `path` is a terminal; `None` when it cannot be opened to tell.
+fn is_terminal(path: &str) -> Option<bool> {
+    use std::io::IsTerminal as _;
+    use std::os::unix::fs::OpenOptionsExt as _;
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(nix::libc::O_NONBLOCK | nix::libc::O_NOCTTY)
+        .open(path)
+        .ok()
+        .map(|file| file.is_terminal())
+}
+
+/// What a file that is not a character device is, in words.
+fn describe_file_type(kind: std::fs::FileType) -> &'static str {
+    if kind.is_file() {
+        "a regular file"
+    } else if kind.is_dir() {
+        "a directory"
+    } else if kind.is_fifo() {
+        "a named pipe"
+    } else if kind.is_socket() {
+        "a socket"
+    } else if kind.is_block_device() {
+        "a block device"
+    } else {
+        "not a device"
     }
 }
 

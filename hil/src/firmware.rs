@@ -16,7 +16,7 @@ use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use nix::sys::signal::{killpg, Signal};
+use nix::sys::signal::{self, killpg, sigprocmask, SigHandler, SigSet, SigmaskHow, Signal};
 
 use crate::escaped::{kill_all, new_lineage, EscapedProcess, LINEAGE_VARIABLE};
 use nix::unistd::Pid;
@@ -130,11 +130,12 @@ pub fn split_command_line(line: &str) -> Result<Vec<String>, SplitError> {
 /// How the firmware ended once the run was over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ended {
-    /// It exited by itself (during the run, or when its ports closed).
+    /// It exited by itself (during the run, when its ports closed, or after a `SIGTERM` it had
+    /// blocked or ignored: see [`FirmwareExit::shrugged_off_sigterm`]).
     ByItself,
-    /// It left on `SIGTERM`.
+    /// It left on `SIGTERM` (killed by it, or exiting from its handler).
     Terminated,
-    /// It ignored `SIGTERM` for [`TERM_GRACE`] and was killed.
+    /// It was still running [`TERM_GRACE`] after `SIGTERM` and was killed.
     Killed,
 }
 
@@ -145,6 +146,8 @@ pub struct FirmwareExit {
     pub status: ExitStatus,
     /// How it came to exit.
     pub ended: Ended,
+    /// `SIGTERM` was sent while the firmware had it blocked or ignored, so it could not act on it.
+    pub shrugged_off_sigterm: bool,
     /// Processes it started that left its group and were still running once the group was
     /// gone; they were killed.
     pub escaped: Vec<EscapedProcess>,
@@ -185,6 +188,21 @@ struct Tail {
     closed: Condvar,
 }
 
+/// The process groups (and lineages) of the firmwares this process started that have not been
+/// dropped yet, for [`kill_all_running`].
+static RUNNING: Mutex<Vec<(Pid, String)>> = Mutex::new(Vec::new());
+
+/// Kills, with `SIGKILL`, every firmware this process started and still holds, its process group
+/// and what left the group: for a harness that must end at once (a second Ctrl-C) and has no
+/// time to shut them down in order. Their [`Firmware`]s reap them when dropped.
+pub fn kill_all_running() {
+    let running = RUNNING.lock().unwrap_or_else(PoisonError::into_inner);
+    for (pgid, lineage) in running.iter() {
+        let _ = killpg(*pgid, Signal::SIGKILL);
+        let _ = kill_all(lineage, Some(pgid.as_raw()));
+    }
+}
+
 /// A running firmware.
 #[derive(Debug)]
 pub struct Firmware {
@@ -199,7 +217,10 @@ pub struct Firmware {
 impl Firmware {
     /// Starts `argv` (the program, then its arguments) with `env` added to the environment,
     /// stdin from `/dev/null`, stdout inherited and stderr captured, as the leader of a new
-    /// process group, and [`LINEAGE_VARIABLE`] set so that what leaves the group is found.
+    /// process group, and [`LINEAGE_VARIABLE`] set so that what leaves the group is found. It
+    /// starts with no signal blocked and every signal at its default disposition, whatever the
+    /// calling thread's, and is killed if the thread that started it ends first (Linux ties the
+    /// parent-death signal to that thread): start it from the thread that runs it.
     ///
     /// # Errors
     /// `argv` is empty, or the program cannot be started.
@@ -208,14 +229,49 @@ impl Firmware {
             .split_first()
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, SplitError::Empty))?;
         let lineage = new_lineage();
-        let mut child = Command::new(program)
+        let mut command = Command::new(program);
+        command
             .args(args)
             .envs(env.iter().copied())
             .env(LINEAGE_VARIABLE, &lineage)
             .stdin(Stdio::null())
             .stderr(Stdio::piped())
-            .process_group(0)
-            .spawn()?;
+            .process_group(0);
+        let parent = nix::unistd::getpid();
+        // The firmware starts with an empty signal mask and every signal at its default, as from
+        // a shell: hilsim waits for SIGINT, SIGTERM and SIGHUP with them blocked in its threads,
+        // and a child inherits the mask (and ignored dispositions, across `exec`), so a firmware
+        // would never see the polite SIGTERM.
+        //
+        // SAFETY: the closure runs in the child between `fork` and `exec`, where only
+        // async-signal-safe calls may be made: it makes only `sigprocmask`, `signal` with
+        // `SIG_DFL` (installing no handler), `prctl` and `getppid`, all plain system calls, and
+        // allocates nothing (an `Errno` becomes an `io::Error` without allocating).
+        #[allow(unsafe_code)]
+        unsafe {
+            command.pre_exec(move || {
+                sigprocmask(SigmaskHow::SIG_SETMASK, Some(&SigSet::empty()), None)?;
+                for which in Signal::iterator() {
+                    if !matches!(which, Signal::SIGKILL | Signal::SIGSTOP) {
+                        signal::signal(which, SigHandler::SigDfl)?;
+                    }
+                }
+                // The leader dies with the thread that started it even when hilsim is killed
+                // outright and cannot shut it down; checked after, in case that already happened.
+                if nix::libc::prctl(
+                    nix::libc::PR_SET_PDEATHSIG,
+                    nix::libc::SIGKILL as nix::libc::c_ulong,
+                ) != 0
+                {
+                    return Err(io::Error::last_os_error());
+                }
+                if nix::unistd::getppid() != parent {
+                    return Err(io::Error::from_raw_os_error(nix::libc::ESRCH));
+                }
+                Ok(())
+            });
+        }
+        let mut child = command.spawn()?;
         let pgid = Pid::from_raw(i32::try_from(child.id()).unwrap_or(i32::MAX));
         let tail = Arc::new(Tail::default());
         if let Some(stderr) = child.stderr.take() {
@@ -230,6 +286,10 @@ impl Firmware {
                 return Err(err);
             }
         }
+        RUNNING
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push((pgid, lineage.clone()));
         Ok(Self {
             child,
             pgid,
@@ -263,29 +323,30 @@ impl Firmware {
     /// # Errors
     /// The child cannot be waited for or signalled.
     pub fn shut_down(&mut self, grace: Duration) -> io::Result<FirmwareExit> {
+        let exit = |status, ended, shrugged_off_sigterm| FirmwareExit {
+            status,
+            ended,
+            shrugged_off_sigterm,
+            escaped: Vec::new(),
+        };
         let mut exit = if let Some(status) = self.wait_for(grace)? {
-            FirmwareExit {
-                status,
-                ended: Ended::ByItself,
-                escaped: Vec::new(),
-            }
+            exit(status, Ended::ByItself, false)
         } else {
+            // What it does with the signal decides what its exit means.
+            let shrugged_off = crate::process::shrugs_off(self.pid(), Signal::SIGTERM);
             signal_group(self.pgid, Signal::SIGTERM)?;
             if let Some(status) = self.wait_for(TERM_GRACE)? {
-                FirmwareExit {
-                    status,
-                    ended: Ended::Terminated,
-                    escaped: Vec::new(),
-                }
+                let ended = if shrugged_off {
+                    Ended::ByItself
+                } else {
+                    Ended::Terminated
+                };
+                exit(status, ended, shrugged_off)
             } else {
                 signal_group(self.pgid, Signal::SIGKILL)?;
                 let status = self.child.wait()?;
                 self.status = Some(status);
-                FirmwareExit {
-                    status,
-                    ended: Ended::Killed,
-                    escaped: Vec::new(),
-                }
+                exit(status, Ended::Killed, shrugged_off)
             }
         };
         // Whatever the leader left running in its group goes too, and what left the group.
@@ -345,6 +406,10 @@ impl Drop for Firmware {
         if self.status.is_none() {
             let _ = self.child.wait();
         }
+        RUNNING
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .retain(|(pgid, _)| *pgid != self.pgid);
     }
 }
 
@@ -511,6 +576,78 @@ mod tests {
             }]
         );
         assert!(gone(escaped as i32), "{escaped}");
+    }
+
+    /// A firmware in Python: no shell between hilsim and it, since a shell resets what it
+    /// inherits and would hide a blocked or ignored signal.
+    fn python(script: &str) -> Firmware {
+        Firmware::spawn(&["python3".into(), "-c".into(), script.into()], &[]).unwrap()
+    }
+
+    /// Waits for the firmware's first stderr line.
+    fn first_line(fw: &Firmware) -> String {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while fw.stderr_tail().lines.is_empty() {
+            assert!(Instant::now() < deadline, "no line from the firmware");
+            thread::sleep(POLL);
+        }
+        fw.stderr_tail().lines[0].clone()
+    }
+
+    #[test]
+    fn a_firmware_started_where_signals_are_blocked_and_ignored_starts_with_neither() {
+        // A harness that waits for these blocks them in its threads; this test thread does too.
+        let mut blocked = SigSet::empty();
+        for which in [Signal::SIGINT, Signal::SIGTERM, Signal::SIGHUP] {
+            blocked.add(which);
+        }
+        blocked.thread_block().unwrap();
+        let mut fw = python(
+            "import signal, sys, time\n\
+             blocked = sorted(int(s) for s in signal.pthread_sigmask(signal.SIG_BLOCK, []))\n\
+             sys.stderr.write(f'{blocked} {signal.getsignal(signal.SIGTERM) == signal.SIG_DFL}\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(30)",
+        );
+        blocked.thread_unblock().unwrap();
+        assert_eq!(first_line(&fw), "[] True");
+        // So the polite SIGTERM works.
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::Terminated);
+        assert!(!exit.shrugged_off_sigterm);
+        assert_eq!(describe_status(exit.status), "signal 15 (SIGTERM)");
+    }
+
+    #[test]
+    fn a_firmware_that_blocks_sigterm_and_exits_later_is_not_said_to_have_left_on_it() {
+        let mut fw = python(
+            "import signal, sys, time\n\
+             signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGTERM])\n\
+             sys.stderr.write('blocked\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(0.5)",
+        );
+        assert_eq!(first_line(&fw), "blocked");
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::ByItself);
+        assert!(exit.shrugged_off_sigterm);
+        assert_eq!(exit.status.code(), Some(0));
+    }
+
+    #[test]
+    fn a_firmware_that_ignores_sigterm_is_killed_and_said_to_have_ignored_it() {
+        let mut fw = python(
+            "import signal, sys, time\n\
+             signal.signal(signal.SIGTERM, signal.SIG_IGN)\n\
+             sys.stderr.write('ignoring\\n')\n\
+             sys.stderr.flush()\n\
+             time.sleep(30)",
+        );
+        assert_eq!(first_line(&fw), "ignoring");
+        let exit = fw.shut_down(Duration::from_millis(50)).unwrap();
+        assert_eq!(exit.ended, Ended::Killed);
+        assert!(exit.shrugged_off_sigterm);
+        assert_eq!(describe_status(exit.status), "signal 9 (SIGKILL)");
     }
 
     #[test]

@@ -47,3 +47,20 @@ pub fn other_pids() -> Vec<u32> {
         },
     )
 }
+
+/// Whether process `pid` has `signal` blocked (in its main thread) or ignored, so that sending
+/// it does nothing (`/proc/PID/status`; Linux; `false` when that cannot be read).
+#[must_use]
+pub fn shrugs_off(pid: u32, signal: nix::sys::signal::Signal) -> bool {
+    let Ok(status) = std::fs::read_to_string(format!("/proc/{pid}/status")) else {
+        return false;
+    };
+    let bit = 1u64 << (signal as i32 - 1);
+    status.lines().any(|line| {
+        ["SigBlk:", "SigIgn:"].iter().any(|key| {
+            line.strip_prefix(key)
+                .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+                .is_some_and(|mask| mask & bit != 0)
+        })
+    })
+}

@@ -8,7 +8,7 @@ use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
 use crate::effects::LidarEffects;
-use crate::neato_packet::{MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
+use crate::neato_packet::{rpm_to_fixed, MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
 use hilsim_recording::Mount;
 
@@ -194,8 +194,9 @@ impl Lidar {
     }
 
     /// The motor speed during revolution `rev`, as the packets report it: quantised to the
-    /// packet field's 1/64 rpm, so a decoder that times readings from the field reproduces the
-    /// emulator's timing exactly.
+    /// packet field's 1/64 rpm and held within what the field carries (1/64 to 1023.98 rpm), so
+    /// a decoder that times readings from the field reproduces the emulator's timing exactly,
+    /// and time always runs forward, however deep a wobble dips during a spin-up.
     #[must_use]
     pub fn rpm_of_revolution(&self, rev: u64) -> f64 {
         let phase = std::f64::consts::TAU * rev as f64 / WOBBLE_PERIOD_REVS + self.wobble_phase;
@@ -205,7 +206,7 @@ impl Lidar {
             .copied()
             .unwrap_or(self.rpm);
         let rpm = speed + self.rpm_wobble * phase.sin();
-        (rpm * 64.0).round() / 64.0
+        f64::from(rpm_to_fixed(rpm).max(1)) / 64.0
     }
 
     /// The unit's motor as the scenario's `[link]` table has it: a spin-up from

@@ -78,10 +78,9 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     })?;
     let duration = seconds("duration_s", duration_s).with_context(|| origin.clone())?;
     if let Some(dir) = &args.out {
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-        if parent.is_some_and(|p| !p.is_dir()) {
-            bail!("{}: the parent directory does not exist", dir.display());
-        }
+        // Refused before the run rather than after it; a missing parent is created when the
+        // recording is written, as `record` does.
+        hilsim_recording::check_replaceable_recording(dir)?;
     }
     let world = HilWorld::new(&scenario, scenario.seed)
         .with_context(|| format!("{origin}: sensor model"))?;
@@ -215,6 +214,7 @@ fn report_json(
                 Ended::Terminated => "terminated",
                 Ended::Killed => "killed",
             },
+            "shrugged_off_sigterm": f.shrugged_off_sigterm,
             "escaped": f.escaped.iter().map(|p| serde_json::json!({"pid": p.pid, "command": p.command})).collect::<Vec<_>>(),
         })
     });

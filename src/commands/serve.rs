@@ -34,8 +34,13 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     let wire_faults = || WireFaults::new(&link_faults, scenario.seed);
     let report = match &args.port {
         Some(path) => {
-            let link = DeviceLink::open(&path.to_string_lossy())
-                .with_context(|| format!("{}: cannot open", path.display()))?;
+            let link = DeviceLink::open(&path.to_string_lossy()).map_err(|err| {
+                let path = path.display();
+                match err.kind() {
+                    std::io::ErrorKind::InvalidInput => anyhow::anyhow!("{path}: {err}"),
+                    _ => anyhow::anyhow!("{path}: cannot open: {err}"),
+                }
+            })?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
             run(emulation, link, pacing, &stop, false, wire_faults())?

@@ -543,3 +543,202 @@ fn issue_19_both_example_firmwares_converge_over_the_capture_link() {
         );
     }
 }
+
+/// A firmware in Python written into `dir`, run as `python3 fw.py`: no shell stands between
+/// hilsim and it, since a shell would reset what it inherits and hide a blocked signal.
+fn python_firmware(dir: &Path, script: &str) -> String {
+    std::fs::write(dir.join("fw.py"), script).unwrap();
+    format!("python3 {}", dir.join("fw.py").display())
+}
+
+/// A firmware that writes which signals it started with blocked and ignored, then sleeps until
+/// told to stop: the polite SIGTERM ends it, and the summary says so.
+#[test]
+fn the_firmware_starts_with_no_signal_blocked_and_leaves_on_sigterm() {
+    let tmp = tempfile::tempdir().unwrap();
+    let firmware = python_firmware(
+        tmp.path(),
+        "import re, time\n\
+         status = open('/proc/self/status').read()\n\
+         open('signals.txt', 'w').write(' '.join(re.findall(r'Sig(?:Blk|Ign):\\s*(\\w+)', status)))\n\
+         time.sleep(30)\n",
+    );
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--duration",
+            "1",
+            "--firmware",
+            &firmware,
+        ],
+    );
+    let text = stdout(&out);
+    assert!(
+        text.contains("firmware: left on SIGTERM once the run was over: signal 15 (SIGTERM)"),
+        "{text}{}",
+        stderr(&out)
+    );
+    let signals = std::fs::read_to_string(tmp.path().join("signals.txt")).unwrap();
+    let masks: Vec<u64> = signals
+        .split(' ')
+        .map(|m| u64::from_str_radix(m, 16).unwrap())
+        .collect();
+    let [blocked, ignored] = masks[..] else {
+        panic!("{signals}")
+    };
+    assert_eq!(blocked, 0, "{signals}");
+    for (name, number) in [("SIGHUP", 1), ("SIGINT", 2), ("SIGTERM", 15)] {
+        assert_eq!(
+            ignored & (1 << (number - 1)),
+            0,
+            "{name} ignored: {signals}"
+        );
+    }
+}
+
+/// `hilsim hil` started with piped output, its `firmware: pid N` line read; returns the child,
+/// the firmware's pid and the rest of its output once it ends.
+fn start_hil(
+    dir: &Path,
+    firmware: &str,
+) -> (std::process::Child, u32, std::thread::JoinHandle<String>) {
+    use std::io::BufRead as _;
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hilsim"))
+        .args(["hil", scenario.to_str().unwrap(), "--duration", "60"])
+        .args(["--firmware", firmware])
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let line = lines
+        .find_map(|l| l.ok().filter(|l| l.starts_with("firmware: pid ")))
+        .expect("a firmware line");
+    // The rest of the output is read as it comes, so that hilsim never blocks on a full pipe.
+    let rest =
+        std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>().join("\n"));
+    (child, firmware_pid(&line), rest)
+}
+
+/// Sends `signal` (`TERM`, `INT`…) to `pid`.
+fn send(signal: &str, pid: u32) {
+    let status = Command::new("kill")
+        .args([&format!("-{signal}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+/// Waits up to `limit` for the child to exit.
+fn wait_within(child: &mut std::process::Child, limit: Duration) -> std::process::ExitStatus {
+    let deadline = std::time::Instant::now() + limit;
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("still running after {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_sigterm_to_hilsim_ends_the_run_and_the_firmware() {
+    let tmp = tempfile::tempdir().unwrap();
+    let firmware = python_firmware(tmp.path(), "import time\ntime.sleep(60)\n");
+    let (mut child, fw, rest) = start_hil(tmp.path(), &firmware);
+    std::thread::sleep(Duration::from_millis(300));
+    send("TERM", child.id());
+    // The ports close, 1 s for the firmware to leave by itself, then its SIGTERM.
+    let status = wait_within(&mut child, Duration::from_secs(10));
+    let text = rest.join().unwrap();
+    assert_eq!(status.code(), Some(1), "{status}: {text}");
+    assert!(text.contains("interrupted at "), "{text}");
+    assert!(
+        text.contains("firmware: left on SIGTERM once the run was over"),
+        "{text}"
+    );
+    assert!(gone(fw), "firmware {fw} still runs");
+}
+
+/// A second signal while the first is being acted on ends hilsim at once, of that signal, and
+/// takes the firmware (here one that ignores SIGTERM) with it.
+#[test]
+fn a_second_signal_ends_hilsim_at_once_with_its_firmware() {
+    use std::os::unix::process::ExitStatusExt as _;
+    let tmp = tempfile::tempdir().unwrap();
+    let firmware = python_firmware(
+        tmp.path(),
+        "import signal, time\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\ntime.sleep(60)\n",
+    );
+    let (mut child, fw, _) = start_hil(tmp.path(), &firmware);
+    std::thread::sleep(Duration::from_millis(300));
+    send("INT", child.id());
+    // Within the second the firmware has to leave by itself.
+    std::thread::sleep(Duration::from_millis(300));
+    send("TERM", child.id());
+    let status = wait_within(&mut child, Duration::from_secs(5));
+    assert_eq!(status.signal(), Some(15), "{status}");
+    assert!(gone(fw), "firmware {fw} still runs");
+}
+
+#[test]
+fn hil_out_creates_a_missing_parent_directory() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/hil-approach.toml");
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--firmware",
+            "true",
+            "--duration",
+            "1",
+            "--out",
+            "missing/parent/run",
+        ],
+    );
+    assert_ne!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(Recording::read_dir(&tmp.path().join("missing/parent/run")).is_ok());
+}
+
+/// `[link] rpm_wobble` is an rpm amplitude: at or above the lidar's rpm it would stop the motor
+/// (the stream's time then ran backwards, or never advanced), so it is refused with the line.
+#[test]
+fn a_link_wobble_as_large_as_the_rpm_is_refused_before_the_firmware_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo_file("scenarios/hil-capture-link.toml")).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l == "[link]")
+        .expect("a [link] table")
+        + 2;
+    let wobbly = text.replacen("[link]\n", "[link]\nrpm_wobble = 20000\n", 1);
+    std::fs::write(tmp.path().join("wobbly.toml"), wobbly).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            "wobbly.toml",
+            "--firmware",
+            "true",
+            "--duration",
+            "3",
+        ],
+    ));
+    assert_eq!(
+        err.trim_end(),
+        format!(
+            "hilsim: wobbly.toml:{line}: link.rpm_wobble: the wobble must be smaller than the \
+             rpm ([sensors.lidar] rpm = 300), found 20000"
+        )
+    );
+}

@@ -386,3 +386,42 @@ fn issue_19_link_faults_reach_the_client_and_are_counted() {
     let rpm_min = counts["rpm_min"].as_f64().unwrap();
     assert!((50.0..60.0).contains(&rpm_min), "{counts}");
 }
+
+/// `--port` given something that is not a terminal says what it is instead.
+#[test]
+fn serve_to_something_that_is_not_a_terminal_says_what_it_is() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("short.toml"), SHORT).unwrap();
+    std::fs::write(tmp.path().join("regular"), "").unwrap();
+    std::fs::create_dir(tmp.path().join("dir")).unwrap();
+    for (port, what) in [
+        ("regular", "a regular file"),
+        ("dir", "a directory"),
+        ("/dev/null", "a character device that is not a terminal"),
+    ] {
+        let err = assert_bad_input(&hilsim(
+            tmp.path(),
+            &["serve", "short.toml", "--fast", "--port", port],
+        ));
+        assert_eq!(
+            err.trim_end(),
+            format!("hilsim: {port}: not a serial device or pseudo-terminal ({what})")
+        );
+    }
+}
+
+/// `[link] rpm_wobble` at or above the lidar's rpm is refused: it used to stop the stream's
+/// clock and `serve --fast` never ended.
+#[test]
+fn serve_refuses_a_link_wobble_as_large_as_the_rpm() {
+    let tmp = tempfile::tempdir().unwrap();
+    let wobbly = format!("{SHORT}[link]\nrpm_wobble = 20000\n");
+    std::fs::write(tmp.path().join("wobbly.toml"), &wobbly).unwrap();
+    let line = wobbly.lines().count();
+    let err = assert_bad_input(&hilsim(tmp.path(), &["serve", "wobbly.toml", "--fast"]));
+    assert!(
+        err.starts_with(&format!("hilsim: wobbly.toml:{line}: link.rpm_wobble: ")),
+        "{err}"
+    );
+    assert!(err.contains("smaller than the rpm"), "{err}");
+}

@@ -10,6 +10,7 @@ use hilsim_lidar_emulator::{Emulation, ModelError};
 use hilsim_sim::{Scenario, Simulation};
 use nix::sys::signal::{self, SigHandler, SigSet, Signal};
 
+use crate::firmware::kill_all_running;
 use crate::pty::PtyLink;
 
 /// The two ports a firmware talks to: open them, start the firmware with their paths, then
@@ -75,11 +76,13 @@ impl HilWorld {
     }
 }
 
-/// Blocks `SIGINT`, `SIGTERM` and `SIGHUP` in the calling thread and raises `stop` whenever one
+/// Blocks `SIGINT`, `SIGTERM` and `SIGHUP` in the calling thread and raises `stop` when one
 /// arrives, so that a run interrupted at the terminal still shuts its firmware down (the
-/// firmware runs in its own process group, out of reach of the terminal's Ctrl-C). Call it
-/// before any other thread is started: threads inherit the mask (child processes do not; the
-/// standard library clears it for them).
+/// firmware runs in its own process group, out of reach of the terminal's Ctrl-C). A second
+/// one, once `stop` is raised, ends the process at once: every running firmware is killed with
+/// its group ([`kill_all_running`]), then the process dies of that signal. Call it
+/// before any other thread is started: threads inherit the mask (so do child processes;
+/// [`Firmware::spawn`](crate::firmware::Firmware::spawn) clears it for the firmware).
 ///
 /// The three signals' dispositions are set to the default first. A process started in the
 /// background of a script, or under `nohup`, inherits them *ignored*; an ignored signal is
@@ -101,9 +104,23 @@ pub fn stop_on_signals(stop: Arc<AtomicBool>) -> io::Result<()> {
     thread::Builder::new()
         .name("hil-signals".into())
         .spawn(move || {
-            while signals.wait().is_ok() {
-                stop.store(true, Ordering::Relaxed);
+            while let Ok(which) = signals.wait() {
+                if stop.swap(true, Ordering::Relaxed) {
+                    kill_all_running();
+                    die_of(which);
+                }
             }
         })?;
     Ok(())
+}
+
+/// Ends the process as `signal` does by default (the caller's parent sees how it ended): the
+/// signal is unblocked in this thread and raised. The dispositions were set to the default.
+fn die_of(signal: Signal) -> ! {
+    let mut only = SigSet::empty();
+    only.add(signal);
+    let _ = only.thread_unblock();
+    let _ = signal::raise(signal);
+    // Not reached unless the disposition was changed since: the shell's code for the signal.
+    std::process::exit(128 + signal as i32)
 }

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use super::report::{Ending, HilReport};
-use crate::firmware::{describe_status, Ended};
+use crate::firmware::{describe_status, Ended, TERM_GRACE};
 
 impl HilReport {
     /// The summary `hilsim hil` prints.
@@ -103,10 +103,19 @@ impl HilReport {
         )?;
         let mut failed = self.fault().is_some();
         if let Some(exit) = &self.firmware {
-            let how = match exit.ended {
-                Ended::ByItself => "exited by itself",
-                Ended::Terminated => "left on SIGTERM once the run was over",
-                Ended::Killed => "ignored SIGTERM and was killed",
+            let how = match (exit.ended, exit.shrugged_off_sigterm) {
+                (Ended::ByItself, false) => "exited by itself".to_string(),
+                (Ended::ByItself, true) => {
+                    "exited by itself after the SIGTERM it had blocked or ignored".to_string()
+                }
+                (Ended::Terminated, _) => "left on SIGTERM once the run was over".to_string(),
+                (Ended::Killed, true) => {
+                    "had SIGTERM blocked or ignored and was killed".to_string()
+                }
+                (Ended::Killed, false) => format!(
+                    "still running {} s after SIGTERM and was killed",
+                    TERM_GRACE.as_secs_f64()
+                ),
             };
             writeln!(out, "firmware: {how}: {}", describe_status(exit.status))?;
             failed |= exit.ended == Ended::ByItself && !exit.status.success();

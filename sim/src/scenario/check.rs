@@ -18,12 +18,15 @@ pub(super) fn fail(path: Vec<Key>, message: impl Into<String>) -> Check {
     })
 }
 
-/// A number as TOML spells it (`nan`, `inf`), so that messages quote the file's own words.
+/// A number as TOML spells it (`nan`, `inf`, `1e300`), so that messages quote the file's own
+/// words: very large or very small magnitudes in exponent form, not hundreds of digits.
 pub(super) fn toml_number(v: f64) -> String {
     if v.is_nan() {
         "nan".to_string()
     } else if v.is_infinite() {
         if v > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else if v != 0.0 && !(1e-6..1e16).contains(&v.abs()) {
+        format!("{v:e}")
     } else {
         v.to_string()
     }

@@ -5,6 +5,8 @@
 
 use serde::Deserialize;
 
+use super::check::toml_number;
+
 /// The `[link]` table as written.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -107,11 +109,14 @@ impl Link {
     }
 
     /// Checks every value: rates in [0, 0.5] (beyond, the stream is noise), times finite and
-    /// non-negative, a reconnection only after a disconnection.
+    /// non-negative, a reconnection only after a disconnection, and the rpm wobble smaller than
+    /// the motor's speed: than the lidar's `rpm`, and during a spin-up than
+    /// [`SPIN_UP_FROM_RPM`] (a wobble as large would stop the motor or turn it backwards).
+    /// `lidar` is `[sensors.lidar]`'s `(rpm, rpm_wobble)`, when the scenario has one.
     ///
     /// # Errors
     /// The first bad key and why.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    pub fn validate(&self, lidar: Option<(f64, f64)>) -> Result<(), (&'static str, String)> {
         self.faults().map_err(|e| ("profile", e))?;
         for (key, value) in [
             ("corrupt_packet_rate", self.corrupt_packet_rate),
@@ -120,13 +125,15 @@ impl Link {
         ] {
             if let Some(v) = value {
                 if !(v.is_finite() && (0.0..=0.5).contains(&v)) {
-                    return Err((key, format!("expected a fraction in [0, 0.5], found {v}")));
+                    return Err((
+                        key,
+                        format!("expected a fraction in [0, 0.5], found {}", toml_number(v)),
+                    ));
                 }
             }
         }
         for (key, value) in [
             ("spin_up_s", self.spin_up_s),
-            ("rpm_wobble", self.rpm_wobble),
             ("disconnect_at_s", self.disconnect_at_s),
             ("reconnect_after_s", self.reconnect_after_s),
         ] {
@@ -134,9 +141,52 @@ impl Link {
                 if !(v.is_finite() && (0.0..=super::MAX_RUN_S).contains(&v)) {
                     return Err((
                         key,
-                        format!("expected 0 to {} , found {v}", super::MAX_RUN_S),
+                        format!(
+                            "expected 0 to {} s, found {}",
+                            super::MAX_RUN_S,
+                            toml_number(v)
+                        ),
                     ));
                 }
+            }
+        }
+        if let Some(v) = self.rpm_wobble {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((
+                    "rpm_wobble",
+                    format!("expected a number ≥ 0, found {}", toml_number(v)),
+                ));
+            }
+            if let Some((rpm, _)) = lidar.filter(|&(rpm, _)| v >= rpm) {
+                return Err((
+                    "rpm_wobble",
+                    format!(
+                        "the wobble must be smaller than the rpm ([sensors.lidar] rpm = {}), \
+                         found {}",
+                        toml_number(rpm),
+                        toml_number(v)
+                    ),
+                ));
+            }
+        }
+        let faults = self.faults().map_err(|e| ("profile", e))?;
+        if let Some((_, lidar_wobble)) = lidar {
+            let wobble = faults.rpm_wobble.unwrap_or(lidar_wobble);
+            if faults.spin_up_s > 0.0 && wobble >= SPIN_UP_FROM_RPM {
+                let key = match (self.rpm_wobble, self.spin_up_s) {
+                    (Some(_), _) => "rpm_wobble",
+                    (None, Some(_)) => "spin_up_s",
+                    (None, None) => "profile",
+                };
+                return Err((
+                    key,
+                    format!(
+                        "a spin-up starts at {SPIN_UP_FROM_RPM} rpm, which a wobble of {} rpm \
+                         would stop: keep the wobble below {SPIN_UP_FROM_RPM} rpm, or spin up \
+                         in no time (`spin_up_s = 0`)",
+                        toml_number(wobble)
+                    ),
+                ));
             }
         }
         if self.reconnect_after_s.is_some() && self.disconnect_at_s.is_none() {
@@ -171,11 +221,78 @@ mod tests {
             profile: Some("perfect".into()),
             ..Link::default()
         };
-        assert!(bad.validate().is_err());
+        assert!(bad.validate(None).is_err());
         let bad = Link {
             dropped_byte_rate: Some(0.9),
             ..Link::default()
         };
-        assert_eq!(bad.validate().unwrap_err().0, "dropped_byte_rate");
+        assert_eq!(bad.validate(None).unwrap_err().0, "dropped_byte_rate");
+    }
+
+    #[test]
+    fn the_rpm_wobble_must_stay_below_the_motor_speed() {
+        let wobble = |v: f64| Link {
+            rpm_wobble: Some(v),
+            ..Link::default()
+        };
+        // `[sensors.lidar]` at 300 rpm with no wobble of its own.
+        let lidar = Some((300.0, 0.0));
+        assert_eq!(wobble(299.0).validate(lidar), Ok(()));
+        for (v, found) in [(300.0, "300"), (20_000.0, "20000"), (1e300, "1e300")] {
+            let (key, message) = wobble(v).validate(lidar).unwrap_err();
+            assert_eq!(key, "rpm_wobble");
+            assert_eq!(
+                message,
+                format!(
+                    "the wobble must be smaller than the rpm ([sensors.lidar] rpm = 300), \
+                     found {found}"
+                )
+            );
+        }
+        for (v, found) in [(-5.0, "-5"), (f64::NAN, "nan"), (f64::INFINITY, "inf")] {
+            let message = wobble(v).validate(lidar).unwrap_err().1;
+            assert_eq!(message, format!("expected a number ≥ 0, found {found}"));
+        }
+        // During a spin-up the motor starts at 50 rpm: a wobble as large, the link's or the
+        // lidar's own, would stop it.
+        let spin_up = Link {
+            spin_up_s: Some(3.0),
+            ..wobble(60.0)
+        };
+        let (key, message) = spin_up.validate(lidar).unwrap_err();
+        assert_eq!(key, "rpm_wobble");
+        assert!(
+            message.contains("a wobble of 60 rpm would stop"),
+            "{message}"
+        );
+        let profile = Link {
+            profile: Some("xv11-capture".into()),
+            ..Link::default()
+        };
+        assert_eq!(profile.validate(Some((300.0, 49.0))), Ok(()));
+        assert_eq!(
+            profile.validate(Some((300.0, 50.0))).unwrap_err().0,
+            "profile"
+        );
+        let no_spin_up = Link {
+            spin_up_s: Some(0.0),
+            ..profile
+        };
+        assert_eq!(no_spin_up.validate(Some((300.0, 250.0))), Ok(()));
+    }
+
+    #[test]
+    fn seconds_are_bounded_and_quoted_compactly() {
+        let link = Link {
+            spin_up_s: Some(1e300),
+            ..Link::default()
+        };
+        assert_eq!(
+            link.validate(None).unwrap_err(),
+            (
+                "spin_up_s",
+                "expected 0 to 86400 s, found 1e300".to_string()
+            )
+        );
     }
 }

@@ -160,7 +160,8 @@ pub(super) fn validate(s: &Scenario) -> Check {
     drive(s)?;
     sensors(s)?;
     validate_effects::validate(s)?;
-    if let Err((key, message)) = s.link.validate() {
+    let lidar = s.sensors.lidar.as_ref().map(|l| (l.rpm, l.rpm_wobble));
+    if let Err((key, message)) = s.link.validate(lidar) {
         return fail(key_path!["link", key], message);
     }
     for (i, e) in s.expect.iter().enumerate() {

@@ -363,3 +363,91 @@ fn coefficients(c: &[f64], sd: &[f64]) -> String {
         .collect();
     format!("[{}]", parts.join(", "))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIDAR_ONLY: &str = r#"{"method": "em", "sensors": {"lidar": {"alpha": [0.05, 0.9, 0.01], "beta": [0, 0, 0.01]}}}"#;
+
+    fn error(text: &str) -> String {
+        Calibration::from_json(text, "cal.json")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn a_byte_order_mark_before_the_json_is_skipped() {
+        let with_mark = format!("\u{feff}{LIDAR_ONLY}");
+        let cal = Calibration::from_json(&with_mark, "cal.json").unwrap();
+        assert_eq!(cal, Calibration::from_json(LIDAR_ONLY, "cal.json").unwrap());
+        assert_eq!(
+            Calibration::all_from_json(&with_mark, "cal.json")
+                .unwrap()
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn a_key_named_twice_is_refused_with_its_line() {
+        let twice = LIDAR_ONLY.replace(
+            r#""method": "em","#,
+            "\"method\": \"em\",\n\"method\": \"em\",",
+        );
+        let err = error(&twice);
+        assert!(
+            err.starts_with("cal.json:2: the key `method` appears twice"),
+            "{err}"
+        );
+        let nested = LIDAR_ONLY.replace(
+            r#""beta": [0, 0, 0.01]"#,
+            r#""beta": [0, 0, 0.01], "alpha": []"#,
+        );
+        assert!(error(&nested).contains("the key `alpha` appears twice"));
+        assert!(error("{").contains("cal.json:1: not JSON"));
+    }
+
+    #[test]
+    fn a_bad_method_is_quoted_terminal_safe_and_a_missing_one_said_so() {
+        let hostile = LIDAR_ONLY.replace(r#""em""#, r#""<\u001b[31m>""#);
+        let err = error(&hostile);
+        assert!(err.ends_with(r#"found "<\u001b[31m>""#), "{err}");
+        assert!(!err.contains('\u{1b}'), "{err}");
+        assert!(!err.contains("Some("), "{err}");
+        let err = error(r#"{"sensors": {}}"#);
+        assert!(err.ends_with("found none"), "{err}");
+        let err = error("[1, 2]");
+        assert!(err.contains("expected a JSON object"), "{err}");
+    }
+
+    #[test]
+    fn a_runs_results_are_not_one_calibration() {
+        let results = format!(r#"{{"scenario": "x", "calibrations": [{LIDAR_ONLY}]}}"#);
+        let err = error(&results);
+        assert!(err.contains("a run's results"), "{err}");
+        assert!(err.contains("hilsim calibrate --json"), "{err}");
+        // Where a run's results are welcome, they are read.
+        assert_eq!(
+            Calibration::all_from_json(&results, "r.json")
+                .unwrap()
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn standard_errors_count_one_per_coefficient() {
+        let one = LIDAR_ONLY.replace(
+            r#""alpha": [0.05, 0.9, 0.01]"#,
+            r#""alpha": [0.05, 0.9, 0.01], "alpha_sd": [0.1]"#,
+        );
+        let err = error(&one);
+        assert!(
+            err.contains("sensors.lidar.alpha_sd has 1 standard errors for 3 alpha coefficients"),
+            "{err}"
+        );
+        let three = one.replace("[0.1]", "[0.1, 0.1, 0.1]");
+        assert!(Calibration::from_json(&three, "cal.json").is_ok());
+    }
+}

@@ -96,7 +96,7 @@ impl FromStr for Prior {
         }
         if !SD_RANGE.contains(&sd) {
             return Err(bad(&format!(
-                "the sd must be from {} to {}",
+                "the sd must be positive: from {:?} to {}",
                 SD_RANGE.start(),
                 SD_RANGE.end()
             )));
@@ -218,6 +218,9 @@ mod tests {
             ("sonar.alpha2=1±0.1", "alpha0..alpha1"),
             ("sonar.alpha1=1±0", "positive"),
             ("sonar.alpha1=x±0.1", "not a number"),
+            ("sonar.alpha1=1e300±0.1", "from -100 to 100"),
+            ("sonar.alpha1=1±1e-300", "positive: from 1e-6 to 100"),
+            ("sonar.alpha1=1±1e300", "positive: from 1e-6 to 100"),
         ] {
             let err = text.parse::<Prior>().unwrap_err().to_string();
             assert!(err.contains(why), "{text}: {err}");

@@ -242,3 +242,104 @@ pub struct ReportArgs {
     #[arg(long)]
     pub out: PathBuf,
 }
+
+/// A clap error as one line (`<what>; see hilsim <cmd> --help`), as every other error is, for
+/// scripts that read one line of stderr. Values the user typed are shown terminal-safe.
+pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> String {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let (path, cmd) = command_path(args);
+    let text = |kind| match err.get(kind) {
+        Some(ContextValue::String(s)) => Some(s.clone()),
+        Some(ContextValue::Strings(v)) if !v.is_empty() => Some(v.join(", ")),
+        Some(ContextValue::StyledStr(s)) => Some(s.to_string()),
+        _ => None,
+    };
+    let typed = |kind| text(kind).map(|s| hilsim_recording::printable(&s).into_owned());
+    let valid = text(ContextKind::ValidValue)
+        .map(|v| format!(" (expected one of: {v})"))
+        .unwrap_or_default();
+    let suggestion = text(ContextKind::SuggestedArg)
+        .or_else(|| text(ContextKind::SuggestedSubcommand))
+        .map(|s| format!(" (did you mean `{s}`?)"))
+        .unwrap_or_default();
+    let what = match (
+        err.kind(),
+        text(ContextKind::InvalidArg),
+        typed(ContextKind::InvalidValue),
+    ) {
+        (ErrorKind::MissingRequiredArgument, Some(arg), _) => format!("missing {arg}"),
+        (ErrorKind::InvalidValue, Some(arg), Some(value)) if value.is_empty() => {
+            format!("{arg}: a value is required{valid}")
+        }
+        (ErrorKind::InvalidValue, Some(arg), Some(value)) => {
+            format!("{arg}: invalid value `{value}`{valid}")
+        }
+        (ErrorKind::ValueValidation, Some(arg), Some(value)) => {
+            let why = std::error::Error::source(err)
+                .map(|e| format!(": {e}"))
+                .unwrap_or_default();
+            format!("{arg}: invalid value `{value}`{why}")
+        }
+        (ErrorKind::UnknownArgument, _, _) => match typed(ContextKind::InvalidArg) {
+            Some(arg) if arg.starts_with('-') => format!("unknown option `{arg}`{suggestion}"),
+            Some(arg) => format!("unexpected argument `{arg}`{suggestion}"),
+            None => "unexpected argument".to_string(),
+        },
+        (ErrorKind::InvalidSubcommand, _, _) => match typed(ContextKind::InvalidSubcommand) {
+            Some(sub) => format!("unknown command `{sub}`{suggestion}"),
+            None => "unknown command".to_string(),
+        },
+        (
+            ErrorKind::MissingSubcommand | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand,
+            _,
+            _,
+        ) => {
+            let subs: Vec<&str> = cmd
+                .get_subcommands()
+                .map(clap::Command::get_name)
+                .filter(|name| *name != "help")
+                .collect();
+            format!("missing a command (one of: {})", subs.join(", "))
+        }
+        (ErrorKind::ArgumentConflict, Some(arg), _) => match text(ContextKind::PriorArg) {
+            Some(prior) if prior == arg => format!("{arg} given more than once"),
+            Some(prior) => format!("{arg} cannot be used with {prior}"),
+            None => format!("{arg} cannot be used with the other arguments given"),
+        },
+        // Anything else: clap's own wording, its lines joined, without the usage block.
+        _ => err
+            .render()
+            .to_string()
+            .lines()
+            .map(str::trim)
+            .filter(|l| {
+                !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+            })
+            .map(|l| l.strip_prefix("error: ").unwrap_or(l))
+            .collect::<Vec<_>>()
+            .join(" ")
+            .replace('\n', " "),
+    };
+    format!("{what}; see {path} --help")
+}
+
+/// `hilsim` followed by the subcommands named in `args` (`hilsim dataset merge`), and the last
+/// of them.
+fn command_path(args: &[std::ffi::OsString]) -> (String, clap::Command) {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command();
+    let mut path = String::from("hilsim");
+    for arg in args.iter().skip(1) {
+        let Some(arg) = arg.to_str() else { break };
+        if arg.starts_with('-') {
+            continue;
+        }
+        let Some(sub) = cmd.find_subcommand(arg).cloned() else {
+            break;
+        };
+        path.push(' ');
+        path.push_str(sub.get_name());
+        cmd = sub;
+    }
+    (path, cmd)
+}

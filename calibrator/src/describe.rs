@@ -97,9 +97,13 @@ impl Calibration {
     /// # Errors
     /// [`CalibrationError::Invalid`] naming `origin` (and the line, for malformed JSON).
     pub fn from_json(text: &str, origin: &str) -> Result<Self, CalibrationError> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|err| {
-            CalibrationError::Invalid(format!("{origin}:{}: not JSON: {err}", err.line()))
-        })?;
+        let value = parse_json(text, origin)?;
+        if let Some(serde_json::Value::Array(_)) = value.get("calibrations") {
+            return Err(CalibrationError::Invalid(format!(
+                "{origin}: a run's results (a `calibrations` list), not one calibration: give \
+                 the JSON that `hilsim calibrate --json` prints"
+            )));
+        }
         Self::from_json_value(&value, origin)
     }
 
@@ -109,9 +113,7 @@ impl Calibration {
     /// # Errors
     /// As [`Calibration::from_json`].
     pub fn all_from_json(text: &str, origin: &str) -> Result<Vec<Self>, CalibrationError> {
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|err| {
-            CalibrationError::Invalid(format!("{origin}:{}: not JSON: {err}", err.line()))
-        })?;
+        let value = parse_json(text, origin)?;
         match value.get("calibrations") {
             Some(serde_json::Value::Array(list)) => list
                 .iter()
@@ -128,15 +130,23 @@ impl Calibration {
     /// [`Calibration::from_json`] of a parsed value.
     fn from_json_value(value: &serde_json::Value, origin: &str) -> Result<Self, CalibrationError> {
         let invalid = |message: String| CalibrationError::Invalid(message);
-        let method = match value["method"].as_str() {
-            Some("em") => Method::Em,
-            Some("landmarks") => Method::Landmarks,
-            Some("groundtruth") => Method::Groundtruth,
-            other => {
-                return Err(invalid(format!(
-                    "{origin}: `method` must be em, landmarks or groundtruth, found {other:?}"
-                )))
-            }
+        if !value.is_object() {
+            return Err(invalid(format!(
+                "{origin}: expected a JSON object (as `hilsim calibrate --json` prints), found {}",
+                shown(value)
+            )));
+        }
+        let method = match value.get("method") {
+            Some(serde_json::Value::String(name)) => Method::from_name(name),
+            _ => None,
+        };
+        let Some(method) = method else {
+            let found = value
+                .get("method")
+                .map_or_else(|| "none".to_string(), shown);
+            return Err(invalid(format!(
+                "{origin}: `method` must be em, landmarks or groundtruth, found {found}"
+            )));
         };
         let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
             v.as_array()?
@@ -171,6 +181,18 @@ impl Calibration {
             let mut m = SensorModel::without_sd(coeffs("alpha")?, coeffs("beta")?);
             m.alpha_sd = optional("alpha_sd")?;
             m.beta_sd = optional("beta_sd")?;
+            // A standard error per coefficient, or none: another count describes another model.
+            for (sd, given, of, n) in [
+                ("alpha_sd", &m.alpha_sd, "alpha", m.alpha.len()),
+                ("beta_sd", &m.beta_sd, "beta", m.beta.len()),
+            ] {
+                if !given.is_empty() && given.len() != n {
+                    return Err(invalid(format!(
+                        "{origin}: sensors.{name}.{sd} has {} standard errors for {n} {of} coefficients",
+                        given.len()
+                    )));
+                }
+            }
             sensors.insert(sensor, m);
         }
         let metrics = value.get("metrics").and_then(|m| {
@@ -237,6 +259,98 @@ impl Calibration {
     }
 }
 
+/// A calibration's JSON text, parsed: a byte-order mark some editors write first is skipped (RFC
+/// 8259 lets a parser ignore it), and an object naming a key twice is refused (the second would
+/// silently replace the first).
+fn parse_json(text: &str, origin: &str) -> Result<serde_json::Value, CalibrationError> {
+    use serde::de::DeserializeSeed;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value = NoDuplicateKeys
+        .deserialize(&mut de)
+        .and_then(|value| de.end().map(|()| value))
+        .map_err(|err| {
+            let what = if err.classify() == serde_json::error::Category::Data {
+                ""
+            } else {
+                "not JSON: "
+            };
+            CalibrationError::Invalid(format!("{origin}:{}: {what}{err}", err.line()))
+        })?;
+    Ok(value)
+}
+
+/// A JSON value for a message: terminal-safe and short.
+fn shown(value: &serde_json::Value) -> String {
+    hilsim_recording::printable_cut(&value.to_string(), 60).into_owned()
+}
+
+/// Deserializes any JSON value, refusing an object that names a key twice.
+struct NoDuplicateKeys;
+
+impl<'de> serde::de::DeserializeSeed<'de> for NoDuplicateKeys {
+    type Value = serde_json::Value;
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, de: D) -> Result<Self::Value, D::Error> {
+        de.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for NoDuplicateKeys {
+    type Value = serde_json::Value;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+
+    fn visit_bool<E>(self, v: bool) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+
+    fn visit_i64<E>(self, v: i64) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+
+    fn visit_u64<E>(self, v: u64) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+
+    fn visit_f64<E>(self, v: f64) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+
+    fn visit_str<E>(self, v: &str) -> Result<Self::Value, E> {
+        Ok(v.into())
+    }
+
+    fn visit_unit<E>(self) -> Result<Self::Value, E> {
+        Ok(serde_json::Value::Null)
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut list = Vec::new();
+        while let Some(item) = seq.next_element_seed(NoDuplicateKeys)? {
+            list.push(item);
+        }
+        Ok(list.into())
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let mut object = serde_json::Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if object.contains_key(&key) {
+                return Err(serde::de::Error::custom(format!(
+                    "the key `{}` appears twice in one object",
+                    hilsim_recording::printable(&key)
+                )));
+            }
+            let value = map.next_value_seed(NoDuplicateKeys)?;
+            object.insert(key, value);
+        }
+        Ok(object.into())
+    }
+}
+
 /// `[a, b]`, or `[a ± sa, b ± sb]` with standard errors (a coefficient held at 0 has none).
 fn coefficients(c: &[f64], sd: &[f64]) -> String {
     let parts: Vec<String> = c
@@ -248,4 +362,92 @@ fn coefficients(c: &[f64], sd: &[f64]) -> String {
         })
         .collect();
     format!("[{}]", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIDAR_ONLY: &str = r#"{"method": "em", "sensors": {"lidar": {"alpha": [0.05, 0.9, 0.01], "beta": [0, 0, 0.01]}}}"#;
+
+    fn error(text: &str) -> String {
+        Calibration::from_json(text, "cal.json")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn a_byte_order_mark_before_the_json_is_skipped() {
+        let with_mark = format!("\u{feff}{LIDAR_ONLY}");
+        let cal = Calibration::from_json(&with_mark, "cal.json").unwrap();
+        assert_eq!(cal, Calibration::from_json(LIDAR_ONLY, "cal.json").unwrap());
+        assert_eq!(
+            Calibration::all_from_json(&with_mark, "cal.json")
+                .unwrap()
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn a_key_named_twice_is_refused_with_its_line() {
+        let twice = LIDAR_ONLY.replace(
+            r#""method": "em","#,
+            "\"method\": \"em\",\n\"method\": \"em\",",
+        );
+        let err = error(&twice);
+        assert!(
+            err.starts_with("cal.json:2: the key `method` appears twice"),
+            "{err}"
+        );
+        let nested = LIDAR_ONLY.replace(
+            r#""beta": [0, 0, 0.01]"#,
+            r#""beta": [0, 0, 0.01], "alpha": []"#,
+        );
+        assert!(error(&nested).contains("the key `alpha` appears twice"));
+        assert!(error("{").contains("cal.json:1: not JSON"));
+    }
+
+    #[test]
+    fn a_bad_method_is_quoted_terminal_safe_and_a_missing_one_said_so() {
+        let hostile = LIDAR_ONLY.replace(r#""em""#, r#""<\u001b[31m>""#);
+        let err = error(&hostile);
+        assert!(err.ends_with(r#"found "<\u001b[31m>""#), "{err}");
+        assert!(!err.contains('\u{1b}'), "{err}");
+        assert!(!err.contains("Some("), "{err}");
+        let err = error(r#"{"sensors": {}}"#);
+        assert!(err.ends_with("found none"), "{err}");
+        let err = error("[1, 2]");
+        assert!(err.contains("expected a JSON object"), "{err}");
+    }
+
+    #[test]
+    fn a_runs_results_are_not_one_calibration() {
+        let results = format!(r#"{{"scenario": "x", "calibrations": [{LIDAR_ONLY}]}}"#);
+        let err = error(&results);
+        assert!(err.contains("a run's results"), "{err}");
+        assert!(err.contains("hilsim calibrate --json"), "{err}");
+        // Where a run's results are welcome, they are read.
+        assert_eq!(
+            Calibration::all_from_json(&results, "r.json")
+                .unwrap()
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn standard_errors_count_one_per_coefficient() {
+        let one = LIDAR_ONLY.replace(
+            r#""alpha": [0.05, 0.9, 0.01]"#,
+            r#""alpha": [0.05, 0.9, 0.01], "alpha_sd": [0.1]"#,
+        );
+        let err = error(&one);
+        assert!(
+            err.contains("sensors.lidar.alpha_sd has 1 standard errors for 3 alpha coefficients"),
+            "{err}"
+        );
+        let three = one.replace("[0.1]", "[0.1, 0.1, 0.1]");
+        assert!(Calibration::from_json(&three, "cal.json").is_ok());
+    }
 }

@@ -23,4 +23,4 @@ pub mod target_samples;
 pub use by_method::{calibrate, calibrate_with, em_options, Settings};
 pub use calibration::{Calibration, LidarModelMetrics, Method, Metrics, Sensor, SensorModel};
 pub use error::CalibrationError;
-pub use target_samples::SampleOptions;
+pub use target_samples::{SampleOptions, START_DISTANCE_RANGE_M};

@@ -38,6 +38,11 @@ use hilsim_recording::{LidarSample, Mount, Recording};
 use self::align::{commanded_forward, interpolate_odometry, nearest_sonar, truth_distances};
 use crate::{CalibrationError, LidarModelMetrics, Metrics};
 
+/// The start distances a calibration takes: a centimetre (no range sensor reads closer) to a
+/// kilometre (a scenario's world is ±1 km). Outside them the model's d² terms lose every digit of
+/// the distances' variation.
+pub const START_DISTANCE_RANGE_M: std::ops::RangeInclusive<f64> = 0.01..=1e3;
+
 /// Which beam to follow and what is known of the start.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleOptions {
@@ -142,13 +147,12 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
     let start = start_distance(rec, opts, beam_index)?;
     let Some(lidar) = rec.lidar.as_ref() else {
         return Err(CalibrationError::Missing(
-            "the recording has no lidar.csv: the EM paper's calibration follows a lidar beam"
-                .into(),
+            "the recording has no lidar.csv: the calibration follows a lidar beam".into(),
         ));
     };
     if rec.commands.is_empty() {
         return Err(CalibrationError::Missing(
-            "commands.csv is empty: the EM calibration needs the commanded motion".into(),
+            "commands.csv is empty: following the target needs the commanded motion".into(),
         ));
     }
     check_finite_commands(rec)?;
@@ -159,6 +163,17 @@ pub fn extract(rec: &Recording, opts: &SampleOptions) -> Result<TargetSamples, C
 
     let forward = commanded_forward(rec, &t_s);
     let commanded_m: Vec<f64> = forward.iter().map(|f| -beam_cos * f).collect();
+    if let Some(d0) = start {
+        // The commands would drive through the target: the start distance is wrong.
+        let closest = commanded_m.iter().fold(d0, |m, c| m.min(d0 + c));
+        if closest <= 0.0 {
+            return Err(CalibrationError::Invalid(format!(
+                "start distance {d0:?} m is shorter than the {:?} m the commands drive towards the \
+                 target",
+                d0 - closest
+            )));
+        }
+    }
     let odometer_travel_m = rec
         .odometry
         .as_deref()
@@ -243,9 +258,11 @@ fn start_distance(
         .target_start_distance_m
         .filter(|_| angular_distance_deg(beam_index, 0.0) < 0.5);
     match opts.start_distance_m.or(meta_start) {
-        Some(d) if d.is_finite() && d > 0.0 => Ok(Some(d)),
+        Some(d) if START_DISTANCE_RANGE_M.contains(&d) => Ok(Some(d)),
         Some(d) => Err(CalibrationError::Invalid(format!(
-            "start distance must be a positive number of metres, got {d}"
+            "start distance must be from {} to {} m, got {d:?}",
+            START_DISTANCE_RANGE_M.start(),
+            START_DISTANCE_RANGE_M.end()
         ))),
         None => Ok(None),
     }

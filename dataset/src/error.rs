@@ -51,12 +51,28 @@ pub enum Error {
         message: String,
     },
     /// A file or directory could not be read or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file or directory concerned.
         path: PathBuf,
-        /// The operating system's error.
-        source: std::io::Error,
+        /// The operating system's error: in the message and not a `source`, since a report that
+        /// prints the chain of sources would say it twice.
+        error: std::io::Error,
+    },
+    /// Another process is making the same runs in the directory (writing the same manifest).
+    #[error(
+        "{}: another hilsim ({}) is writing this dataset's {manifest}: one process per shard; \
+         wait for it, or give another --out or --shard",
+        dir.display(),
+        pid.map_or_else(|| "PID unknown".to_string(), |p| format!("pid {p}"))
+    )]
+    Busy {
+        /// The dataset directory.
+        dir: PathBuf,
+        /// The manifest the other process writes.
+        manifest: String,
+        /// The other process's ID, when it has written it.
+        pid: Option<u32>,
     },
     /// A recording could not be written.
     #[error(transparent)]
@@ -64,10 +80,10 @@ pub enum Error {
 }
 
 impl Error {
-    pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
+    pub(crate) fn io(path: &Path, error: std::io::Error) -> Self {
         Self::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 

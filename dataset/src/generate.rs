@@ -22,6 +22,7 @@ use crate::layout::{
     entries, leftover, manifest_name, remove_leftovers, run_dir_name, run_dirs, Leftover,
     DATASET_FILE,
 };
+use crate::lock::WriterLock;
 use crate::manifest::{self, Outcome, Row};
 use crate::params::Params;
 use crate::progress::{Plan, Progress, RunReport, Summary};
@@ -93,6 +94,7 @@ impl Dataset {
         open_dir(dir, p)?;
         let manifest_file = manifest_name(shard);
         let manifest_path = dir.join(&manifest_file);
+        let _lock = WriterLock::take(dir, &manifest_file)?;
         remove_leftovers(dir, |l| match l {
             Leftover::Run(r) => *r < p.runs && shard.contains(*r),
             Leftover::File(name) => *name == manifest_file,

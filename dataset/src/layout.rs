@@ -91,7 +91,9 @@ pub(crate) fn remove_leftovers(dir: &Path, owns: impl Fn(&Leftover) -> bool) -> 
         let Some(what) = leftover(&name) else {
             continue;
         };
-        if !owns(&what) {
+        // A live process's temporary is its work in progress (another shard's, say).
+        let pid = name.rsplit_once('.').and_then(|(_, pid)| pid.parse().ok());
+        if !owns(&what) || pid.is_some_and(crate::lock::alive) {
             continue;
         }
         let result = if path.is_dir() {

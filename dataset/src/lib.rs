@@ -27,6 +27,7 @@ mod dataset;
 mod error;
 mod generate;
 pub mod layout;
+mod lock;
 pub mod manifest;
 mod merge;
 mod params;

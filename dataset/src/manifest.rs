@@ -7,12 +7,15 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use crate::content::RunContent;
 use crate::layout::{entries, is_manifest};
 use crate::Error;
+
+/// The largest manifest read (it is read whole): a row for each of [`crate::MAX_RUNS`] runs, at
+/// most a KiB each (a failed run's reason is one line).
+pub const MAX_MANIFEST_BYTES: u64 = 1 << 30;
 
 /// A run's row.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,7 +100,7 @@ pub struct Entry {
 /// # Errors
 /// The file cannot be read, or is not a manifest.
 pub fn read(path: &Path) -> Result<Vec<Entry>, Error> {
-    let text = fs::read_to_string(path).map_err(|err| Error::io(path, err))?;
+    let text = hilsim_recording::read_small_text(path, MAX_MANIFEST_BYTES, "a manifest")?;
     let mut lines = text.lines();
     let header = split(lines.next().unwrap_or_default())
         .ok_or_else(|| Error::corrupt(path, "line 1: not a manifest header"))?;
@@ -189,6 +192,7 @@ fn split(line: &str) -> Option<Vec<String>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     #[test]
     fn rows_render_and_read_back() {

@@ -16,7 +16,7 @@ use crate::layout::{
     DATASET_FILE, MANIFEST_FILE,
 };
 use crate::manifest::{self, Outcome, Row};
-use crate::params::Params;
+use crate::params::{Params, MAX_PARAMS_BYTES};
 use crate::{draw, run_seed, Error};
 
 /// What a merge did.
@@ -211,8 +211,9 @@ fn check_output(out: &Path) -> Result<(), Error> {
 /// `reference_file`.
 fn start_output(out: &Path, reference_file: &Path) -> Result<(), Error> {
     fs::create_dir_all(out).map_err(|err| Error::io(out, err))?;
-    let bytes = fs::read(reference_file).map_err(|err| Error::io(reference_file, err))?;
-    write_owned_file_atomically(&out.join(DATASET_FILE), &bytes)?;
+    let text =
+        hilsim_recording::read_small_text(reference_file, MAX_PARAMS_BYTES, "a dataset.toml")?;
+    write_owned_file_atomically(&out.join(DATASET_FILE), text.as_bytes())?;
     Ok(())
 }
 
@@ -326,7 +327,9 @@ fn same_dataset(dirs: &[PathBuf]) -> Result<(PathBuf, Params), Error> {
     let mut reference: Option<(PathBuf, Params)> = None;
     for d in dirs {
         let file = d.join(DATASET_FILE);
-        if !file.is_file() {
+        // `exists`, not `is_file`: a dataset.toml that is a device is refused by its reader, which
+        // says so.
+        if !file.exists() {
             return Err(Error::mismatch(
                 d,
                 "not a dataset directory (no dataset.toml)",

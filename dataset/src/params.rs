@@ -15,6 +15,10 @@ use crate::{Error, Vary};
 /// The file's format name.
 pub const FORMAT: &str = "hilsim-dataset/1";
 
+/// The largest `dataset.toml` read: one is a few hundred bytes (a `--vary` a line), and it is
+/// read whole, as a scenario file (also at most 1 MiB) is.
+pub const MAX_PARAMS_BYTES: u64 = 1 << 20;
+
 /// The parameters of a dataset: every run is a function of these and its index alone.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Params {
@@ -84,7 +88,7 @@ impl Params {
     /// # Errors
     /// The file cannot be read or is not a `dataset.toml`.
     pub fn read(path: &Path) -> Result<Self, Error> {
-        let text = fs::read_to_string(path).map_err(|err| Error::io(path, err))?;
+        let text = hilsim_recording::read_small_text(path, MAX_PARAMS_BYTES, "a dataset.toml")?;
         let file: File = toml::from_str(&text).map_err(|err| {
             Error::corrupt(
                 path,

@@ -100,6 +100,12 @@ impl FromStr for Vary {
         };
         let (key, range) = spec.split_once('=').ok_or_else(|| bad(SYNTAX))?;
         let (lo, hi) = range.split_once("..").ok_or_else(|| bad(SYNTAX))?;
+        // `1...2` would read as 1..0.2: a bound beside the two dots has a digit there.
+        if lo.trim_end().ends_with('.') || hi.trim_start().starts_with('.') {
+            return Err(bad(&format!(
+                "`{range}`: more than two dots between the bounds (write .5 as 0.5); {SYNTAX}"
+            )));
+        }
         let number = |s: &str| {
             let s = s.trim();
             // Rust also reads `inf`, `nan` and `infinity`: refuse anything but a finite number.
@@ -361,6 +367,12 @@ mod tests {
             ("robot.start.x=0..inf", "`inf` is not a finite number"),
             ("robot.start.x=nan..1", "`nan` is not a finite number"),
             ("robot.start.x=2..1", "expected LO ≤ HI"),
+            (
+                "robot.start.y=1...2",
+                "`1...2`: more than two dots between the bounds",
+            ),
+            ("robot.start.y=1. ..2", "more than two dots"),
+            ("robot.start.y=0.5..-.5", "expected LO ≤ HI"),
             ("a[x]=0..1", "is not a key path"),
             ("a[1=0..1", "is not a key path"),
             ("a b=0..1", "is not a key path"),

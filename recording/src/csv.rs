@@ -164,6 +164,12 @@ impl<'p> Lines<'p> {
         };
         let text = std::str::from_utf8(bytes)
             .map_err(|_| Error::format(self.path, Some(self.line), "not UTF-8 text"))?;
+        // A byte-order mark some editors put first is no part of the header's first name.
+        let text = if self.line == 1 {
+            text.trim_start_matches('\u{feff}')
+        } else {
+            text
+        };
         Ok(Some((self.line, text.trim_end_matches('\r'))))
     }
 }

@@ -82,7 +82,7 @@ pub(crate) fn size(bytes: u64) -> String {
 
 /// Reads a small text file whole: at most `max_bytes`, UTF-8 (else an error at the line of the
 /// first byte that is not).
-pub(crate) fn read_small_text(path: &Path, max_bytes: u64, what: &str) -> Result<String, Error> {
+pub fn read_small_text(path: &Path, max_bytes: u64, what: &str) -> Result<String, Error> {
     let file = open_regular(path, max_bytes, what)?;
     let mut bytes = Vec::new();
     file.take(max_bytes + 1)

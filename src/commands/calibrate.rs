@@ -87,8 +87,13 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions
     if !beam_deg.is_finite() {
         bail!("--beam: expected a finite angle in degrees");
     }
-    if start.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
-        bail!("--start-distance: expected a positive distance in metres");
+    let range = hilsim_calibrator::START_DISTANCE_RANGE_M;
+    if let Some(d) = start.filter(|d| !range.contains(d)) {
+        bail!(
+            "--start-distance: expected a distance from {} to {} m, found {d:?}",
+            range.start(),
+            range.end()
+        );
     }
     Ok(SampleOptions {
         beam_deg,

@@ -37,13 +37,19 @@ pub struct DiagnoseArgs {
     pub report: Option<PathBuf>,
     /// Run N blind trials: each draws an effect (or none) and its parameters, records a "real"
     /// run with it, diagnoses it against the nominal scenario and scores the answer.
-    #[arg(long, value_name = "N")]
-    pub self_test: Option<u64>,
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub self_test: Option<i64>,
     /// Seed of the self-test's draws (default 1).
     #[arg(long, value_name = "S", requires = "self_test")]
     pub seed: Option<u64>,
     /// Self-test: strength of the drawn effects, a factor on the documented moderate ranges.
-    #[arg(long, value_name = "X", requires = "self_test", default_value_t = 1.0)]
+    #[arg(
+        long,
+        value_name = "X",
+        requires = "self_test",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     pub strength: f64,
     /// Self-test: conceal only this effect in every trial (a catalogue name, or `none`), to
     /// study one class.
@@ -116,9 +122,10 @@ fn options(args: &DiagnoseArgs) -> Result<Options> {
 
 pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(n) = args.self_test {
-        if n == 0 {
-            bail!("--self-test: expected at least one trial");
-        }
+        let n = match u64::try_from(n) {
+            Ok(n) if n > 0 => n,
+            _ => bail!("--self-test: expected at least one trial, found {n}"),
+        };
         if n > self_test::MAX_TRIALS {
             bail!(
                 "--self-test: expected at most {} trials, found {n}",
@@ -126,7 +133,13 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
             );
         }
         if !(args.strength.is_finite() && args.strength > 0.0 && args.strength <= 5.0) {
-            bail!("--strength: expected a factor in (0, 5]");
+            bail!(
+                "--strength: expected a factor in (0, 5], found {}",
+                args.strength
+            );
+        }
+        if args.report.is_some() && args.trial.is_none() {
+            bail!("--report with --self-test needs --trial I: the report is of one trial");
         }
         let scenario = match &args.sim {
             Some(path) => hilsim_sim::Scenario::load(path)?,

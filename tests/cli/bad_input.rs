@@ -145,12 +145,102 @@ fn a_missing_scenario_file_is_named() {
 }
 
 #[test]
-fn usage_errors_exit_2() {
+fn usage_errors_are_one_line_naming_the_help_to_read() {
     let tmp = tempfile::tempdir().unwrap();
-    let out = hilsim(tmp.path(), &["run", "--seed", "minus-one"]);
-    assert_eq!(out.status.code(), Some(2));
-    let out = hilsim(tmp.path(), &["record", "x.toml"]);
-    assert_eq!(out.status.code(), Some(2), "--out is required");
-    let out = hilsim(tmp.path(), &["frobnicate"]);
-    assert_eq!(out.status.code(), Some(2));
+    for (args, says, help) in [
+        (
+            &["run", "--seed", "minus-one"][..],
+            "--seed",
+            "hilsim run --help",
+        ),
+        (
+            &["record", "x.toml"][..],
+            "missing --out",
+            "hilsim record --help",
+        ),
+        (
+            &["frobnicate"][..],
+            "unknown command `frobnicate`",
+            "hilsim --help",
+        ),
+        (&[][..], "missing a command", "hilsim --help"),
+        (
+            &["import"][..],
+            "missing --out <OUT>, <BAG>",
+            "hilsim import --help",
+        ),
+        (
+            &["run", "x.toml", "--via", "carrier-pigeon"][..],
+            "invalid value `carrier-pigeon` (expected one of: memory, serial)",
+            "hilsim run --help",
+        ),
+        (
+            &["diagnose", "--self-test", "--trial", "1"][..],
+            "--self-test <N>: a value is required",
+            "hilsim diagnose --help",
+        ),
+        (
+            &["dataset", "merge"][..],
+            "missing --out",
+            "hilsim dataset merge --help",
+        ),
+    ] {
+        let err = assert_bad_input(&hilsim(tmp.path(), args));
+        assert!(err.starts_with("hilsim: "), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(
+            err.trim_end().ends_with(&format!("; see {help}")),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+#[test]
+fn a_typed_value_in_a_usage_error_is_shown_terminal_safe() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = assert_bad_input(&hilsim(tmp.path(), &["run", "--via", "a\x1b[31mb\nc"]));
+    assert!(err.contains("a\\e[31mb\\nc"), "{err}");
+}
+
+#[test]
+fn help_and_version_go_to_stdout_and_succeed() {
+    let tmp = tempfile::tempdir().unwrap();
+    for args in [&["--help"][..], &["--version"], &["calibrate", "--help"]] {
+        let out = hilsim(tmp.path(), args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(stderr(&out).is_empty(), "{args:?}: {}", stderr(&out));
+        assert!(stdout(&out).contains("hilsim"), "{args:?}");
+    }
+}
+
+#[test]
+fn negative_numbers_reach_their_own_check() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = assert_bad_input(&hilsim(tmp.path(), &["diagnose", "--self-test", "-5"]));
+    assert!(
+        err.contains("--self-test: expected at least one trial, found -5"),
+        "{err}"
+    );
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--self-test", "1", "--strength", "-1"],
+    ));
+    assert!(
+        err.contains("--strength: expected a factor in (0, 5], found -1"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_self_test_report_without_a_trial_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--self-test", "1", "--report", "rep"],
+    ));
+    assert!(
+        err.contains("--report with --self-test needs --trial"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("rep").exists());
 }

@@ -545,3 +545,122 @@ fn issue_18_shard_processes_started_at_once_on_a_fresh_directory_all_succeed() {
         assert_same_tree(&tmp.path().join(&out), &tmp.path().join("whole"));
     }
 }
+
+#[test]
+fn a_dataset_directorys_own_files_are_read_within_bounds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 0.5);
+    let make = |out: &str| hilsim(tmp.path(), &["dataset", &s, "--runs", "2", "--out", out]);
+    for d in ["params-device", "params-large", "manifest-device", "src"] {
+        let out = make(d);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    }
+    let swap = |file: &str, to: &dyn Fn(&Path)| {
+        let path = tmp.path().join(file);
+        std::fs::remove_file(&path).unwrap();
+        to(&path);
+    };
+    let device = |p: &Path| std::os::unix::fs::symlink("/dev/zero", p).unwrap();
+    swap("params-device/dataset.toml", &device);
+    swap("params-large/dataset.toml", &|p| {
+        let comment = format!("#{}\n", "x".repeat(2 << 20));
+        std::fs::write(p, comment).unwrap();
+    });
+    swap("manifest-device/manifest.csv", &device);
+    for (d, says) in [
+        (
+            "params-device",
+            "params-device/dataset.toml: not a regular file but a character device",
+        ),
+        (
+            "params-large",
+            "params-large/dataset.toml: larger than 1 MiB; not a dataset.toml",
+        ),
+        (
+            "manifest-device",
+            "manifest-device/manifest.csv: not a regular file but a character device",
+        ),
+    ] {
+        let err = assert_bad_input(&make(d));
+        assert!(err.contains(says), "{d}: {err}");
+    }
+    // A merge source's dataset.toml likewise: named, not called missing.
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["dataset", "merge", "--out", "m", "src", "params-device"],
+    ));
+    assert!(
+        err.contains("params-device/dataset.toml: not a regular file"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_os_error_is_said_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["dataset", "merge", "--out", "m", "nowhere"],
+    ));
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}
+
+#[test]
+fn a_range_with_three_dots_is_refused_not_read_as_a_fraction() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 0.5);
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &[
+            "dataset",
+            &s,
+            "--runs",
+            "2",
+            "--out",
+            "d",
+            "--vary",
+            "robot.start.y=1...2",
+        ],
+    ));
+    assert!(
+        err.contains("more than two dots between the bounds"),
+        "{err}"
+    );
+    assert!(!err.contains("0.2"), "{err}");
+}
+
+#[test]
+fn a_second_writer_of_the_same_runs_is_refused_and_the_first_completes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = scenario(tmp.path(), 1.0);
+    let args = ["dataset", &s, "--runs", "16", "--jobs", "1", "--out", "d"];
+    let first = Command::new(env!("CARGO_BIN_EXE_hilsim"))
+        .args(args)
+        .current_dir(tmp.path())
+        .env_clear()
+        .env("PATH", std::env::var_os("PATH").unwrap_or_default())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Until the first holds the lock (its file appears once dataset.toml exists).
+    let lock = tmp.path().join("d/.manifest.csv.lock");
+    let start = Instant::now();
+    while !lock.exists() && start.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let second = hilsim(tmp.path(), &args);
+    let first = first.wait_with_output().unwrap();
+    assert_eq!(first.status.code(), Some(0), "{}", stderr(&first));
+    // The second either found the first at work, or (on a slow machine) started after it ended.
+    if second.status.code() != Some(0) {
+        let err = assert_bad_input(&second);
+        assert!(err.contains("another hilsim (pid "), "{err}");
+        assert!(
+            err.contains("is writing this dataset's manifest.csv"),
+            "{err}"
+        );
+    }
+    assert_eq!(run_dirs(&tmp.path().join("d")), 16);
+    assert!(!lock.exists(), "the lock file goes with its holder");
+}

@@ -265,9 +265,13 @@ fn fit_sensor(
                 ap[(i, i)] += weight;
                 bp[i] += weight * mean;
             }
-            let next = Cholesky::new(ap)
-                .map(|c| c.solve(&bp))
-                .ok_or_else(singular)?;
+            // The data alone were solvable: a failure here is the priors' weight.
+            let next = Cholesky::new(ap).map(|c| c.solve(&bp)).ok_or_else(|| {
+                CalibrationError::Diverged(format!(
+                    "the {name} normal equations with the priors are singular (a prior's sd \
+                     is too small against the readings' noise)"
+                ))
+            })?;
             let next_b2 = residual_sq(&next);
             let done = (next - alpha).amax() < 1e-12 && (next_b2 - b2).abs() < 1e-15;
             alpha = next;

@@ -11,6 +11,14 @@ use crate::{CalibrationError, Sensor};
 
 use super::model::{LIDAR, ODOMETER, SENSORS, SONAR};
 
+/// The largest prior mean: a bias coefficient is an offset in metres, a scale or a per-metre
+/// curvature, none of which is near 100 for a distance sensor.
+pub const MAX_ABS_MEAN: f64 = 100.0;
+
+/// A prior's sd: below a millionth its weight swamps the data's normal equations (they lose
+/// every digit), above 100 it says nothing.
+pub const SD_RANGE: std::ops::RangeInclusive<f64> = 1e-6..=100.0;
+
 /// One coefficient's prior: `alpha_i ~ N(mean, sd²)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prior {
@@ -81,11 +89,17 @@ impl FromStr for Prior {
             .trim()
             .parse()
             .map_err(|_| bad("the sd is not a number"))?;
-        if !mean.is_finite() {
-            return Err(bad("the value must be finite"));
+        if !(mean.is_finite() && mean.abs() <= MAX_ABS_MEAN) {
+            return Err(bad(&format!(
+                "the value must be from -{MAX_ABS_MEAN} to {MAX_ABS_MEAN}"
+            )));
         }
-        if !(sd.is_finite() && sd > 0.0) {
-            return Err(bad("the sd must be positive and finite"));
+        if !SD_RANGE.contains(&sd) {
+            return Err(bad(&format!(
+                "the sd must be positive: from {:?} to {}",
+                SD_RANGE.start(),
+                SD_RANGE.end()
+            )));
         }
         Ok(Self {
             sensor,
@@ -204,6 +218,9 @@ mod tests {
             ("sonar.alpha2=1±0.1", "alpha0..alpha1"),
             ("sonar.alpha1=1±0", "positive"),
             ("sonar.alpha1=x±0.1", "not a number"),
+            ("sonar.alpha1=1e300±0.1", "from -100 to 100"),
+            ("sonar.alpha1=1±1e-300", "positive: from 1e-6 to 100"),
+            ("sonar.alpha1=1±1e300", "positive: from 1e-6 to 100"),
         ] {
             let err = text.parse::<Prior>().unwrap_err().to_string();
             assert!(err.contains(why), "{text}: {err}");

@@ -161,7 +161,7 @@ fn check_lidar(rec: &Recording) -> Result<&[LidarSample], CalibrationError> {
         .as_deref()
         .filter(|l| !l.is_empty())
         .ok_or_else(|| {
-            CalibrationError::Missing("landmarks: the recording has no lidar.csv readings".into())
+            CalibrationError::Missing("the recording has no lidar.csv readings".into())
         })?;
     if lidar.windows(2).any(|w| w[1].t_s < w[0].t_s) {
         return Err(CalibrationError::Invalid(

@@ -61,3 +61,34 @@ fn metrics_follow_the_papers_nmse() {
     assert!((m.mse_raw - 0.005).abs() < 1e-12);
     assert!((m.nmse_calibrated - 0.5 * 0.04 / 4.0).abs() < 1e-12);
 }
+
+#[test]
+fn a_start_distance_outside_its_range_or_behind_the_commands_is_invalid() {
+    let ahead = |t_s| CommandSample {
+        t_s,
+        left_mps: 0.1,
+        right_mps: 0.1,
+    };
+    let rec = rec_with(vec![ahead(0.0)], 5);
+    for d in [1e-300, 0.0, 1e300, f64::NAN] {
+        let opts = SampleOptions {
+            start_distance_m: Some(d),
+            ..SampleOptions::default()
+        };
+        let err = extract(&rec, &opts).unwrap_err().to_string();
+        assert!(
+            err.contains("start distance must be from 0.01 to 1000 m"),
+            "{d}: {err}"
+        );
+    }
+    // 0.1 m/s for 0.8 s towards a target 0.05 m away: the commands drive through it.
+    let opts = SampleOptions {
+        start_distance_m: Some(0.05),
+        ..SampleOptions::default()
+    };
+    let err = extract(&rec, &opts).unwrap_err().to_string();
+    assert!(
+        err.contains("start distance 0.05 m is shorter than the 0.08"),
+        "{err}"
+    );
+}

@@ -55,9 +55,42 @@ pub struct ExportReport {
     pub messages: BTreeMap<String, u64>,
 }
 
-/// A recording's t_s as a stamp.
+/// A recording's t_s as a stamp (within [`check_stamps`]' range).
 fn stamp_ns(t_s: f64) -> i64 {
     START_NS + (t_s * 1e9).round() as i64
+}
+
+/// Refuses a recording with a time that no stamp holds: `builtin_interfaces/Time`'s `sec` is an
+/// int32, so a stamp ends 2³¹ s (68 years) after the epoch, and a time beyond would wrap.
+///
+/// # Errors
+/// The table and row of the first such time.
+fn check_stamps(rec: &Recording) -> Result<(), Error> {
+    let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
+    let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
+    let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+    let beyond = |table: &str, t: Box<dyn Iterator<Item = f64> + '_>| {
+        match t.enumerate().find(|(_, t)| !(earliest..=latest).contains(t)) {
+            None => Ok(()),
+            Some((row, t_s)) => Err(Error::bag(
+                Path::new(table),
+                format!(
+                    "row {}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
+                     int32: t_s from {earliest:.0} to {latest:.0} s)",
+                    row + 1
+                ),
+            )),
+        }
+    };
+    beyond("commands.csv", Box::new(rec.commands.iter().map(|r| r.t_s)))?;
+    beyond(
+        "odometry.csv",
+        Box::new(rec.odometry.iter().flatten().map(|r| r.t_s)),
+    )?;
+    beyond("lidar.csv", Box::new(rec.lidar.iter().flatten().map(|r| r.t_s)))?;
+    beyond("sonar.csv", Box::new(rec.sonar.iter().flatten().map(|r| r.t_s)))?;
+    beyond("truth.csv", Box::new(rec.truth.iter().flatten().map(|r| r.t_s)))?;
+    Ok(())
 }
 
 fn header(t_ns: i64, frame: &str) -> Header {
@@ -190,6 +223,7 @@ pub fn export_with(
     options: &ExportOptions<'_>,
     out: &Path,
 ) -> Result<ExportReport, Error> {
+    check_stamps(recording)?;
     let rows = recording.lidar.as_ref().map_or(0, Vec::len);
     if options.calibrated_m.is_some_and(|c| c.len() != rows) {
         return Err(Error::bag(out, "calibrated ranges: not one per lidar row"));

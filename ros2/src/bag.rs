@@ -315,7 +315,11 @@ pub(crate) fn summary_channels(path: &Path) -> Result<Option<Vec<Channel>>, Erro
     };
     let mut found = Vec::new();
     for c in summary.channels.values() {
-        let type_name = c.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
+        let type_name = c
+            .schema
+            .as_ref()
+            .map(|s| s.name.clone())
+            .unwrap_or_default();
         let schema_id = c.schema.as_ref().map_or(0, |s| s.id);
         found.push(Channel {
             id: c.id,
@@ -532,7 +536,9 @@ impl<V: FnMut(Item<'_>) -> Result<bool, Error>> Records<'_, V> {
             _ => None,
         };
         if let Some((record, what, at)) = first_name {
-            let id = data.get(..2).map_or(0, |b| u16::from_le_bytes([b[0], b[1]]));
+            let id = data
+                .get(..2)
+                .map_or(0, |b| u16::from_le_bytes([b[0], b[1]]));
             let len = data
                 .get(at..at + 4)
                 .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
@@ -875,6 +881,34 @@ mod tests {
             .map(|p| p.file_name().unwrap().to_string_lossy().to_string())
             .collect();
         assert_eq!(names, ["b_0.mcap", "b_2.mcap", "b_10.mcap"]);
+    }
+
+    /// A whole-file stream that inflates beyond its limit is stopped there, with a line saying
+    /// so, whatever is left of it.
+    #[test]
+    fn a_stream_inflating_beyond_its_limit_is_stopped() {
+        let zeros = zstd::encode_all(&[0u8; 1 << 16][..], 3).unwrap();
+        let decoder = zstd::stream::read::Decoder::new(&zeros[..]).unwrap();
+        let mut limited = Inflation {
+            inner: decoder,
+            left: 1000,
+            limit: 1000,
+        };
+        let err = std::io::copy(&mut limited, &mut std::io::sink()).unwrap_err();
+        assert!(
+            err.to_string().contains("inflates beyond 1000 bytes"),
+            "{err}"
+        );
+        let decoder = zstd::stream::read::Decoder::new(&zeros[..]).unwrap();
+        let mut limited = Inflation {
+            inner: decoder,
+            left: 1 << 16,
+            limit: 1 << 16,
+        };
+        assert_eq!(
+            std::io::copy(&mut limited, &mut std::io::sink()).unwrap(),
+            1 << 16
+        );
     }
 
     #[test]

@@ -115,13 +115,19 @@ mod tests {
         encode(&odometry, &mut bytes);
         assert!(decode::<LaserScan>(&bytes).is_ok(), "a prefix decodes");
         let err = decode_whole::<LaserScan>(&bytes, 0).unwrap_err();
-        assert!(err.contains("bytes after the message's last field"), "{err}");
+        assert!(
+            err.contains("bytes after the message's last field"),
+            "{err}"
+        );
         assert_eq!(decode_whole::<Odometry>(&bytes, 0).unwrap(), odometry);
         bytes.extend_from_slice(&[0; 3]);
         assert!(decode_whole::<Odometry>(&bytes, 0).is_ok(), "padding to 4");
         bytes.extend_from_slice(&[0; 4]);
         assert!(decode_whole::<Odometry>(&bytes, 0).is_err());
-        assert!(decode_whole::<Odometry>(&bytes, 4).is_ok(), "an appended float32");
+        assert!(
+            decode_whole::<Odometry>(&bytes, 4).is_ok(),
+            "an appended float32"
+        );
     }
 
     #[test]

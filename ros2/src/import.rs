@@ -5,8 +5,8 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use hilsim_recording::{
-    printable, wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample, RecordingStream,
-    SampleSink, SonarMount, SonarSample, Tables, TruthSample,
+    printable, wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample,
+    RecordingStream, SampleSink, SonarMount, SonarSample, Tables, TruthSample,
 };
 
 use crate::bag::{self, Item};
@@ -69,8 +69,8 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     if options.wheel_joints.is_some() && options.wheel_radius_m.is_none() {
         return Err(Error::bag(
             bag,
-            "--wheel-joints names the wheels' joints, whose angles need --wheel-radius-m R to \
-             become wheel travel",
+            "--wheel-joints names the wheels without a radius: its wheel angles need \
+             --wheel-radius-m R to become wheel travel",
         ));
     }
     let files = bag::bag_files(bag)?;
@@ -1062,7 +1062,9 @@ impl Converter {
 /// unless it is a number and the half-angle within [0°, 90°), as `meta.toml` requires.
 fn sonar_half_angle_deg(field_of_view_rad: f64) -> Option<f64> {
     let half_angle_deg = (0.5 * field_of_view_rad).to_degrees();
-    (0.0..90.0).contains(&half_angle_deg).then_some(half_angle_deg)
+    (0.0..90.0)
+        .contains(&half_angle_deg)
+        .then_some(half_angle_deg)
 }
 
 /// The wheel joint of one `side` (`left`, `right`) among a JointState's names: the one whose

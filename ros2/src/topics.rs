@@ -136,7 +136,10 @@ pub(crate) const LISTED: usize = 10;
 
 /// Names read from a bag as one line: each made printable, at most ten of them, then how many
 /// more there are (a bag can hold thousands).
-pub(crate) fn listing<T: AsRef<str>>(names: impl IntoIterator<Item = T>, separator: &str) -> String {
+pub(crate) fn listing<T: AsRef<str>>(
+    names: impl IntoIterator<Item = T>,
+    separator: &str,
+) -> String {
     let mut shown = Vec::new();
     let mut more = 0;
     for name in names {

@@ -8,8 +8,34 @@ use serde::{Deserialize, Serialize};
 /// ARM.
 const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
 
-/// Decodes a message; the error says what is wrong (for a line naming the topic).
+/// The bytes a serializer may leave after a message's last field: the body is padded to a
+/// multiple of 4.
+const END_PADDING: usize = 3;
+
+/// Decodes a whole message: its fields, then at most `appended` bytes of fields a newer
+/// distribution adds (and the padding to 4). More left over is a message of another type that
+/// happened to decode: an error, as any other.
+pub(crate) fn decode_whole<'de, T: Deserialize<'de>>(
+    data: &'de [u8],
+    appended: usize,
+) -> Result<T, String> {
+    let (message, left) = decode_prefix(data)?;
+    if left > appended + END_PADDING {
+        return Err(format!(
+            "{left} bytes after the message's last field: the bytes are laid out as another \
+             type"
+        ));
+    }
+    Ok(message)
+}
+
+/// Decodes the start of a message (e.g. the header every stamped message begins with).
 pub(crate) fn decode<'de, T: Deserialize<'de>>(data: &'de [u8]) -> Result<T, String> {
+    decode_prefix(data).map(|(message, _)| message)
+}
+
+/// A message decoded from the start of `data`, and the count of bytes left after it.
+fn decode_prefix<'de, T: Deserialize<'de>>(data: &'de [u8]) -> Result<(T, usize), String> {
     let Some((head, body)) = data.split_first_chunk::<4>() else {
         return Err(format!(
             "a message of {} bytes, shorter than its CDR header",
@@ -26,7 +52,7 @@ pub(crate) fn decode<'de, T: Deserialize<'de>>(data: &'de [u8]) -> Result<T, Str
         }
     };
     decoded
-        .map(|(message, _)| message)
+        .map(|(message, used)| (message, body.len().saturating_sub(used)))
         .map_err(|err| format!("malformed CDR ({err})"))
 }
 
@@ -77,6 +103,31 @@ mod tests {
         let scan: LaserScan = decode(&be).unwrap();
         assert_eq!((scan.header.stamp.sec, scan.header.stamp.nanosec), (7, 9));
         assert_eq!(scan.ranges, vec![2.5]);
+    }
+
+    /// A message of one type read as another can decode without error and leave bytes over:
+    /// a whole message must end where its fields do (but for padding and fields appended by
+    /// a newer distribution).
+    #[test]
+    fn bytes_left_after_a_message_are_an_error() {
+        let odometry = Odometry::default();
+        let mut bytes = Vec::new();
+        encode(&odometry, &mut bytes);
+        assert!(decode::<LaserScan>(&bytes).is_ok(), "a prefix decodes");
+        let err = decode_whole::<LaserScan>(&bytes, 0).unwrap_err();
+        assert!(
+            err.contains("bytes after the message's last field"),
+            "{err}"
+        );
+        assert_eq!(decode_whole::<Odometry>(&bytes, 0).unwrap(), odometry);
+        bytes.extend_from_slice(&[0; 3]);
+        assert!(decode_whole::<Odometry>(&bytes, 0).is_ok(), "padding to 4");
+        bytes.extend_from_slice(&[0; 4]);
+        assert!(decode_whole::<Odometry>(&bytes, 0).is_err());
+        assert!(
+            decode_whole::<Odometry>(&bytes, 4).is_ok(),
+            "an appended float32"
+        );
     }
 
     #[test]

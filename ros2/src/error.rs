@@ -31,7 +31,12 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Bag { path, message } => write!(f, "{}: {message}", path.display()),
+            // A path can come from a bag (`metadata.yaml` lists its files).
+            Self::Bag { path, message } => write!(
+                f,
+                "{}: {message}",
+                hilsim_recording::printable_cut(&path.display().to_string(), 4096)
+            ),
             Self::Recording(err) => err.fmt(f),
         }
     }

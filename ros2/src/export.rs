@@ -55,9 +55,52 @@ pub struct ExportReport {
     pub messages: BTreeMap<String, u64>,
 }
 
-/// A recording's t_s as a stamp.
+/// A recording's t_s as a stamp (within [`check_stamps`]' range).
 fn stamp_ns(t_s: f64) -> i64 {
     START_NS + (t_s * 1e9).round() as i64
+}
+
+/// Refuses a recording with a time that no stamp holds: `builtin_interfaces/Time`'s `sec` is an
+/// int32, so a stamp ends 2³¹ s (68 years) after the epoch, and a time beyond would wrap.
+///
+/// # Errors
+/// The table and row of the first such time.
+fn check_stamps(rec: &Recording) -> Result<(), Error> {
+    let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
+    let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
+    let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+    let beyond = |table: &str, t: Box<dyn Iterator<Item = f64> + '_>| match t
+        .enumerate()
+        .find(|(_, t)| !(earliest..=latest).contains(t))
+    {
+        None => Ok(()),
+        Some((row, t_s)) => Err(Error::bag(
+            Path::new(table),
+            format!(
+                "row {}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
+                     int32: t_s from {earliest:.0} to {latest:.0} s)",
+                row + 1
+            ),
+        )),
+    };
+    beyond("commands.csv", Box::new(rec.commands.iter().map(|r| r.t_s)))?;
+    beyond(
+        "odometry.csv",
+        Box::new(rec.odometry.iter().flatten().map(|r| r.t_s)),
+    )?;
+    beyond(
+        "lidar.csv",
+        Box::new(rec.lidar.iter().flatten().map(|r| r.t_s)),
+    )?;
+    beyond(
+        "sonar.csv",
+        Box::new(rec.sonar.iter().flatten().map(|r| r.t_s)),
+    )?;
+    beyond(
+        "truth.csv",
+        Box::new(rec.truth.iter().flatten().map(|r| r.t_s)),
+    )?;
+    Ok(())
 }
 
 fn header(t_ns: i64, frame: &str) -> Header {
@@ -190,6 +233,7 @@ pub fn export_with(
     options: &ExportOptions<'_>,
     out: &Path,
 ) -> Result<ExportReport, Error> {
+    check_stamps(recording)?;
     let rows = recording.lidar.as_ref().map_or(0, Vec::len);
     if options.calibrated_m.is_some_and(|c| c.len() != rows) {
         return Err(Error::bag(out, "calibrated ranges: not one per lidar row"));
@@ -707,6 +751,31 @@ fn markers(world: &World) -> MarkerArray {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A time that a stamp's int32 seconds cannot hold is refused, naming the table and row,
+    /// not wrapped to 1901.
+    #[test]
+    fn times_no_stamp_holds_are_refused_not_wrapped() {
+        use hilsim_recording::{Meta, TruthSample};
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("x.mcap");
+        let mut rec = Recording::new(Meta::default());
+        let pose = |t_s| TruthSample {
+            t_s,
+            x_m: 0.0,
+            y_m: 0.0,
+            yaw_rad: 0.0,
+        };
+        // The last second a stamp holds, from t = 0 stamped at START_NS.
+        rec.truth = Some(vec![pose(0.0), pose(2_147_483_646.5)]);
+        export(&rec, None, &out).unwrap();
+        rec.truth = Some(vec![pose(0.0), pose(1.0), pose(3.7e292)]);
+        let err = export(&rec, None, &out).unwrap_err().to_string();
+        assert!(
+            err.starts_with("truth.csv: row 3: t_s 3.7e292 s, beyond what a ROS 2 stamp holds"),
+            "{err}"
+        );
+    }
     use crate::bag::{self, Item};
     use crate::cdr::decode;
     use hilsim_recording::{Meta, Mount, SonarSample, TruthSample};

@@ -5,12 +5,12 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use hilsim_recording::{
-    wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample, RecordingStream,
-    SampleSink, SonarMount, SonarSample, Tables, TruthSample,
+    printable, wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample,
+    RecordingStream, SampleSink, SonarMount, SonarSample, Tables, TruthSample,
 };
 
 use crate::bag::{self, Item};
-use crate::cdr::decode;
+use crate::cdr::{decode, decode_whole};
 use crate::msgs::{JointState, LaserScan, Odometry, PoseStamped, Range, Time, Twist, TwistStamped};
 use crate::topics::{self, Chosen, Kind, Role};
 use crate::Error;
@@ -66,6 +66,13 @@ pub struct ImportReport {
 /// The bag cannot be read (not MCAP, truncated, an unreadable compression, a message that does
 /// not decode as its type); the topics are ambiguous; the output cannot be written.
 pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, Error> {
+    if options.wheel_joints.is_some() && options.wheel_radius_m.is_none() {
+        return Err(Error::bag(
+            bag,
+            "--wheel-joints names the wheels without a radius: its wheel angles need \
+             --wheel-radius-m R to become wheel travel",
+        ));
+    }
     let files = bag::bag_files(bag)?;
     let mut channels = Vec::new();
     for file in &files {
@@ -79,8 +86,9 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
                 return Err(Error::bag(
                     bag,
                     format!(
-                        "topic {topic}: message encoding `{}`, not `cdr` (ROS 2)",
-                        c.message_encoding
+                        "topic {}: message encoding `{}`, not `cdr` (ROS 2)",
+                        printable(topic),
+                        printable(&c.message_encoding)
                     ),
                 ));
             }
@@ -88,20 +96,19 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     }
     let mut notes = Vec::new();
     if chosen.is_empty() {
-        let all: Vec<_> = topic_types
-            .iter()
-            .map(|(t, ty)| format!("{t} ({ty})"))
-            .collect();
+        let all = if topic_types.is_empty() {
+            "none".to_string()
+        } else {
+            topics::listing(
+                topic_types.iter().map(|(t, ty)| format!("{t} ({ty})")),
+                ", ",
+            )
+        };
         return Err(Error::bag(
             bag,
             format!(
                 "no topic of a type hilsim reads (LaserScan, Odometry, JointState, Twist, \
-                 TwistStamped, Range, PoseStamped); topics: {}",
-                if all.is_empty() {
-                    "none".to_string()
-                } else {
-                    all.join(", ")
-                }
+                 TwistStamped, Range, PoseStamped); topics: {all}"
             ),
         ));
     }
@@ -123,20 +130,23 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
                 return Err(Error::bag(
                     bag,
                     format!(
-                        "topic {topic} is sensor_msgs/msg/JointState: its wheel angles need \
-                         --wheel-radius-m R to become wheel travel"
+                        "topic {} is sensor_msgs/msg/JointState: its wheel angles need \
+                         --wheel-radius-m R to become wheel travel",
+                        printable(topic)
                     ),
                 ));
             }
             notes.push(format!(
-                "{topic} (JointState) skipped: wheel angles need --wheel-radius-m to become \
-                 wheel travel"
+                "{} (JointState) skipped: wheel angles need --wheel-radius-m to become wheel \
+                 travel",
+                printable(topic)
             ));
             chosen.remove(&Role::Odometry);
         }
         Some((topic, Kind::Odometry)) if options.wheel_radius_m.is_some() => {
             notes.push(format!(
-                "--wheel-radius-m unused: the odometry is {topic}'s Odometry, not wheel angles"
+                "--wheel-radius-m unused: the odometry is {}'s Odometry, not wheel angles",
+                printable(topic)
             ));
         }
         _ => {}
@@ -160,16 +170,21 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     if let Some((topic, Kind::JointState)) = chosen.get(&Role::Odometry) {
         if !converter.rows.contains_key(&Role::Odometry) {
             let which = match &options.wheel_joints {
-                Some([left, right]) => format!("joints {left} and {right}"),
+                Some([left, right]) => {
+                    format!("joints {} and {}", printable(left), printable(right))
+                }
                 None => format!(
-                    "joints named `left` and `right` (the first message's: {:?}); name the \
+                    "joints named `left` and `right` (the first message's: {}); name the \
                      wheels with --wheel-joints LEFT,RIGHT",
-                    converter.joints_seen
+                    topics::listing(&converter.joints_seen, ", ")
                 ),
             };
             return Err(Error::bag(
                 bag,
-                format!("topic {topic}: no JointState message has positions for the {which}"),
+                format!(
+                    "topic {}: no JointState message has positions for the {which}",
+                    printable(topic)
+                ),
             ));
         }
     }
@@ -178,15 +193,30 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     if tables.lidar && final_meta.lidar.is_none() {
         final_meta.lidar = Some(hilsim_recording::Mount::default());
     }
-    if let (true, None, Some(fov)) = (tables.sonar, &final_meta.sonar, converter.sonar_fov_rad) {
-        let half_angle_deg = (0.5 * fov).to_degrees();
-        if half_angle_deg.is_finite() && (0.0..90.0).contains(&half_angle_deg) {
-            final_meta.sonar = Some(SonarMount {
-                x_m: 0.0,
-                y_m: 0.0,
-                yaw_deg: 0.0,
-                half_angle_deg: decimal_of_f32(half_angle_deg as f32),
-            });
+    if tables.sonar && final_meta.sonar.is_none() {
+        let sonar_topic = chosen.get(&Role::Sonar).map_or("", |(t, _)| t.as_str());
+        match converter.sonar_fov_rad.and_then(sonar_half_angle_deg) {
+            Some(half_angle_deg) => {
+                final_meta.sonar = Some(SonarMount {
+                    x_m: 0.0,
+                    y_m: 0.0,
+                    yaw_deg: 0.0,
+                    half_angle_deg: decimal_of_f32(half_angle_deg as f32),
+                });
+                if converter.sonar_fov_unusable > 0 {
+                    notes.push(format!(
+                        "sonar half-angle from {}'s first usable field_of_view; {} before it \
+                         not a number or not within 0..π radians",
+                        printable(sonar_topic),
+                        converter.sonar_fov_unusable
+                    ));
+                }
+            }
+            None => notes.push(format!(
+                "no [sonar] in meta.toml: no message of {} has a field_of_view within 0..π \
+                 radians to take the half-angle from; give it with --meta FILE",
+                printable(sonar_topic)
+            )),
         }
     }
     stream.finish()?;
@@ -201,21 +231,30 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
 
 /// Streams one MCAP file through the converter.
 ///
+/// The topics were chosen from the file's summary section when it has one: a channel of the
+/// data section that the summary does not list as it is would have its messages lost, so it is
+/// an error.
+///
 /// # Errors
-/// As [`import`].
+/// As [`import`], and a data section that contradicts the file's summary.
 pub fn read_file<S>(file: &Path, converter: &mut Converter, sink: &mut S) -> Result<(), Error>
 where
     S: SampleSink<Error = hilsim_recording::Error>,
 {
-    let mut roles: HashMap<u16, (Role, Kind, String)> = HashMap::new();
+    let summary = bag::summary_channels(file)?;
+    // Each chosen channel's role, kind, topic and count of messages so far.
+    let mut roles: HashMap<u16, (Role, Kind, String, u64)> = HashMap::new();
     bag::stream(file, |item| match item {
         Item::Channel(c) => {
+            if let Some(listed) = &summary {
+                check_listed(file, &c, listed)?;
+            }
             if let Some((role, (_, kind))) = converter
                 .chosen
                 .iter()
                 .find(|(_, (topic, _))| *topic == c.topic)
             {
-                roles.insert(c.id, (*role, *kind, c.topic));
+                roles.insert(c.id, (*role, *kind, c.topic, 0));
             }
             Ok(())
         }
@@ -236,20 +275,50 @@ where
             log_time,
             data,
         } => {
-            let Some((role, kind, topic)) = roles.get(&channel_id) else {
+            let Some((role, kind, topic, count)) = roles.get_mut(&channel_id) else {
                 return Ok(());
             };
+            *count += 1;
             let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
             converter
                 .message(*role, *kind, log_ns, data, sink)
                 .map_err(|err| match err {
-                    Fault::Message(message) => {
-                        Error::bag(file, format!("topic {topic}: {message}"))
-                    }
+                    Fault::Message(message) => Error::bag(
+                        file,
+                        format!("topic {}, message {count}: {message}", printable(topic)),
+                    ),
                     Fault::Sink(err) => Error::Recording(err),
                 })
         }
     })
+}
+
+/// A data-section channel against the summary's list: the same id must be there with the same
+/// topic, type and encoding.
+fn check_listed(file: &Path, channel: &bag::Channel, listed: &[bag::Channel]) -> Result<(), Error> {
+    let shown = |c: &bag::Channel| format!("{} ({})", printable(&c.topic), printable(&c.type_name));
+    match listed.iter().find(|l| l.id == channel.id) {
+        Some(l) if l == channel => Ok(()),
+        Some(l) => Err(Error::bag(
+            file,
+            format!(
+                "channel {} is {} in the data section but {} in the summary section: the file \
+                 contradicts itself (altered or damaged)",
+                channel.id,
+                shown(channel),
+                shown(l)
+            ),
+        )),
+        None => Err(Error::bag(
+            file,
+            format!(
+                "channel {} ({}) is in the data section but not in the summary section: the file \
+                 contradicts itself (altered or damaged)",
+                channel.id,
+                shown(channel)
+            ),
+        )),
+    }
 }
 
 /// How far into a bag (log time) the earliest message is looked for: a scan's stamp is its first
@@ -382,7 +451,9 @@ pub struct Converter {
     /// The wheel travel at the first odometry message.
     odometry_start_m: (f64, f64),
     sonar_out_of_range: u64,
+    /// The first usable `field_of_view`, and the count of unusable ones before it.
     sonar_fov_rad: Option<f64>,
+    sonar_fov_unusable: u64,
     /// The last scan's reading angles: a lidar's scans share them.
     scan_angles: ScanAngles,
 }
@@ -518,6 +589,7 @@ impl Converter {
             odometry_start_m: (0.0, 0.0),
             sonar_out_of_range: 0,
             sonar_fov_rad: None,
+            sonar_fov_unusable: 0,
             scan_angles: ScanAngles::default(),
         }
     }
@@ -608,14 +680,21 @@ impl Converter {
         let bad = |err: String| Fault::Message(format!("not a {} ({err})", kind.ros_name()));
         match (role, kind) {
             (Role::Lidar, _) => {
-                let scan: LaserScan = decode(data).map_err(bad)?;
+                let scan: LaserScan = decode_whole(data, 0).map_err(bad)?;
                 self.scan(&scan, log_ns, sink)
             }
             (Role::Sonar, _) => {
-                let range: Range = decode(data).map_err(bad)?;
+                // Rolling appends `variance` (a float32) to Range.
+                let range: Range = decode_whole(data, 4).map_err(bad)?;
                 let ns = self.stamped(range.header.stamp, log_ns);
-                self.sonar_fov_rad
-                    .get_or_insert(f64::from(range.field_of_view));
+                if self.sonar_fov_rad.is_none() {
+                    let fov = f64::from(range.field_of_view);
+                    if sonar_half_angle_deg(fov).is_some() {
+                        self.sonar_fov_rad = Some(fov);
+                    } else {
+                        self.sonar_fov_unusable += 1;
+                    }
+                }
                 let valid = range.range.is_finite()
                     && range.range > 0.0
                     && range.range >= range.min_range
@@ -633,12 +712,12 @@ impl Converter {
                 })?)
             }
             (Role::Commands, Kind::TwistStamped) => {
-                let twist: TwistStamped = decode(data).map_err(bad)?;
+                let twist: TwistStamped = decode_whole(data, 0).map_err(bad)?;
                 let ns = self.stamped(twist.header.stamp, log_ns);
                 self.command(ns, &twist.twist, sink)
             }
             (Role::Commands, _) => {
-                let twist: Twist = decode(data).map_err(bad)?;
+                let twist: Twist = decode_whole(data, 0).map_err(bad)?;
                 match self.clock_offset_ns {
                     Some(offset) => self.command(log_ns + offset, &twist, sink),
                     None if self.pending_commands.len() < MAX_PENDING_COMMANDS => {
@@ -652,22 +731,22 @@ impl Converter {
                 }
             }
             (Role::Truth, Kind::Odometry) => {
-                let odometry: Odometry = decode(data).map_err(bad)?;
+                let odometry: Odometry = decode_whole(data, 0).map_err(bad)?;
                 let ns = self.stamped(odometry.header.stamp, log_ns);
                 self.truth(ns, &odometry.pose.pose, sink)
             }
             (Role::Truth, _) => {
-                let pose: PoseStamped = decode(data).map_err(bad)?;
+                let pose: PoseStamped = decode_whole(data, 0).map_err(bad)?;
                 let ns = self.stamped(pose.header.stamp, log_ns);
                 self.truth(ns, &pose.pose, sink)
             }
             (Role::Odometry, Kind::JointState) => {
-                let joints: JointState = decode(data).map_err(bad)?;
+                let joints: JointState = decode_whole(data, 0).map_err(bad)?;
                 let ns = self.stamped(joints.header.stamp, log_ns);
                 self.joints(ns, &joints, sink)
             }
             (Role::Odometry, _) => {
-                let odometry: Odometry = decode(data).map_err(bad)?;
+                let odometry: Odometry = decode_whole(data, 0).map_err(bad)?;
                 let ns = self.stamped(odometry.header.stamp, log_ns);
                 self.odometry(ns, &odometry, sink)
             }
@@ -747,12 +826,13 @@ impl Converter {
         S: SampleSink<Error = hilsim_recording::Error>,
     {
         let (v, w) = (twist.linear.x, twist.angular.z);
-        if !(v.is_finite() && w.is_finite()) {
+        let half = 0.5 * self.wheel_base_m * w;
+        // Speeds near f64's limit can sum beyond it.
+        if ![v, w, v - half, v + half].iter().all(|x| x.is_finite()) {
             self.not_finite(Role::Commands);
             return Ok(());
         }
         let t_s = self.seconds(Role::Commands, ns, 0.0);
-        let half = 0.5 * self.wheel_base_m * w;
         self.count(Role::Commands, 1);
         Ok(sink.command(&CommandSample {
             t_s,
@@ -808,8 +888,16 @@ impl Converter {
                 *right_m += ds + 0.5 * turn * self.wheel_base_m;
                 (*x0, *y0, *yaw0) = (x, y, yaw);
                 // To the nanometre, far below any encoder's tick: the rounding error of the
-                // sums (1e-17 m a step) does not show, and a millimetre stays `0.002`.
-                let nm = |m: f64| (m * 1e9).round() / 1e9;
+                // sums (1e-17 m a step) does not show, and a millimetre stays `0.002`. (Beyond
+                // 1e290 m there are no nanometres to round to.)
+                let nm = |m: f64| {
+                    let scaled = m * 1e9;
+                    if scaled.is_finite() {
+                        scaled.round() / 1e9
+                    } else {
+                        m
+                    }
+                };
                 (nm(*left_m), nm(*right_m))
             }
             _ => {
@@ -824,6 +912,13 @@ impl Converter {
                 (left_m, right_m)
             }
         };
+        if !(left_m.is_finite() && right_m.is_finite()) {
+            // The poses are finite but so far apart that the travel between them is not a
+            // number: the rows after it would all be wrong.
+            return Err(Fault::Message(format!(
+                "a pose at ({x:e}, {y:e}) m that puts the wheel travel beyond any number"
+            )));
+        }
         let t_s = self.seconds(Role::Odometry, ns, 0.0);
         self.count(Role::Odometry, 1);
         Ok(sink.odometry(&OdometrySample {
@@ -945,7 +1040,7 @@ impl Converter {
         }
         if self.joints_missing > 0 {
             let names = match &self.odometry {
-                Some(OdometryState::Joints { names, .. }) => names.join(" and "),
+                Some(OdometryState::Joints { names, .. }) => topics::listing(names, " and "),
                 _ => "the wheels".to_string(),
             };
             notes.push(format!(
@@ -963,6 +1058,15 @@ impl Converter {
     }
 }
 
+/// A sonar's half-angle, degrees, of a `sensor_msgs/Range` `field_of_view` (radians): `None`
+/// unless it is a number and the half-angle within [0°, 90°), as `meta.toml` requires.
+fn sonar_half_angle_deg(field_of_view_rad: f64) -> Option<f64> {
+    let half_angle_deg = (0.5 * field_of_view_rad).to_degrees();
+    (0.0..90.0)
+        .contains(&half_angle_deg)
+        .then_some(half_angle_deg)
+}
+
 /// The wheel joint of one `side` (`left`, `right`) among a JointState's names: the one whose
 /// name has the side in it (any case), or, of several, the one that also has `wheel`.
 /// `None` when no joint has the side in its name; an error when several do and not one of them
@@ -975,8 +1079,9 @@ fn wheel_joint(names: &[String], side: &str) -> Result<Option<String>, Fault> {
         ([], _) => Ok(None),
         ([one], _) | (_, [one]) => Ok(Some((*one).clone())),
         _ => Err(Fault::Message(format!(
-            "which joints are the wheels? several of the joints {names:?} are named `{side}`; \
-             name the wheels with --wheel-joints LEFT,RIGHT"
+            "which joints are the wheels? several of the joints {} are named `{side}`; \
+             name the wheels with --wheel-joints LEFT,RIGHT",
+            topics::listing(names, ", ")
         ))),
     }
 }

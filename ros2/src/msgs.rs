@@ -1,7 +1,7 @@
 //! The ROS 2 messages hilsim reads and writes, field for field in the order of their `.msg`
-//! definitions (CDR has no field names: the order is the format). Decoding a message of a newer
-//! distribution with fields appended (e.g. `sensor_msgs/Range`'s `variance` in Rolling) reads
-//! the fields named here and ignores the rest.
+//! definitions (CDR has no field names: the order is the format). A message must end where its
+//! fields do; the one field a newer distribution appends to a type read here
+//! (`sensor_msgs/Range`'s `variance`) is allowed for, and ignored.
 
 use serde::de::{self, SeqAccess, Visitor};
 use serde::ser::SerializeTuple;

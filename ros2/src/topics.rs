@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::Path;
 
+use hilsim_recording::printable;
+
 use crate::bag::Channel;
 use crate::Error;
 
@@ -129,6 +131,31 @@ impl Kind {
     }
 }
 
+/// How many names a one-line message lists before "and N more".
+pub(crate) const LISTED: usize = 10;
+
+/// Names read from a bag as one line: each made printable, at most ten of them, then how many
+/// more there are (a bag can hold thousands).
+pub(crate) fn listing<T: AsRef<str>>(
+    names: impl IntoIterator<Item = T>,
+    separator: &str,
+) -> String {
+    let mut shown = Vec::new();
+    let mut more = 0;
+    for name in names {
+        if shown.len() < LISTED {
+            shown.push(printable(name.as_ref()).into_owned());
+        } else {
+            more += 1;
+        }
+    }
+    let mut line = shown.join(separator);
+    if more > 0 {
+        line.push_str(&format!("{separator}and {more} more"));
+    }
+    line
+}
+
 /// The topics of a bag (over all its files): name → type name.
 pub type TopicTypes = BTreeMap<String, String>;
 
@@ -146,7 +173,12 @@ pub fn topic_types(bag: &Path, channels: &[Channel]) -> Result<TopicTypes, Error
             if old != c.type_name {
                 return Err(Error::bag(
                     bag,
-                    format!("topic {} has two types, {old} and {}", c.topic, c.type_name),
+                    format!(
+                        "topic {} has two types, {} and {}",
+                        printable(&c.topic),
+                        printable(&old),
+                        printable(&c.type_name)
+                    ),
                 ));
             }
         }
@@ -168,13 +200,13 @@ pub fn choose(
     let mut chosen = Chosen::new();
     for (&role, topic) in named {
         let Some(type_name) = topics.get(topic) else {
-            let all: Vec<_> = topics.keys().map(String::as_str).collect();
             return Err(Error::bag(
                 bag,
                 format!(
-                    "no topic {topic} ({}); topics: {}",
+                    "no topic {} ({}); topics: {}",
+                    printable(topic),
                     role.flag(),
-                    all.join(", ")
+                    listing(topics.keys().map(String::as_str), ", ")
                 ),
             ));
         };
@@ -184,7 +216,9 @@ pub fn choose(
             return Err(Error::bag(
                 bag,
                 format!(
-                    "topic {topic} is {type_name}; {} takes {}",
+                    "topic {} is {}; {} takes {}",
+                    printable(topic),
+                    printable(type_name),
                     role.flag(),
                     wanted.join(" or ")
                 ),
@@ -215,7 +249,7 @@ pub fn choose(
                             "{} topics of type {}: {}; choose the {role}'s with {} TOPIC",
                             many.len(),
                             kind.ros_name(),
-                            many.join(", "),
+                            listing(many.iter().copied(), ", "),
                             role.flag()
                         ),
                     ))

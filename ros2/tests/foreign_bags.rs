@@ -169,8 +169,9 @@ fn wheel_joints_that_are_not_plain_are_named_or_refused_in_one_line() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("skid.mcap: topic /joint_states: which joints are the wheels? several")
-            && err.ends_with("name the wheels with --wheel-joints LEFT,RIGHT"),
+        err.contains(
+            "skid.mcap: topic /joint_states, message 1: which joints are the wheels? several"
+        ) && err.ends_with("name the wheels with --wheel-joints LEFT,RIGHT"),
         "{err}"
     );
     assert!(!err.contains('\n'));

@@ -92,7 +92,12 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     let report = hilsim_ros2::import(&args.bag, &args.out, &options)?;
     for (role, (topic, kind)) in &report.chosen {
         let rows = report.rows.get(role).copied().unwrap_or(0);
-        writeln!(out, "{role:<9} {topic} ({}): {rows} rows", kind.ros_name())?;
+        writeln!(
+            out,
+            "{role:<9} {} ({}): {rows} rows",
+            hilsim_recording::printable(topic),
+            kind.ros_name()
+        )?;
     }
     for note in &report.notes {
         writeln!(out, "note: {note}")?;

@@ -180,3 +180,67 @@ impl<T> Iterator for Rows<T> {
         self.0.next()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Recording;
+    use std::fs;
+
+    fn minimal(dir: &Path) {
+        fs::write(
+            dir.join("meta.toml"),
+            "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n",
+        )
+        .unwrap();
+        fs::write(
+            dir.join("commands.csv"),
+            "t_s,left_mps,right_mps\n0,0.1,0.1\n",
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn rows_are_the_samples_read_dir_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        fs::write(
+            dir.path().join("sonar.csv"),
+            "t_s,range_m\n\n0.0,1.0\n0.1, 1.5 \n",
+        )
+        .unwrap();
+        let whole = Recording::read_dir(dir.path()).unwrap();
+        let run = RecordingDir::open(dir.path()).unwrap();
+        let mut checked = Recording::default();
+        run.check(&mut checked).unwrap();
+        assert_eq!(checked.sonar, whole.sonar);
+        let sonar: Vec<_> = run.sonar().unwrap().unwrap().map(Result::unwrap).collect();
+        assert_eq!(Some(sonar), whole.sonar);
+        assert!(run.lidar().unwrap().is_none() && !run.tables().lidar);
+    }
+
+    /// `check` gives the error a reader of the whole file finds first (a row of the wrong width
+    /// before an earlier bad value); the rows end at the first error on the way.
+    #[test]
+    fn check_gives_read_dirs_error_and_rows_the_first_on_the_way() {
+        let dir = tempfile::tempdir().unwrap();
+        minimal(dir.path());
+        fs::write(
+            dir.path().join("sonar.csv"),
+            "t_s,range_m\n0,1\n0,abc\n0.1\n",
+        )
+        .unwrap();
+        let whole = Recording::read_dir(dir.path()).unwrap_err().to_string();
+        let run = RecordingDir::open(dir.path()).unwrap();
+        let checked = run.check(&mut Recording::default()).unwrap_err();
+        assert_eq!(checked.to_string(), whole);
+        assert!(whole.ends_with("sonar.csv:4: expected 2 fields (t_s,range_m), found 1"));
+        let rows: Vec<_> = run.sonar().unwrap().unwrap().collect();
+        assert_eq!(rows.len(), 2, "a sample, an error, the end");
+        let err = rows[1].as_ref().unwrap_err().to_string();
+        assert!(
+            err.ends_with("sonar.csv:3: column `range_m`: expected a finite number, found `abc`"),
+            "{err}"
+        );
+    }
+}

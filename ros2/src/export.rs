@@ -451,17 +451,88 @@ impl<'a> Revolutions<'a> {
     }
 }
 
-/// Which stream has the next message: the earliest time, a tie to the first in `times`' order.
-fn earliest(times: [Option<f64>; 5]) -> Option<usize> {
-    let mut best: Option<(usize, f64)> = None;
-    for (i, t) in times.into_iter().enumerate() {
-        if let Some(t) = t {
-            if best.is_none_or(|(_, b)| t.total_cmp(&b).is_lt()) {
-                best = Some((i, t));
+/// What the next message is made from.
+enum Next {
+    /// The revolution [`Merge::revolution`] holds.
+    Scan,
+    Command(CommandSample),
+    Odometry(OdometrySample),
+    Sonar(SonarSample),
+    Truth(TruthSample),
+}
+
+/// The tables merged by time, holding one row of each (one revolution of the lidar's) ahead.
+/// At one time a scan comes first, then a command, the odometry, the sonar and the truth (as a
+/// stable sort of the tables in that order would put them).
+struct Merge<'a> {
+    scans: Revolutions<'a>,
+    /// Whether the revolution held has been given out (it is left until the next call).
+    scan_given: bool,
+    commands: Head<'a, CommandSample>,
+    odometry: Head<'a, OdometrySample>,
+    sonar: Head<'a, SonarSample>,
+    truth: Head<'a, TruthSample>,
+}
+
+impl<'a> Merge<'a> {
+    fn new(
+        lidar: Stream<'a, LidarSample>,
+        commands: Stream<'a, CommandSample>,
+        odometry: Stream<'a, OdometrySample>,
+        sonar: Stream<'a, SonarSample>,
+        truth: Stream<'a, TruthSample>,
+    ) -> Result<Self, Error> {
+        Ok(Self {
+            scans: Revolutions::new(lidar)?,
+            scan_given: false,
+            commands: Head::new(commands)?,
+            odometry: Head::new(odometry)?,
+            sonar: Head::new(sonar)?,
+            truth: Head::new(truth)?,
+        })
+    }
+
+    /// The revolution of the last [`Next::Scan`].
+    fn revolution(&self) -> &[LidarSample] {
+        &self.scans.current
+    }
+
+    /// The next message's time and what it is made from; `None` at the end of every table.
+    fn next(&mut self) -> Result<Option<(f64, Next)>, Error> {
+        if std::mem::take(&mut self.scan_given) {
+            self.scans.advance()?;
+        }
+        let times = [
+            self.scans.current.first().map(|s| s.t_s),
+            self.commands.next.map(|c| c.t_s),
+            self.odometry.next.map(|o| o.t_s),
+            self.sonar.next.map(|s| s.t_s),
+            self.truth.next.map(|p| p.t_s),
+        ];
+        // The earliest time; a tie goes to the first in `times`' order.
+        let mut earliest: Option<(usize, f64)> = None;
+        for (i, t) in times.into_iter().enumerate() {
+            if let Some(t) = t {
+                if earliest.is_none_or(|(_, e)| t.total_cmp(&e).is_lt()) {
+                    earliest = Some((i, t));
+                }
             }
         }
+        let Some((which, t_s)) = earliest else {
+            return Ok(None);
+        };
+        let next = match which {
+            0 => {
+                self.scan_given = true;
+                Some(Next::Scan)
+            }
+            1 => self.commands.take()?.map(Next::Command),
+            2 => self.odometry.take()?.map(Next::Odometry),
+            3 => self.sonar.take()?.map(Next::Sonar),
+            _ => self.truth.take()?.map(Next::Truth),
+        };
+        Ok(next.map(|next| (t_s, next)))
     }
-    best.map(|(i, _)| i)
 }
 
 fn write_all<W: Write>(
@@ -547,26 +618,18 @@ fn write_all<W: Write>(
         .map_or(0.0, |s| (2.0 * s.half_angle_deg).to_radians() as f32);
     let mut odometry_path = OdometryPath::new(source.odometry_again, wheel_base)?;
     let mut dead_reckoning = DeadReckoning::default();
-    let mut scans = Revolutions::new(source.lidar)?;
-    let mut commands = Head::new(source.commands)?;
-    let mut odometry = Head::new(source.odometry)?;
-    let mut sonar = Head::new(source.sonar)?;
-    let mut truth = Head::new(source.truth)?;
-    // The tables merged by time; at one time, a scan first, then a command, the odometry, the
-    // sonar and the truth.
-    loop {
-        let times = [
-            scans.current.first().map(|s| s.t_s),
-            commands.next.map(|c| c.t_s),
-            odometry.next.map(|o| o.t_s),
-            sonar.next.map(|s| s.t_s),
-            truth.next.map(|p| p.t_s),
-        ];
-        let Some(which) = earliest(times) else { break };
-        let t_ns = times[which].map_or(START_NS, stamp_ns);
-        match which {
-            0 => {
-                let rev = &scans.current;
+    let mut merge = Merge::new(
+        source.lidar,
+        source.commands,
+        source.odometry,
+        source.sonar,
+        source.truth,
+    )?;
+    while let Some((t_s, next)) = merge.next()? {
+        let t_ns = stamp_ns(t_s);
+        match next {
+            Next::Scan => {
+                let rev = merge.revolution();
                 let mut scan = laser_scan(rev, range_max);
                 bag.write("/scan", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
                 if let Some(calibrated) = calibrated {
@@ -583,10 +646,8 @@ fn write_all<W: Write>(
                     scan.range_max = f32::MAX;
                     bag.write("/scan_calibrated", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
                 }
-                scans.advance()?;
             }
-            1 => {
-                let Some(c) = commands.take()? else { break };
+            Next::Command(c) => {
                 let twist = TwistStamped {
                     header: header(t_ns, "base_link"),
                     twist: twist(
@@ -596,8 +657,7 @@ fn write_all<W: Write>(
                 };
                 bag.write("/cmd_vel", "geometry_msgs/msg/TwistStamped", t_ns, &twist)?;
             }
-            2 => {
-                let Some(o) = odometry.take()? else { break };
+            Next::Odometry(o) => {
                 let (pose, velocity) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
                 let mut message = Odometry {
                     header: header(t_ns, "odom"),
@@ -618,8 +678,7 @@ fn write_all<W: Write>(
                     },
                 )?;
             }
-            3 => {
-                let Some(s) = sonar.take()? else { break };
+            Next::Sonar(s) => {
                 let range = Range {
                     header: header(t_ns, "sonar"),
                     radiation_type: 0,
@@ -630,8 +689,7 @@ fn write_all<W: Write>(
                 };
                 bag.write("/sonar", "sensor_msgs/msg/Range", t_ns, &range)?;
             }
-            _ => {
-                let Some(p) = truth.take()? else { break };
+            Next::Truth(p) => {
                 let pose = PoseStamped {
                     header: header(t_ns, "map"),
                     pose: pose(p.x_m, p.y_m, p.yaw_rad),
@@ -939,7 +997,8 @@ mod tests {
     use super::*;
     use crate::bag::{self, Item};
     use crate::cdr::decode;
-    use hilsim_recording::{Meta, Mount, SonarSample, TruthSample};
+    use hilsim_recording::{Meta, Mount};
+    use std::cell::Cell;
 
     /// Every transform of a file (`/tf` and `/tf_static`), and its `/odom` messages.
     fn transforms_and_odometry(path: &Path) -> (Vec<TransformStamped>, Vec<Odometry>) {
@@ -1109,5 +1168,142 @@ mod tests {
                 assert!(close && yaw_error.abs() < 1e-9, "{p:?}: {in_map:?}");
             }
         }
+    }
+
+    /// A recording with every table: the arc of [`run`], three revolutions, commands at times
+    /// the other tables share (ties), a sonar.
+    fn full() -> Recording {
+        let mut rec = run(true, true);
+        rec.lidar = Some(
+            (0..3u32)
+                .flat_map(|rev| {
+                    (0..360u32).map(move |a| LidarSample {
+                        t_s: f64::from(rev) * 0.2 + f64::from(a) * 0.2 / 360.0,
+                        rev: rev.into(),
+                        angle_deg: f64::from(a),
+                        range_m: 1.0 + f64::from(a) / 100.0,
+                        strength: 100,
+                        invalid: a % 7 == 0,
+                        warning: false,
+                        true_range_m: None,
+                    })
+                })
+                .collect(),
+        );
+        rec.commands = (0..5)
+            .map(|i| CommandSample {
+                t_s: f64::from(i) * 0.1,
+                left_mps: 0.1,
+                right_mps: 0.12,
+            })
+            .collect();
+        rec
+    }
+
+    /// The streamed export of a directory writes the very bytes of the export of the same
+    /// recording held in memory (with the calibrated scans too).
+    #[test]
+    fn a_directory_exports_the_bytes_of_its_recording_in_memory() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = full();
+        let path = dir.path().join("run");
+        rec.write_dir(&path).unwrap();
+        let calibrated = |s: &LidarSample| if s.invalid { f64::NAN } else { 0.9 * s.range_m };
+        let world = World {
+            walls: vec![[[0.0, 0.0], [1.0, 0.0]]],
+            ..World::default()
+        };
+        let options = ExportOptions {
+            world: Some(&world),
+            calibrated: Some(&calibrated),
+            ..ExportOptions::default()
+        };
+        let (held, streamed) = (
+            dir.path().join("held.mcap"),
+            dir.path().join("streamed.mcap"),
+        );
+        let report = export_with(&rec, &options, &held).unwrap();
+        let run = RecordingDir::open(&path).unwrap();
+        assert_eq!(export_dir(&run, &options, &streamed).unwrap(), report);
+        assert_eq!(report.messages["/scan"], 3);
+        assert_eq!(
+            std::fs::read(&held).unwrap(),
+            std::fs::read(&streamed).unwrap()
+        );
+    }
+
+    /// A table's stream that counts the rows taken from it.
+    fn counted<'a, T: Copy + 'a>(rows: &'a [T], taken: &'a Cell<usize>) -> Stream<'a, T> {
+        Box::new(rows.iter().map(move |&row| {
+            taken.set(taken.get() + 1);
+            Ok(row)
+        }))
+    }
+
+    /// Merging the tables by time holds one row of each table ahead of the messages given
+    /// out (of the lidar, a revolution and a row), in time order: what an export holds does not
+    /// grow with the tables.
+    #[test]
+    fn the_merge_holds_one_row_of_each_table_ahead() {
+        let rec = full();
+        let taken: [Cell<usize>; 5] = Default::default();
+        let mut given = [0usize; 5];
+        let mut merge = Merge::new(
+            counted(rec.lidar.as_deref().unwrap(), &taken[0]),
+            counted(&rec.commands, &taken[1]),
+            counted(rec.odometry.as_deref().unwrap(), &taken[2]),
+            counted(rec.sonar.as_deref().unwrap(), &taken[3]),
+            counted(rec.truth.as_deref().unwrap(), &taken[4]),
+        )
+        .unwrap();
+        let mut last = f64::NEG_INFINITY;
+        while let Some((t_s, next)) = merge.next().unwrap() {
+            assert!(t_s >= last, "{t_s} after {last}");
+            last = t_s;
+            match next {
+                Next::Scan => given[0] += merge.revolution().len(),
+                Next::Command(_) => given[1] += 1,
+                Next::Odometry(_) => given[2] += 1,
+                Next::Sonar(_) => given[3] += 1,
+                Next::Truth(_) => given[4] += 1,
+            }
+            // A revolution held besides the row after it.
+            let ahead = [360 + 1, 1, 1, 1, 1];
+            for ((taken, given), ahead) in taken.iter().zip(given).zip(ahead) {
+                let taken = taken.get();
+                assert!(taken <= given + ahead, "{taken} taken, {given} given");
+            }
+        }
+        let rows = [360 * 3, 5, 41, 1, 41];
+        assert_eq!(given, rows);
+    }
+
+    /// A revolution longer than [`MAX_SCAN_READINGS`] is sent as several scans, so what is held
+    /// for one is bounded whatever the file says.
+    #[test]
+    fn a_revolution_longer_than_the_bound_is_sent_as_several_scans() {
+        let taken = Cell::new(0);
+        let rows = 2 * MAX_SCAN_READINGS + 5;
+        let lidar = (0..rows).map(|i| {
+            taken.set(taken.get() + 1);
+            Ok(LidarSample {
+                t_s: i as f64 * 1e-6,
+                rev: 0,
+                angle_deg: (i % 360) as f64,
+                range_m: 1.0,
+                strength: 1,
+                invalid: false,
+                warning: false,
+                true_range_m: None,
+            })
+        });
+        let mut revolutions = Revolutions::new(Box::new(lidar)).unwrap();
+        let mut sizes = Vec::new();
+        while !revolutions.current.is_empty() {
+            assert!(taken.get() <= sizes.iter().sum::<usize>() + MAX_SCAN_READINGS + 1);
+            sizes.push(revolutions.current.len());
+            revolutions.advance().unwrap();
+        }
+        assert_eq!(sizes, [MAX_SCAN_READINGS, MAX_SCAN_READINGS, 5]);
     }
 }

@@ -1306,4 +1306,27 @@ mod tests {
         }
         assert_eq!(sizes, [MAX_SCAN_READINGS, MAX_SCAN_READINGS, 5]);
     }
+
+    /// A malformed table stops a streamed export before anything is written, with the error a
+    /// reader of the whole recording gives (a row of the wrong width before an earlier bad
+    /// value), not the first the merge would meet.
+    #[test]
+    fn a_malformed_table_is_read_dirs_error_and_nothing_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run");
+        full().write_dir(&path).unwrap();
+        let sonar = "t_s,range_m\n0,1\n0.1,abc\n0.2\n";
+        std::fs::write(path.join("sonar.csv"), sonar).unwrap();
+        let whole = Recording::read_dir(&path).unwrap_err().to_string();
+        assert!(whole.ends_with("sonar.csv:4: expected 2 fields (t_s,range_m), found 1"));
+        let out = dir.path().join("run.mcap");
+        let run = RecordingDir::open(&path).unwrap();
+        let err = export_dir(&run, &ExportOptions::default(), &out).unwrap_err();
+        assert_eq!(err.to_string(), whole);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "only the recording"
+        );
+    }
 }

@@ -12,7 +12,7 @@
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::input::{self, MAX_LINE_BYTES, MAX_TABLE_BYTES};
 use crate::Error;
@@ -20,45 +20,31 @@ use crate::Error;
 /// What a table is called in the errors of its limits.
 const WHAT: &str = "a recording's table";
 
-/// Reads a table whole: `columns` finds the columns it needs in the header, then `sample` makes
-/// each row, in order, into a sample.
+/// Makes each row of a table into a sample, in order; made from the table's header (the columns
+/// it needs found there) and keeping what it needs between rows (the previous row's time).
+pub(crate) type Parse<T> = Box<dyn FnMut(&Row) -> Result<T, Error>>;
+
+/// Reads a table whole: `columns` finds the columns it needs in the header and gives the parser
+/// that makes each row, in order, into a sample, handed to `keep`.
 ///
 /// Errors are those a reader of the whole text finds first, in this order: a line that is not
 /// UTF-8 (the first), an empty file, a row with the wrong number of fields (the first), the first
-/// error of `columns`, the first error of `sample`. So after an error the rest of the file is
-/// still read (one line at a time) for an error that comes before it. Two limits end the reading
-/// at once, with their own error: a line longer than [`MAX_LINE_BYTES`], and more than
-/// [`MAX_TABLE_BYTES`] in all.
-pub(crate) fn read_table<C, T>(
+/// error of `columns`, the first error of the parser. So after an error the rest of the file is
+/// still read (one line at a time) for an error that comes before it, and `keep` may have been
+/// given samples before an error is returned. Two limits end the reading at once, with their own
+/// error: a line longer than [`MAX_LINE_BYTES`], and more than [`MAX_TABLE_BYTES`] in all.
+pub(crate) fn read_table<T>(
     path: &Path,
-    columns: impl FnOnce(&Header) -> Result<C, Error>,
-    mut sample: impl FnMut(&C, &Row) -> Result<T, Error>,
-) -> Result<Vec<T>, Error> {
+    columns: impl FnOnce(&Header) -> Result<Parse<T>, Error>,
+    mut keep: impl FnMut(T),
+) -> Result<(), Error> {
     let mut lines = Lines::open(path)?;
-    let header = loop {
-        match lines.next()? {
-            None => {
-                return Err(Error::format(
-                    path,
-                    Some(1),
-                    "empty file: expected a header row",
-                ))
-            }
-            Some((_, text)) if text.trim().is_empty() => {}
-            Some((_, text)) => {
-                break Header {
-                    path,
-                    columns: text.split(',').map(|c| c.trim().to_string()).collect(),
-                }
-            }
-        }
-    };
+    let header = read_header(&mut lines)?;
     let width = header.columns.len();
     // The first error found, and whether it is a row of the wrong width (only a line that is not
     // UTF-8 comes before that).
     let (mut first, mut wrong_width) = (None, false);
-    let columns = columns(&header).map_err(|err| first = Some(err)).ok();
-    let mut samples = Vec::new();
+    let mut parse = columns(&header).map_err(|err| first = Some(err)).ok();
     // Each field's byte range in its line, trimmed: one vector for every row.
     let mut fields = Vec::with_capacity(width);
     while let Some((line, text)) = lines.next()? {
@@ -67,35 +53,111 @@ pub(crate) fn read_table<C, T>(
         }
         split_fields(text, &mut fields);
         if fields.len() != width {
-            first = Some(Error::format(
-                path,
-                Some(line),
-                format!(
-                    "expected {width} fields ({}), found {}",
-                    header.columns.join(","),
-                    fields.len()
-                ),
-            ));
+            first = Some(header.wrong_width(line, fields.len()));
             wrong_width = true;
-        } else if let (None, Some(columns)) = (&first, &columns) {
+        } else if let (None, Some(parse)) = (&first, &mut parse) {
             let row = Row {
                 header: &header,
                 line,
                 text,
                 fields: &fields,
             };
-            match sample(columns, &row) {
-                Ok(s) => samples.push(s),
-                Err(err) => {
-                    first = Some(err);
-                    samples = Vec::new();
-                }
+            match parse(&row) {
+                Ok(s) => keep(s),
+                Err(err) => first = Some(err),
             }
         }
     }
     match first {
         Some(err) => Err(err),
-        None => Ok(samples),
+        None => Ok(()),
+    }
+}
+
+/// A table read one row at a time, holding one line: each row's sample, or the first error met
+/// in the file's order (a line that is not UTF-8, a row of the wrong width, a value the parser
+/// refuses), after which it ends. [`read_table`] finds the error a whole-file reader finds first;
+/// this finds the first on the way.
+pub(crate) struct TableRows<T> {
+    lines: Lines,
+    header: Header,
+    parse: Parse<T>,
+    fields: Vec<Range<usize>>,
+    ended: bool,
+}
+
+impl<T> TableRows<T> {
+    /// Opens the table and reads its header.
+    pub(crate) fn open(
+        path: &Path,
+        columns: impl FnOnce(&Header) -> Result<Parse<T>, Error>,
+    ) -> Result<Self, Error> {
+        let mut lines = Lines::open(path)?;
+        let header = read_header(&mut lines)?;
+        let parse = columns(&header)?;
+        Ok(Self {
+            fields: Vec::with_capacity(header.columns.len()),
+            lines,
+            header,
+            parse,
+            ended: false,
+        })
+    }
+
+    fn next_row(&mut self) -> Result<Option<T>, Error> {
+        while let Some((line, text)) = self.lines.next()? {
+            if text.trim().is_empty() {
+                continue;
+            }
+            split_fields(text, &mut self.fields);
+            if self.fields.len() != self.header.columns.len() {
+                return Err(self.header.wrong_width(line, self.fields.len()));
+            }
+            let row = Row {
+                header: &self.header,
+                line,
+                text,
+                fields: &self.fields,
+            };
+            return (self.parse)(&row).map(Some);
+        }
+        Ok(None)
+    }
+}
+
+impl<T> Iterator for TableRows<T> {
+    type Item = Result<T, Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ended {
+            return None;
+        }
+        let next = self.next_row().transpose();
+        self.ended = !matches!(next, Some(Ok(_)));
+        next
+    }
+}
+
+/// The header: the first line that is not blank.
+fn read_header(lines: &mut Lines) -> Result<Header, Error> {
+    loop {
+        match lines.next()? {
+            None => {
+                return Err(Error::format(
+                    &lines.path,
+                    Some(1),
+                    "empty file: expected a header row",
+                ))
+            }
+            Some((_, text)) if text.trim().is_empty() => {}
+            Some((_, text)) => {
+                let columns = text.split(',').map(|c| c.trim().to_string()).collect();
+                return Ok(Header {
+                    path: lines.path.clone(),
+                    columns,
+                });
+            }
+        }
     }
 }
 
@@ -112,19 +174,19 @@ fn split_fields(text: &str, fields: &mut Vec<Range<usize>>) {
 }
 
 /// The lines of a file, one at a time, bounded.
-struct Lines<'p> {
-    path: &'p Path,
+struct Lines {
+    path: PathBuf,
     reader: BufReader<File>,
     line: usize,
     bytes: u64,
     buf: Vec<u8>,
 }
 
-impl<'p> Lines<'p> {
-    fn open(path: &'p Path) -> Result<Self, Error> {
+impl Lines {
+    fn open(path: &Path) -> Result<Self, Error> {
         let file = input::open_regular(path, MAX_TABLE_BYTES, WHAT)?;
         Ok(Self {
-            path,
+            path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),
             line: 0,
             bytes: 0,
@@ -139,20 +201,20 @@ impl<'p> Lines<'p> {
         let n = (&mut self.reader)
             .take(MAX_LINE_BYTES as u64 + 1)
             .read_until(b'\n', &mut self.buf)
-            .map_err(|err| Error::io(self.path, err))?;
+            .map_err(|err| Error::io(&self.path, err))?;
         if n == 0 {
             return Ok(None);
         }
         self.line += 1;
         self.bytes += n as u64;
         if self.bytes > MAX_TABLE_BYTES {
-            return Err(input::too_large(self.path, MAX_TABLE_BYTES, WHAT));
+            return Err(input::too_large(&self.path, MAX_TABLE_BYTES, WHAT));
         }
         let bytes = match self.buf.strip_suffix(b"\n") {
             Some(line) => line,
             None if n > MAX_LINE_BYTES => {
                 return Err(Error::format(
-                    self.path,
+                    &self.path,
                     Some(self.line),
                     format!(
                         "line longer than {}; not {WHAT}",
@@ -163,7 +225,7 @@ impl<'p> Lines<'p> {
             None => &self.buf,
         };
         let text = std::str::from_utf8(bytes)
-            .map_err(|_| Error::format(self.path, Some(self.line), "not UTF-8 text"))?;
+            .map_err(|_| Error::format(&self.path, Some(self.line), "not UTF-8 text"))?;
         // A byte-order mark some editors put first is no part of the header's first name.
         let text = if self.line == 1 {
             text.trim_start_matches('\u{feff}')
@@ -175,17 +237,30 @@ impl<'p> Lines<'p> {
 }
 
 /// A table's header: its columns, found by name.
-pub(crate) struct Header<'p> {
-    path: &'p Path,
+pub(crate) struct Header {
+    path: PathBuf,
     columns: Vec<String>,
 }
 
-impl Header<'_> {
+impl Header {
+    /// The error for a row of `found` fields at `line`.
+    fn wrong_width(&self, line: usize, found: usize) -> Error {
+        Error::format(
+            &self.path,
+            Some(line),
+            format!(
+                "expected {} fields ({}), found {found}",
+                self.columns.len(),
+                self.columns.join(",")
+            ),
+        )
+    }
+
     /// The index of a required column.
     pub(crate) fn column(&self, name: &str) -> Result<usize, Error> {
         self.optional_column(name).ok_or_else(|| {
             Error::format(
-                self.path,
+                &self.path,
                 Some(1),
                 format!(
                     "missing column `{name}` in header `{}`",
@@ -203,7 +278,7 @@ impl Header<'_> {
 
 /// One data row.
 pub(crate) struct Row<'h, 'f> {
-    header: &'h Header<'h>,
+    header: &'h Header,
     pub(crate) line: usize,
     text: &'f str,
     fields: &'f [Range<usize>],
@@ -217,7 +292,7 @@ impl Row<'_, '_> {
 
     /// An error at this row's line.
     pub(crate) fn error(&self, msg: String) -> Error {
-        Error::format(self.header.path, Some(self.line), msg)
+        Error::format(&self.header.path, Some(self.line), msg)
     }
 
     /// A finite float.

@@ -28,6 +28,7 @@ mod names;
 pub mod pose;
 mod printable;
 mod read;
+mod rows;
 mod samples;
 mod stream;
 mod write;
@@ -44,6 +45,7 @@ pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};
 pub use printable::{printable, printable_cut, MAX_NAME_CHARS};
+pub use rows::{RecordingDir, Rows};
 pub use samples::{
     CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
 };

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::csv::read_table;
+use crate::csv::{read_table, Header, Parse};
 use crate::input::{self, MAX_META_BYTES};
 use crate::{
     CommandSample, Error, LidarSample, Meta, OdometrySample, Recording, SonarSample, TruthSample,
@@ -27,14 +27,14 @@ impl Recording {
             return Err(Error::format(dir, None, "not a recording directory"));
         }
         let meta = read_meta(&dir.join("meta.toml"))?;
-        let commands = read_commands(&dir.join("commands.csv"))?;
+        let commands = read_whole(&dir.join("commands.csv"), commands)?;
         Ok(Self {
             meta,
             commands,
-            odometry: optional(dir, "odometry.csv", read_odometry)?,
-            lidar: optional(dir, "lidar.csv", read_lidar)?,
-            sonar: optional(dir, "sonar.csv", read_sonar)?,
-            truth: optional(dir, "truth.csv", read_truth)?,
+            odometry: optional(dir, "odometry.csv", odometry)?,
+            lidar: optional(dir, "lidar.csv", lidar)?,
+            sonar: optional(dir, "sonar.csv", sonar)?,
+            truth: optional(dir, "truth.csv", truth)?,
         })
     }
 }
@@ -52,18 +52,32 @@ impl Meta {
 fn optional<T>(
     dir: &Path,
     name: &str,
-    read: fn(&Path) -> Result<Vec<T>, Error>,
+    parse: fn(&Header) -> Result<Parse<T>, Error>,
 ) -> Result<Option<Vec<T>>, Error> {
     let path = dir.join(name);
-    // Absent only when nothing is there: a link that leads nowhere (or round in a loop) is a
-    // broken table, reported by the reader, not a sensor the robot lacks.
-    if std::fs::symlink_metadata(&path).is_err() {
+    if !is_present(&path) {
         return Ok(None);
     }
-    read(&path).map(Some)
+    read_whole(&path, parse).map(Some)
 }
 
-fn read_meta(path: &Path) -> Result<Meta, Error> {
+/// Whether a table is there. Absent only when nothing is there: a link that leads nowhere (or
+/// round in a loop) is a broken table, reported by the reader, not a sensor the robot lacks.
+pub(crate) fn is_present(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok()
+}
+
+/// A table's samples, all of them.
+fn read_whole<T>(
+    path: &Path,
+    parse: fn(&Header) -> Result<Parse<T>, Error>,
+) -> Result<Vec<T>, Error> {
+    let mut samples = Vec::new();
+    read_table(path, parse, |s| samples.push(s))?;
+    Ok(samples)
+}
+
+pub(crate) fn read_meta(path: &Path) -> Result<Meta, Error> {
     let text = input::read_small_text(path, MAX_META_BYTES, "a meta.toml")?;
     let meta: Meta = toml::from_str(&text).map_err(|err| {
         let line = err
@@ -111,36 +125,31 @@ fn read_meta(path: &Path) -> Result<Meta, Error> {
 
 /// A time-ordered table of numbers: `t_s` and then `columns`, each row made into a sample by
 /// `sample(t_s, values)` (columns looked up, and cells parsed, in that order).
-fn read_numbers<T, const N: usize>(
-    path: &Path,
+fn numbers<T: 'static, const N: usize>(
+    header: &Header,
     columns: [&str; N],
-    sample: impl Fn(f64, [f64; N]) -> T,
-) -> Result<Vec<T>, Error> {
+    sample: fn(f64, [f64; N]) -> T,
+) -> Result<Parse<T>, Error> {
+    let t = header.column("t_s")?;
+    let mut indices = [0; N];
+    for (index, name) in indices.iter_mut().zip(columns) {
+        *index = header.column(name)?;
+    }
     let mut prev = None;
-    read_table(
-        path,
-        |header| {
-            let t = header.column("t_s")?;
-            let mut indices = [0; N];
-            for (index, name) in indices.iter_mut().zip(columns) {
-                *index = header.column(name)?;
-            }
-            Ok((t, indices))
-        },
-        |(t, indices), row| {
-            let t_s = row.f64(*t)?;
-            row.check_time(t_s, &mut prev)?;
-            let mut values = [0.0; N];
-            for (value, &index) in values.iter_mut().zip(indices) {
-                *value = row.f64(index)?;
-            }
-            Ok(sample(t_s, values))
-        },
-    )
+    Ok(Box::new(move |row| {
+        let t_s = row.f64(t)?;
+        row.check_time(t_s, &mut prev)?;
+        let mut values = [0.0; N];
+        for (value, &index) in values.iter_mut().zip(&indices) {
+            *value = row.f64(index)?;
+        }
+        Ok(sample(t_s, values))
+    }))
 }
 
-fn read_commands(path: &Path) -> Result<Vec<CommandSample>, Error> {
-    read_numbers(path, ["left_mps", "right_mps"], |t_s, [l, r]| {
+/// `commands.csv`'s rows.
+pub(crate) fn commands(header: &Header) -> Result<Parse<CommandSample>, Error> {
+    numbers(header, ["left_mps", "right_mps"], |t_s, [l, r]| {
         CommandSample {
             t_s,
             left_mps: l,
@@ -149,15 +158,19 @@ fn read_commands(path: &Path) -> Result<Vec<CommandSample>, Error> {
     })
 }
 
-fn read_odometry(path: &Path) -> Result<Vec<OdometrySample>, Error> {
-    read_numbers(path, ["left_m", "right_m"], |t_s, [l, r]| OdometrySample {
-        t_s,
-        left_m: l,
-        right_m: r,
+/// `odometry.csv`'s rows.
+pub(crate) fn odometry(header: &Header) -> Result<Parse<OdometrySample>, Error> {
+    numbers(header, ["left_m", "right_m"], |t_s, [l, r]| {
+        OdometrySample {
+            t_s,
+            left_m: l,
+            right_m: r,
+        }
     })
 }
 
-fn read_lidar(path: &Path) -> Result<Vec<LidarSample>, Error> {
+/// `lidar.csv`'s rows.
+pub(crate) fn lidar(header: &Header) -> Result<Parse<LidarSample>, Error> {
     struct Columns {
         t: usize,
         rev: usize,
@@ -168,75 +181,67 @@ fn read_lidar(path: &Path) -> Result<Vec<LidarSample>, Error> {
         warning: usize,
         truth: Option<usize>,
     }
+    let c = Columns {
+        t: header.column("t_s")?,
+        rev: header.column("rev")?,
+        angle: header.column("angle_deg")?,
+        range: header.column("range_m")?,
+        strength: header.column("strength")?,
+        invalid: header.column("invalid")?,
+        warning: header.column("warning")?,
+        truth: header.optional_column("true_range_m"),
+    };
     let mut prev = None;
-    read_table(
-        path,
-        |header| {
-            Ok(Columns {
-                t: header.column("t_s")?,
-                rev: header.column("rev")?,
-                angle: header.column("angle_deg")?,
-                range: header.column("range_m")?,
-                strength: header.column("strength")?,
-                invalid: header.column("invalid")?,
-                warning: header.column("warning")?,
-                truth: header.optional_column("true_range_m"),
-            })
-        },
-        |c, row| {
-            let t_s = row.f64(c.t)?;
-            row.check_time(t_s, &mut prev)?;
-            let angle_deg = row.f64(c.angle)?;
-            if !(0.0..360.0).contains(&angle_deg) {
-                return Err(row.error(format!(
-                    "column `angle_deg`: expected a number in [0, 360), found {angle_deg}"
-                )));
-            }
-            let range_m = row.f64(c.range)?;
-            if range_m < 0.0 {
-                return Err(row.error(format!(
-                    "column `range_m`: must not be negative, found {range_m}"
-                )));
-            }
-            Ok(LidarSample {
-                t_s,
-                rev: row.uint(c.rev)?,
-                angle_deg,
-                range_m,
-                strength: row.uint(c.strength)?,
-                invalid: row.flag(c.invalid)?,
-                warning: row.flag(c.warning)?,
-                true_range_m: c.truth.map(|c| row.f64(c)).transpose()?,
-            })
-        },
-    )
+    Ok(Box::new(move |row| {
+        let t_s = row.f64(c.t)?;
+        row.check_time(t_s, &mut prev)?;
+        let angle_deg = row.f64(c.angle)?;
+        if !(0.0..360.0).contains(&angle_deg) {
+            return Err(row.error(format!(
+                "column `angle_deg`: expected a number in [0, 360), found {angle_deg}"
+            )));
+        }
+        let range_m = row.f64(c.range)?;
+        if range_m < 0.0 {
+            return Err(row.error(format!(
+                "column `range_m`: must not be negative, found {range_m}"
+            )));
+        }
+        Ok(LidarSample {
+            t_s,
+            rev: row.uint(c.rev)?,
+            angle_deg,
+            range_m,
+            strength: row.uint(c.strength)?,
+            invalid: row.flag(c.invalid)?,
+            warning: row.flag(c.warning)?,
+            true_range_m: c.truth.map(|c| row.f64(c)).transpose()?,
+        })
+    }))
 }
 
-fn read_sonar(path: &Path) -> Result<Vec<SonarSample>, Error> {
+/// `sonar.csv`'s rows.
+pub(crate) fn sonar(header: &Header) -> Result<Parse<SonarSample>, Error> {
+    let (t, range, truth) = (
+        header.column("t_s")?,
+        header.column("range_m")?,
+        header.optional_column("true_range_m"),
+    );
     let mut prev = None;
-    read_table(
-        path,
-        |header| {
-            Ok((
-                header.column("t_s")?,
-                header.column("range_m")?,
-                header.optional_column("true_range_m"),
-            ))
-        },
-        |&(t, range, truth), row| {
-            let t_s = row.f64(t)?;
-            row.check_time(t_s, &mut prev)?;
-            Ok(SonarSample {
-                t_s,
-                range_m: row.f64(range)?,
-                true_range_m: truth.map(|c| row.f64(c)).transpose()?,
-            })
-        },
-    )
+    Ok(Box::new(move |row| {
+        let t_s = row.f64(t)?;
+        row.check_time(t_s, &mut prev)?;
+        Ok(SonarSample {
+            t_s,
+            range_m: row.f64(range)?,
+            true_range_m: truth.map(|c| row.f64(c)).transpose()?,
+        })
+    }))
 }
 
-fn read_truth(path: &Path) -> Result<Vec<TruthSample>, Error> {
-    read_numbers(path, ["x_m", "y_m", "yaw_rad"], |t_s, [x, y, yaw]| {
+/// `truth.csv`'s rows.
+pub(crate) fn truth(header: &Header) -> Result<Parse<TruthSample>, Error> {
+    numbers(header, ["x_m", "y_m", "yaw_rad"], |t_s, [x, y, yaw]| {
         TruthSample {
             t_s,
             x_m: x,

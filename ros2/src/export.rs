@@ -19,7 +19,12 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 
-use hilsim_recording::{AtomicFile, LidarSample, OdometrySample, Recording};
+use std::convert::Infallible;
+
+use hilsim_recording::{
+    AtomicFile, CommandSample, LidarSample, Meta, OdometrySample, Recording, RecordingDir, Rows,
+    SampleSink, SonarSample, Tables, TruthSample,
+};
 use mcap::records::{MessageHeader, Metadata};
 use mcap::write::NoSeek;
 use mcap::{Compression, WriteOptions};
@@ -60,49 +65,6 @@ fn stamp_ns(t_s: f64) -> i64 {
     START_NS + (t_s * 1e9).round() as i64
 }
 
-/// Refuses a recording with a time that no stamp holds: `builtin_interfaces/Time`'s `sec` is an
-/// int32, so a stamp ends 2³¹ s (68 years) after the epoch, and a time beyond would wrap.
-///
-/// # Errors
-/// The table and row of the first such time.
-fn check_stamps(rec: &Recording) -> Result<(), Error> {
-    let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
-    let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
-    let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
-    let beyond = |table: &str, t: Box<dyn Iterator<Item = f64> + '_>| match t
-        .enumerate()
-        .find(|(_, t)| !(earliest..=latest).contains(t))
-    {
-        None => Ok(()),
-        Some((row, t_s)) => Err(Error::bag(
-            Path::new(table),
-            format!(
-                "row {}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
-                     int32: t_s from {earliest:.0} to {latest:.0} s)",
-                row + 1
-            ),
-        )),
-    };
-    beyond("commands.csv", Box::new(rec.commands.iter().map(|r| r.t_s)))?;
-    beyond(
-        "odometry.csv",
-        Box::new(rec.odometry.iter().flatten().map(|r| r.t_s)),
-    )?;
-    beyond(
-        "lidar.csv",
-        Box::new(rec.lidar.iter().flatten().map(|r| r.t_s)),
-    )?;
-    beyond(
-        "sonar.csv",
-        Box::new(rec.sonar.iter().flatten().map(|r| r.t_s)),
-    )?;
-    beyond(
-        "truth.csv",
-        Box::new(rec.truth.iter().flatten().map(|r| r.t_s)),
-    )?;
-    Ok(())
-}
-
 fn header(t_ns: i64, frame: &str) -> Header {
     Header {
         stamp: Time::from_ns(t_ns),
@@ -123,15 +85,20 @@ fn qos(latched: bool) -> String {
 }
 
 /// An MCAP file being written: channels by topic and a reused message buffer.
-struct Bag<W: Write> {
+struct Bag<'p, W: Write> {
     writer: mcap::Writer<NoSeek<W>>,
+    out: &'p Path,
     channels: BTreeMap<&'static str, u16>,
     sequence: u32,
     buffer: Vec<u8>,
     report: ExportReport,
 }
 
-impl<W: Write> Bag<W> {
+impl<W: Write> Bag<'_, W> {
+    fn fail(&self, err: mcap::McapError) -> Error {
+        Error::bag(self.out, err.to_string())
+    }
+
     fn channel(&mut self, topic: &'static str, type_name: &str) -> Result<u16, mcap::McapError> {
         if let Some(&id) = self.channels.get(topic) {
             return Ok(id);
@@ -150,6 +117,17 @@ impl<W: Write> Bag<W> {
     }
 
     fn write<T: serde::Serialize>(
+        &mut self,
+        topic: &'static str,
+        type_name: &str,
+        t_ns: i64,
+        message: &T,
+    ) -> Result<(), Error> {
+        self.write_message(topic, type_name, t_ns, message)
+            .map_err(|err| self.fail(err))
+    }
+
+    fn write_message<T: serde::Serialize>(
         &mut self,
         topic: &'static str,
         type_name: &str,
@@ -174,17 +152,6 @@ impl<W: Write> Bag<W> {
     }
 }
 
-/// One message to write, in time order.
-#[derive(Clone, Copy)]
-enum Event {
-    /// A revolution: the range of lidar rows.
-    Scan(usize, usize),
-    Sonar(usize),
-    Odometry(usize),
-    Command(usize),
-    Truth(usize),
-}
-
 /// Writes `recording` as an MCAP file at `out` (atomically: a temporary sibling renamed into
 /// place when complete), with `world` drawn as markers when given; chunks zstd-compressed (as
 /// `ros2 bag record --storage-preset-profile zstd_fast` writes them).
@@ -204,14 +171,14 @@ pub fn export(
 }
 
 /// What an export writes besides the recording.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct ExportOptions<'a> {
     /// The world, drawn as markers (`/world`).
     pub world: Option<&'a World>,
     /// zstd chunks (else plain, as rosbag2's default preset writes them).
     pub compress: bool,
-    /// A calibrated range for each lidar row (NaN for none), sent as `/scan_calibrated`.
-    pub calibrated_m: Option<&'a [f64]>,
+    /// A lidar reading's calibrated range (NaN for none), sent as `/scan_calibrated`.
+    pub calibrated: Option<&'a dyn Fn(&LidarSample) -> f64>,
 }
 
 impl Default for ExportOptions<'_> {
@@ -219,7 +186,7 @@ impl Default for ExportOptions<'_> {
         Self {
             world: None,
             compress: true,
-            calibrated_m: None,
+            calibrated: None,
         }
     }
 }
@@ -227,35 +194,117 @@ impl Default for ExportOptions<'_> {
 /// As [`export`], with the options given.
 ///
 /// # Errors
-/// The file cannot be written, or `calibrated_m` is not one range per lidar row.
+/// The file cannot be written.
 pub fn export_with(
     recording: &Recording,
     options: &ExportOptions<'_>,
     out: &Path,
 ) -> Result<ExportReport, Error> {
-    check_stamps(recording)?;
-    let rows = recording.lidar.as_ref().map_or(0, Vec::len);
-    if options.calibrated_m.is_some_and(|c| c.len() != rows) {
-        return Err(Error::bag(out, "calibrated ranges: not one per lidar row"));
+    let mut extent = Extent::default();
+    for c in &recording.commands {
+        extent.note_command(c);
     }
-    let (world, compress) = (options.world, options.compress);
+    recording
+        .odometry
+        .iter()
+        .flatten()
+        .for_each(|o| extent.note_odometry(o));
+    recording
+        .lidar
+        .iter()
+        .flatten()
+        .for_each(|r| extent.note_lidar(r));
+    recording
+        .sonar
+        .iter()
+        .flatten()
+        .for_each(|s| extent.note_sonar(s));
+    recording
+        .truth
+        .iter()
+        .flatten()
+        .for_each(|p| extent.note_truth(p));
+    fn rows<T: Copy>(table: Option<&[T]>) -> Stream<'_, T> {
+        Box::new(table.unwrap_or_default().iter().copied().map(Ok))
+    }
+    let source = Source {
+        meta: &recording.meta,
+        tables: Tables {
+            odometry: recording.odometry.is_some(),
+            lidar: recording.lidar.is_some(),
+            sonar: recording.sonar.is_some(),
+            truth: recording.truth.is_some(),
+        },
+        commands: rows(Some(&recording.commands)),
+        odometry: rows(recording.odometry.as_deref()),
+        odometry_again: rows(recording.odometry.as_deref()),
+        lidar: rows(recording.lidar.as_deref()),
+        sonar: rows(recording.sonar.as_deref()),
+        truth: rows(recording.truth.as_deref()),
+    };
+    write_file(source, &extent, options, out)
+}
+
+/// As [`export_with`], reading the recording directory as streams: its tables are checked
+/// first (a malformed one is the error [`Recording::read_dir`] gives, and nothing is written),
+/// then read again row by row, merged by time into the file. Memory is bounded whatever the
+/// recording's length: a few rows of each table, one revolution (at most
+/// [`MAX_SCAN_READINGS`] readings), the MCAP chunk being filled (768 KiB) and the file's index of
+/// its chunks (a few dozen bytes per chunk).
+///
+/// # Errors
+/// A table is malformed, or the file cannot be written.
+pub fn export_dir(
+    dir: &RecordingDir,
+    options: &ExportOptions<'_>,
+    out: &Path,
+) -> Result<ExportReport, Error> {
+    let mut extent = Extent::default();
+    dir.check(&mut extent)?;
+    fn rows<'a, T: 'a>(table: Option<Rows<T>>) -> Stream<'a, T> {
+        match table {
+            Some(rows) => Box::new(rows),
+            None => Box::new(std::iter::empty()),
+        }
+    }
+    let source = Source {
+        meta: dir.meta(),
+        tables: dir.tables(),
+        commands: Box::new(dir.commands()?),
+        odometry: rows(dir.odometry()?),
+        odometry_again: rows(dir.odometry()?),
+        lidar: rows(dir.lidar()?),
+        sonar: rows(dir.sonar()?),
+        truth: rows(dir.truth()?),
+    };
+    write_file(source, &extent, options, out)
+}
+
+fn write_file(
+    source: Source<'_>,
+    extent: &Extent,
+    options: &ExportOptions<'_>,
+    out: &Path,
+) -> Result<ExportReport, Error> {
+    extent.check_stamps()?;
     let file = AtomicFile::create(out)?;
     let fail = |err: mcap::McapError| Error::bag(out, err.to_string());
     let writer = WriteOptions::new()
         .profile("ros2")
         .library(concat!("hilsim ", env!("CARGO_PKG_VERSION")))
-        .compression(compress.then_some(Compression::Zstd))
+        .compression(options.compress.then_some(Compression::Zstd))
         .disable_seeking(true)
         .create(NoSeek::new(file))
         .map_err(fail)?;
     let mut bag = Bag {
         writer,
+        out,
         channels: BTreeMap::new(),
         sequence: 0,
         buffer: Vec::with_capacity(1 << 14),
         report: ExportReport::default(),
     };
-    write_all(&mut bag, recording, world, options.calibrated_m).map_err(fail)?;
+    write_all(&mut bag, source, extent, options)?;
     bag.writer.finish().map_err(fail)?;
     let report = std::mem::take(&mut bag.report);
     let file = bag.writer.into_inner().into_inner();
@@ -263,14 +312,290 @@ pub fn export_with(
     Ok(report)
 }
 
+/// A table's samples in time order.
+type Stream<'a, T> = Box<dyn Iterator<Item = Result<T, hilsim_recording::Error>> + 'a>;
+
+/// What an export reads: the metadata, which tables there are, and each table as a stream (the
+/// odometry twice: the messages, and the path the truth's transforms are placed on).
+struct Source<'a> {
+    meta: &'a Meta,
+    tables: Tables,
+    commands: Stream<'a, CommandSample>,
+    odometry: Stream<'a, OdometrySample>,
+    odometry_again: Stream<'a, OdometrySample>,
+    lidar: Stream<'a, LidarSample>,
+    sonar: Stream<'a, SonarSample>,
+    truth: Stream<'a, TruthSample>,
+}
+
+/// What the messages need from whole tables before the first is written: the scans' and the
+/// sonar's largest range (their `range_max`, `max_range`), where the odometry started, whether
+/// there is any truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Extent {
+    /// Rows seen of each table, in `TABLES`' order.
+    rows: [u64; 5],
+    /// The first row whose time no stamp holds: its table, its row (1-based) and its time.
+    beyond_stamp: Option<(&'static str, u64, f64)>,
+    range_max: f32,
+    sonar_max: f32,
+    first_odometry: Option<OdometrySample>,
+    truth: bool,
+}
+
+impl Default for Extent {
+    fn default() -> Self {
+        Self {
+            rows: [0; 5],
+            beyond_stamp: None,
+            range_max: 1.0,
+            sonar_max: 1.0,
+            first_odometry: None,
+            truth: false,
+        }
+    }
+}
+
+/// The tables, in the order [`Extent`] counts their rows.
+const TABLES: [&str; 5] = [
+    "commands.csv",
+    "odometry.csv",
+    "lidar.csv",
+    "sonar.csv",
+    "truth.csv",
+];
+
+impl Extent {
+    /// Counts a row of table `k` (of [`TABLES`]) and keeps the first whose time `t_s` a stamp
+    /// cannot hold.
+    fn note_time(&mut self, k: usize, t_s: f64) {
+        self.rows[k] += 1;
+        let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
+        let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
+        let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+        if self.beyond_stamp.is_none() && !(earliest..=latest).contains(&t_s) {
+            self.beyond_stamp = Some((TABLES[k], self.rows[k], t_s));
+        }
+    }
+
+    /// Refuses a recording with a time that a ROS 2 stamp cannot hold (its seconds are an
+    /// int32), naming the table and row, rather than wrapping it to another century.
+    fn check_stamps(&self) -> Result<(), Error> {
+        let Some((table, row, t_s)) = self.beyond_stamp else {
+            return Ok(());
+        };
+        let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
+        let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
+        let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+        Err(Error::bag(
+            Path::new(table),
+            format!(
+                "row {row}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
+                 int32: t_s from {earliest:.0} to {latest:.0} s)"
+            ),
+        ))
+    }
+
+    fn note_command(&mut self, c: &CommandSample) {
+        self.note_time(0, c.t_s);
+    }
+    fn note_odometry(&mut self, o: &OdometrySample) {
+        self.note_time(1, o.t_s);
+        self.first_odometry.get_or_insert(*o);
+    }
+    fn note_lidar(&mut self, r: &LidarSample) {
+        self.note_time(2, r.t_s);
+        if !r.invalid {
+            self.range_max = self.range_max.max(r.range_m as f32);
+        }
+    }
+    fn note_sonar(&mut self, s: &SonarSample) {
+        self.note_time(3, s.t_s);
+        self.sonar_max = self.sonar_max.max(s.range_m as f32);
+    }
+    fn note_truth(&mut self, p: &TruthSample) {
+        self.note_time(4, p.t_s);
+        self.truth = true;
+    }
+}
+
+impl SampleSink for Extent {
+    type Error = Infallible;
+    fn command(&mut self, c: &CommandSample) -> Result<(), Infallible> {
+        self.note_command(c);
+        Ok(())
+    }
+    fn odometry(&mut self, o: &OdometrySample) -> Result<(), Infallible> {
+        self.note_odometry(o);
+        Ok(())
+    }
+    fn lidar(&mut self, r: &LidarSample) -> Result<(), Infallible> {
+        self.note_lidar(r);
+        Ok(())
+    }
+    fn sonar(&mut self, s: &SonarSample) -> Result<(), Infallible> {
+        self.note_sonar(s);
+        Ok(())
+    }
+    fn truth(&mut self, p: &TruthSample) -> Result<(), Infallible> {
+        self.note_truth(p);
+        Ok(())
+    }
+}
+
+/// The most readings one `/scan` message holds: a longer revolution (rows of one `rev`) is sent
+/// as several scans. A Neato revolution has 360; the bound keeps what is held for a scan small
+/// whatever the file says.
+pub const MAX_SCAN_READINGS: usize = 100_000;
+
+/// A stream with its next sample taken out and looked at.
+struct Head<'a, T> {
+    next: Option<T>,
+    rest: Stream<'a, T>,
+}
+
+impl<'a, T> Head<'a, T> {
+    fn new(mut rest: Stream<'a, T>) -> Result<Self, Error> {
+        let next = rest.next().transpose()?;
+        Ok(Self { next, rest })
+    }
+
+    /// The next sample, the one after it taken out.
+    fn take(&mut self) -> Result<Option<T>, Error> {
+        let next = self.rest.next().transpose()?;
+        Ok(std::mem::replace(&mut self.next, next))
+    }
+}
+
+/// The lidar's rows a revolution at a time (consecutive rows of one `rev`, at most
+/// [`MAX_SCAN_READINGS`]).
+struct Revolutions<'a> {
+    rows: Head<'a, LidarSample>,
+    current: Vec<LidarSample>,
+}
+
+impl<'a> Revolutions<'a> {
+    fn new(rows: Stream<'a, LidarSample>) -> Result<Self, Error> {
+        let mut revolutions = Self {
+            rows: Head::new(rows)?,
+            current: Vec::new(),
+        };
+        revolutions.advance()?;
+        Ok(revolutions)
+    }
+
+    /// Moves to the next revolution (empty at the end).
+    fn advance(&mut self) -> Result<(), Error> {
+        self.current.clear();
+        while let Some(next) = &self.rows.next {
+            let full = self.current.len() == MAX_SCAN_READINGS;
+            if full
+                || self
+                    .current
+                    .first()
+                    .is_some_and(|first| first.rev != next.rev)
+            {
+                break;
+            }
+            self.current.extend(self.rows.take()?);
+        }
+        Ok(())
+    }
+}
+
+/// What the next message is made from.
+enum Next {
+    /// The revolution [`Merge::revolution`] holds.
+    Scan,
+    Command(CommandSample),
+    Odometry(OdometrySample),
+    Sonar(SonarSample),
+    Truth(TruthSample),
+}
+
+/// The tables merged by time, holding one row of each (one revolution of the lidar's) ahead.
+/// At one time a scan comes first, then a command, the odometry, the sonar and the truth (as a
+/// stable sort of the tables in that order would put them).
+struct Merge<'a> {
+    scans: Revolutions<'a>,
+    /// Whether the revolution held has been given out (it is left until the next call).
+    scan_given: bool,
+    commands: Head<'a, CommandSample>,
+    odometry: Head<'a, OdometrySample>,
+    sonar: Head<'a, SonarSample>,
+    truth: Head<'a, TruthSample>,
+}
+
+impl<'a> Merge<'a> {
+    fn new(
+        lidar: Stream<'a, LidarSample>,
+        commands: Stream<'a, CommandSample>,
+        odometry: Stream<'a, OdometrySample>,
+        sonar: Stream<'a, SonarSample>,
+        truth: Stream<'a, TruthSample>,
+    ) -> Result<Self, Error> {
+        Ok(Self {
+            scans: Revolutions::new(lidar)?,
+            scan_given: false,
+            commands: Head::new(commands)?,
+            odometry: Head::new(odometry)?,
+            sonar: Head::new(sonar)?,
+            truth: Head::new(truth)?,
+        })
+    }
+
+    /// The revolution of the last [`Next::Scan`].
+    fn revolution(&self) -> &[LidarSample] {
+        &self.scans.current
+    }
+
+    /// The next message's time and what it is made from; `None` at the end of every table.
+    fn next(&mut self) -> Result<Option<(f64, Next)>, Error> {
+        if std::mem::take(&mut self.scan_given) {
+            self.scans.advance()?;
+        }
+        let times = [
+            self.scans.current.first().map(|s| s.t_s),
+            self.commands.next.map(|c| c.t_s),
+            self.odometry.next.map(|o| o.t_s),
+            self.sonar.next.map(|s| s.t_s),
+            self.truth.next.map(|p| p.t_s),
+        ];
+        // The earliest time; a tie goes to the first in `times`' order.
+        let mut earliest: Option<(usize, f64)> = None;
+        for (i, t) in times.into_iter().enumerate() {
+            if let Some(t) = t {
+                if earliest.is_none_or(|(_, e)| t.total_cmp(&e).is_lt()) {
+                    earliest = Some((i, t));
+                }
+            }
+        }
+        let Some((which, t_s)) = earliest else {
+            return Ok(None);
+        };
+        let next = match which {
+            0 => {
+                self.scan_given = true;
+                Some(Next::Scan)
+            }
+            1 => self.commands.take()?.map(Next::Command),
+            2 => self.odometry.take()?.map(Next::Odometry),
+            3 => self.sonar.take()?.map(Next::Sonar),
+            _ => self.truth.take()?.map(Next::Truth),
+        };
+        Ok(next.map(|next| (t_s, next)))
+    }
+}
+
 fn write_all<W: Write>(
-    bag: &mut Bag<W>,
-    rec: &Recording,
-    world: Option<&World>,
-    calibrated_m: Option<&[f64]>,
-) -> Result<(), mcap::McapError> {
+    bag: &mut Bag<'_, W>,
+    source: Source<'_>,
+    extent: &Extent,
+    options: &ExportOptions<'_>,
+) -> Result<(), Error> {
+    let (world, calibrated) = (options.world, options.calibrated);
     let mut metadata = BTreeMap::from([(START_KEY.to_string(), START_NS.to_string())]);
-    if let Some(first) = rec.odometry.as_ref().and_then(|o| o.first()) {
+    if let Some(first) = extent.first_odometry {
         for (key, value) in ODOMETRY_START_KEYS
             .iter()
             .zip([first.left_m, first.right_m])
@@ -278,25 +603,26 @@ fn write_all<W: Write>(
             metadata.insert((*key).to_string(), value.to_string());
         }
     }
-    bag.writer.write_metadata(&Metadata {
-        name: START_METADATA.to_string(),
-        metadata,
-    })?;
-    let truth = rec.truth.as_deref().unwrap_or_default();
-    let odometry = rec.odometry.as_deref().unwrap_or_default();
-    let wheel_base = rec.meta.robot.wheel_base_m;
+    bag.writer
+        .write_metadata(&Metadata {
+            name: START_METADATA.to_string(),
+            metadata,
+        })
+        .map_err(|err| bag.fail(err))?;
+    let meta = source.meta;
+    let wheel_base = meta.robot.wheel_base_m;
     // The frames as REP 105 chains them, one tree that a viewer shows in `map`: map → odom
     // (where the odometry started, from the truth) → base_link (the odometry) → laser, sonar
     // (the mounts). Without odometry the truth places base_link in map; without truth, odom is
     // put at map's origin; with neither, base_link is.
     let mut fixed = Vec::new();
-    match (truth.is_empty(), odometry.is_empty()) {
+    match (!extent.truth, extent.first_odometry.is_none()) {
         (true, false) => fixed.push(transform(START_NS, "map", "odom", 0.0, 0.0, 0.0)),
         (true, true) => fixed.push(transform(START_NS, "map", "base_link", 0.0, 0.0, 0.0)),
         (false, _) => {}
     }
-    if rec.lidar.is_some() {
-        let lidar = rec.meta.lidar.unwrap_or_default();
+    if source.tables.lidar {
+        let lidar = meta.lidar.unwrap_or_default();
         fixed.push(transform(
             START_NS,
             "base_link",
@@ -306,10 +632,9 @@ fn write_all<W: Write>(
             lidar.yaw_rad(),
         ));
     }
-    if rec.sonar.is_some() {
+    if source.tables.sonar {
         // A sonar without a mount in meta.toml is at the robot's centre, facing forward.
-        let (x, y, yaw_deg) = rec
-            .meta
+        let (x, y, yaw_deg) = meta
             .sonar
             .as_ref()
             .map_or((0.0, 0.0, 0.0), |s| (s.x_m, s.y_m, s.yaw_deg));
@@ -338,35 +663,31 @@ fn write_all<W: Write>(
             &markers(world),
         )?;
     }
-    let events = events(rec);
-    let lidar = rec.lidar.as_deref().unwrap_or_default();
-    let sonar = rec.sonar.as_deref().unwrap_or_default();
-    let range_max = lidar
-        .iter()
-        .filter(|s| !s.invalid)
-        .map(|s| s.range_m as f32)
-        .fold(1.0f32, f32::max);
-    let sonar_max = sonar
-        .iter()
-        .map(|s| s.range_m as f32)
-        .fold(1.0f32, f32::max);
-    let sonar_fov = rec
-        .meta
+    let (range_max, sonar_max) = (extent.range_max, extent.sonar_max);
+    let sonar_fov = meta
         .sonar
         .as_ref()
         .map_or(0.0, |s| (2.0 * s.half_angle_deg).to_radians() as f32);
-    let odometry_path = OdometryPath::new(odometry, wheel_base);
+    let mut odometry_path = OdometryPath::new(source.odometry_again, wheel_base)?;
     let mut dead_reckoning = DeadReckoning::default();
-    for (t_s, event) in events {
+    let mut merge = Merge::new(
+        source.lidar,
+        source.commands,
+        source.odometry,
+        source.sonar,
+        source.truth,
+    )?;
+    while let Some((t_s, next)) = merge.next()? {
         let t_ns = stamp_ns(t_s);
-        match event {
-            Event::Scan(from, to) => {
-                let mut scan = laser_scan(&lidar[from..to], range_max);
+        match next {
+            Next::Scan => {
+                let rev = merge.revolution();
+                let mut scan = laser_scan(rev, range_max);
                 bag.write("/scan", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
-                if let Some(calibrated) = calibrated_m {
+                if let Some(calibrated) = calibrated {
                     // The same revolution, each reading replaced by its calibrated range.
-                    let reported = laser_scan_ranges(&lidar[from..to], |i| {
-                        let d = calibrated[from + i];
+                    let reported = laser_scan_ranges(rev, |i| {
+                        let d = calibrated(&rev[i]);
                         if d.is_finite() {
                             d as f32
                         } else {
@@ -378,19 +699,7 @@ fn write_all<W: Write>(
                     bag.write("/scan_calibrated", "sensor_msgs/msg/LaserScan", t_ns, &scan)?;
                 }
             }
-            Event::Sonar(i) => {
-                let range = Range {
-                    header: header(t_ns, "sonar"),
-                    radiation_type: 0,
-                    field_of_view: sonar_fov,
-                    min_range: 0.0,
-                    max_range: sonar_max,
-                    range: sonar[i].range_m as f32,
-                };
-                bag.write("/sonar", "sensor_msgs/msg/Range", t_ns, &range)?;
-            }
-            Event::Command(i) => {
-                let c = &rec.commands[i];
+            Next::Command(c) => {
                 let twist = TwistStamped {
                     header: header(t_ns, "base_link"),
                     twist: twist(
@@ -400,8 +709,7 @@ fn write_all<W: Write>(
                 };
                 bag.write("/cmd_vel", "geometry_msgs/msg/TwistStamped", t_ns, &twist)?;
             }
-            Event::Odometry(i) => {
-                let o = &odometry[i];
+            Next::Odometry(o) => {
                 let (pose, velocity) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
                 let mut message = Odometry {
                     header: header(t_ns, "odom"),
@@ -422,8 +730,18 @@ fn write_all<W: Write>(
                     },
                 )?;
             }
-            Event::Truth(i) => {
-                let p = &truth[i];
+            Next::Sonar(s) => {
+                let range = Range {
+                    header: header(t_ns, "sonar"),
+                    radiation_type: 0,
+                    field_of_view: sonar_fov,
+                    min_range: 0.0,
+                    max_range: sonar_max,
+                    range: s.range_m as f32,
+                };
+                bag.write("/sonar", "sensor_msgs/msg/Range", t_ns, &range)?;
+            }
+            Next::Truth(p) => {
                 let pose = PoseStamped {
                     header: header(t_ns, "map"),
                     pose: pose(p.x_m, p.y_m, p.yaw_rad),
@@ -437,7 +755,7 @@ fn write_all<W: Write>(
                 // base_link is in map where the truth says: through odom when there is
                 // odometry (odom's place is the truth composed with the inverse of the
                 // odometry's pose at that time, as tf2 interpolates it).
-                let tf = match odometry_path.at(p.t_s) {
+                let tf = match odometry_path.at(p.t_s)? {
                     Some(odom_pose) => {
                         // odom's origin in base_link, then in map through the truth.
                         let origin = hilsim_recording::Pose::default().relative_to(&odom_pose);
@@ -459,39 +777,6 @@ fn write_all<W: Write>(
         }
     }
     Ok(())
-}
-
-/// Every message's time and what it is, in time order (a stable sort: ties keep table order).
-fn events(rec: &Recording) -> Vec<(f64, Event)> {
-    let mut events = Vec::new();
-    if let Some(lidar) = &rec.lidar {
-        let mut from = 0;
-        for i in 1..=lidar.len() {
-            if i == lidar.len() || lidar[i].rev != lidar[from].rev {
-                events.push((lidar[from].t_s, Event::Scan(from, i)));
-                from = i;
-            }
-        }
-    }
-    let table = |n: usize, t: &dyn Fn(usize) -> f64, e: fn(usize) -> Event| {
-        (0..n).map(|i| (t(i), e(i))).collect::<Vec<_>>()
-    };
-    events.extend(table(
-        rec.commands.len(),
-        &|i| rec.commands[i].t_s,
-        Event::Command,
-    ));
-    if let Some(o) = &rec.odometry {
-        events.extend(table(o.len(), &|i| o[i].t_s, Event::Odometry));
-    }
-    if let Some(s) = &rec.sonar {
-        events.extend(table(s.len(), &|i| s[i].t_s, Event::Sonar));
-    }
-    if let Some(p) = &rec.truth {
-        events.extend(table(p.len(), &|i| p[i].t_s, Event::Truth));
-    }
-    events.sort_by(|a, b| a.0.total_cmp(&b.0));
-    events
 }
 
 /// A revolution's angles unwrapped into one increasing turn from the first, degrees from it,
@@ -639,42 +924,53 @@ impl DeadReckoning {
     }
 }
 
-/// The odometry's poses (dead-reckoned as `/odom` sends them) at each row's time.
-struct OdometryPath {
-    times_s: Vec<f64>,
-    poses: Vec<hilsim_recording::Pose>,
+/// The odometry's poses (dead-reckoned as `/odom` sends them), read along as the truth's times
+/// advance: the two rows around the latest time asked.
+struct OdometryPath<'a> {
+    rows: Head<'a, OdometrySample>,
+    dead_reckoning: DeadReckoning,
+    wheel_base: f64,
+    /// The last row at or before the time asked, and the first after it, with their poses.
+    before: Option<(f64, hilsim_recording::Pose)>,
+    after: Option<(f64, hilsim_recording::Pose)>,
 }
 
-impl OdometryPath {
-    fn new(odometry: &[OdometrySample], wheel_base: f64) -> Self {
-        let mut dead_reckoning = DeadReckoning::default();
-        let (times_s, poses) = odometry
-            .iter()
-            .map(|o| {
-                let (pose, _) = dead_reckoning.step(o.t_s, o.left_m, o.right_m, wheel_base);
-                let (x, y) = (pose.position.x, pose.position.y);
-                (
-                    o.t_s,
-                    hilsim_recording::Pose::new(x, y, pose.orientation.yaw()),
-                )
-            })
-            .unzip();
-        Self { times_s, poses }
+impl<'a> OdometryPath<'a> {
+    fn new(odometry: Stream<'a, OdometrySample>, wheel_base: f64) -> Result<Self, Error> {
+        Ok(Self {
+            rows: Head::new(odometry)?,
+            dead_reckoning: DeadReckoning::default(),
+            wheel_base,
+            before: None,
+            after: None,
+        })
     }
 
     /// The pose at `t_s` as tf2 interpolates between two stamped transforms: the position
     /// linearly, the yaw along the shorter way (a quaternion slerp about z), which is
     /// [`hilsim_recording::Pose::lerp`]; the first or last pose outside the rows' times. `None`
-    /// without odometry.
-    fn at(&self, t_s: f64) -> Option<hilsim_recording::Pose> {
-        let after = self.times_s.partition_point(|&t| t <= t_s);
-        let last = self.poses.len().checked_sub(1)?;
-        if after == 0 || after > last {
-            return Some(self.poses[after.min(last)]);
+    /// without odometry. Times asked must not go backwards (the truth's rows do not).
+    fn at(&mut self, t_s: f64) -> Result<Option<hilsim_recording::Pose>, Error> {
+        loop {
+            if self.after.is_none() {
+                let Some(o) = self.rows.take()? else { break };
+                let (pose, _) =
+                    self.dead_reckoning
+                        .step(o.t_s, o.left_m, o.right_m, self.wheel_base);
+                let (x, y) = (pose.position.x, pose.position.y);
+                let pose = hilsim_recording::Pose::new(x, y, pose.orientation.yaw());
+                self.after = Some((o.t_s, pose));
+            }
+            match self.after {
+                Some((t, _)) if t <= t_s => self.before = self.after.take(),
+                _ => break,
+            }
         }
-        let (t0, t1) = (self.times_s[after - 1], self.times_s[after]);
-        let f = (t_s - t0) / (t1 - t0);
-        Some(self.poses[after - 1].lerp(&self.poses[after], f))
+        Ok(match (self.before, self.after) {
+            (Some((t0, p0)), Some((t1, p1))) => Some(p0.lerp(&p1, (t_s - t0) / (t1 - t0))),
+            (Some((_, p)), None) | (None, Some((_, p))) => Some(p),
+            (None, None) => None,
+        })
     }
 }
 
@@ -778,7 +1074,8 @@ mod tests {
     }
     use crate::bag::{self, Item};
     use crate::cdr::decode;
-    use hilsim_recording::{Meta, Mount, SonarSample, TruthSample};
+    use hilsim_recording::{Meta, Mount};
+    use std::cell::Cell;
 
     /// Every transform of a file (`/tf` and `/tf_static`), and its `/odom` messages.
     fn transforms_and_odometry(path: &Path) -> (Vec<TransformStamped>, Vec<Odometry>) {
@@ -948,5 +1245,165 @@ mod tests {
                 assert!(close && yaw_error.abs() < 1e-9, "{p:?}: {in_map:?}");
             }
         }
+    }
+
+    /// A recording with every table: the arc of [`run`], three revolutions, commands at times
+    /// the other tables share (ties), a sonar.
+    fn full() -> Recording {
+        let mut rec = run(true, true);
+        rec.lidar = Some(
+            (0..3u32)
+                .flat_map(|rev| {
+                    (0..360u32).map(move |a| LidarSample {
+                        t_s: f64::from(rev) * 0.2 + f64::from(a) * 0.2 / 360.0,
+                        rev: rev.into(),
+                        angle_deg: f64::from(a),
+                        range_m: 1.0 + f64::from(a) / 100.0,
+                        strength: 100,
+                        invalid: a % 7 == 0,
+                        warning: false,
+                        true_range_m: None,
+                    })
+                })
+                .collect(),
+        );
+        rec.commands = (0..5)
+            .map(|i| CommandSample {
+                t_s: f64::from(i) * 0.1,
+                left_mps: 0.1,
+                right_mps: 0.12,
+            })
+            .collect();
+        rec
+    }
+
+    /// The streamed export of a directory writes the very bytes of the export of the same
+    /// recording held in memory (with the calibrated scans too).
+    #[test]
+    fn a_directory_exports_the_bytes_of_its_recording_in_memory() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = full();
+        let path = dir.path().join("run");
+        rec.write_dir(&path).unwrap();
+        let calibrated = |s: &LidarSample| if s.invalid { f64::NAN } else { 0.9 * s.range_m };
+        let world = World {
+            walls: vec![[[0.0, 0.0], [1.0, 0.0]]],
+            ..World::default()
+        };
+        let options = ExportOptions {
+            world: Some(&world),
+            calibrated: Some(&calibrated),
+            ..ExportOptions::default()
+        };
+        let (held, streamed) = (
+            dir.path().join("held.mcap"),
+            dir.path().join("streamed.mcap"),
+        );
+        let report = export_with(&rec, &options, &held).unwrap();
+        let run = RecordingDir::open(&path).unwrap();
+        assert_eq!(export_dir(&run, &options, &streamed).unwrap(), report);
+        assert_eq!(report.messages["/scan"], 3);
+        assert_eq!(
+            std::fs::read(&held).unwrap(),
+            std::fs::read(&streamed).unwrap()
+        );
+    }
+
+    /// A table's stream that counts the rows taken from it.
+    fn counted<'a, T: Copy + 'a>(rows: &'a [T], taken: &'a Cell<usize>) -> Stream<'a, T> {
+        Box::new(rows.iter().map(move |&row| {
+            taken.set(taken.get() + 1);
+            Ok(row)
+        }))
+    }
+
+    /// Merging the tables by time holds one row of each table ahead of the messages given
+    /// out (of the lidar, a revolution and a row), in time order: what an export holds does not
+    /// grow with the tables.
+    #[test]
+    fn the_merge_holds_one_row_of_each_table_ahead() {
+        let rec = full();
+        let taken: [Cell<usize>; 5] = Default::default();
+        let mut given = [0usize; 5];
+        let mut merge = Merge::new(
+            counted(rec.lidar.as_deref().unwrap(), &taken[0]),
+            counted(&rec.commands, &taken[1]),
+            counted(rec.odometry.as_deref().unwrap(), &taken[2]),
+            counted(rec.sonar.as_deref().unwrap(), &taken[3]),
+            counted(rec.truth.as_deref().unwrap(), &taken[4]),
+        )
+        .unwrap();
+        let mut last = f64::NEG_INFINITY;
+        while let Some((t_s, next)) = merge.next().unwrap() {
+            assert!(t_s >= last, "{t_s} after {last}");
+            last = t_s;
+            match next {
+                Next::Scan => given[0] += merge.revolution().len(),
+                Next::Command(_) => given[1] += 1,
+                Next::Odometry(_) => given[2] += 1,
+                Next::Sonar(_) => given[3] += 1,
+                Next::Truth(_) => given[4] += 1,
+            }
+            // A revolution held besides the row after it.
+            let ahead = [360 + 1, 1, 1, 1, 1];
+            for ((taken, given), ahead) in taken.iter().zip(given).zip(ahead) {
+                let taken = taken.get();
+                assert!(taken <= given + ahead, "{taken} taken, {given} given");
+            }
+        }
+        let rows = [360 * 3, 5, 41, 1, 41];
+        assert_eq!(given, rows);
+    }
+
+    /// A revolution longer than [`MAX_SCAN_READINGS`] is sent as several scans, so what is held
+    /// for one is bounded whatever the file says.
+    #[test]
+    fn a_revolution_longer_than_the_bound_is_sent_as_several_scans() {
+        let taken = Cell::new(0);
+        let rows = 2 * MAX_SCAN_READINGS + 5;
+        let lidar = (0..rows).map(|i| {
+            taken.set(taken.get() + 1);
+            Ok(LidarSample {
+                t_s: i as f64 * 1e-6,
+                rev: 0,
+                angle_deg: (i % 360) as f64,
+                range_m: 1.0,
+                strength: 1,
+                invalid: false,
+                warning: false,
+                true_range_m: None,
+            })
+        });
+        let mut revolutions = Revolutions::new(Box::new(lidar)).unwrap();
+        let mut sizes = Vec::new();
+        while !revolutions.current.is_empty() {
+            assert!(taken.get() <= sizes.iter().sum::<usize>() + MAX_SCAN_READINGS + 1);
+            sizes.push(revolutions.current.len());
+            revolutions.advance().unwrap();
+        }
+        assert_eq!(sizes, [MAX_SCAN_READINGS, MAX_SCAN_READINGS, 5]);
+    }
+
+    /// A malformed table stops a streamed export before anything is written, with the error a
+    /// reader of the whole recording gives (a row of the wrong width before an earlier bad
+    /// value), not the first the merge would meet.
+    #[test]
+    fn a_malformed_table_is_read_dirs_error_and_nothing_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run");
+        full().write_dir(&path).unwrap();
+        let sonar = "t_s,range_m\n0,1\n0.1,abc\n0.2\n";
+        std::fs::write(path.join("sonar.csv"), sonar).unwrap();
+        let whole = Recording::read_dir(&path).unwrap_err().to_string();
+        assert!(whole.ends_with("sonar.csv:4: expected 2 fields (t_s,range_m), found 1"));
+        let out = dir.path().join("run.mcap");
+        let run = RecordingDir::open(&path).unwrap();
+        let err = export_dir(&run, &ExportOptions::default(), &out).unwrap_err();
+        assert_eq!(err.to_string(), whole);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "only the recording"
+        );
     }
 }

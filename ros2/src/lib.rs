@@ -37,7 +37,10 @@ pub const MCAP_FILE: hilsim_recording::FileKind = hilsim_recording::FileKind {
     name: "an MCAP file",
     starts_with: b"\x89MCAP0\r\n",
 };
-pub use export::{export, export_with, ExportOptions, ExportReport, World, START_NS};
+pub use export::{
+    export, export_dir, export_with, ExportOptions, ExportReport, World, MAX_SCAN_READINGS,
+    START_NS,
+};
 pub use import::{
     angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,
 };

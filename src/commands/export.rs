@@ -1,13 +1,17 @@
 //! `hilsim export RECORDING --mcap OUT [--scenario FILE] [--calibration FILE]`: a recording as
 //! ROS 2 messages in an MCAP file (and the `--mcap OUT` of `record` and `run`).
 
+use std::convert::Infallible;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use hilsim_calibrator::landmarks::Inverse;
 use hilsim_calibrator::Sensor;
-use hilsim_recording::{check_output_file, OutputTarget, Recording};
+use hilsim_recording::{
+    check_output_file, CommandSample, LidarSample, OdometrySample, OutputTarget, Recording,
+    RecordingDir, SampleSink, SonarSample, TruthSample,
+};
 use hilsim_sim::Scenario;
 
 #[derive(Debug, clap::Args)]
@@ -40,17 +44,29 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
         .as_deref()
         .map(super::read_calibration)
         .transpose()?;
-    let recording = Recording::read_dir(&args.recording)?;
-    let calibrated = match (&calibration, args.calibration.as_deref()) {
+    let recording = RecordingDir::open(&args.recording)?;
+    let inverse = match (&calibration, args.calibration.as_deref()) {
         (Some(calibration), Some(path)) => Some(calibrated_ranges(&recording, calibration, path)?),
         _ => None,
     };
+    // An invalid reading has no calibrated range.
+    let calibrated = inverse.map(|inverse| {
+        move |s: &LidarSample| {
+            if s.invalid {
+                f64::NAN
+            } else {
+                inverse.distance(s.range_m)
+            }
+        }
+    });
     let options = hilsim_ros2::ExportOptions {
         world: world.as_ref(),
-        calibrated_m: calibrated.as_deref(),
+        calibrated: calibrated
+            .as_ref()
+            .map(|f| f as &dyn Fn(&LidarSample) -> f64),
         ..hilsim_ros2::ExportOptions::default()
     };
-    hilsim_ros2::export_with(&recording, &options, &args.mcap)?;
+    hilsim_ros2::export_dir(&recording, &options, &args.mcap)?;
     // Written to standard output, the file is the output: the line saying so goes beside it.
     if OutputTarget::of(&args.mcap).is_ok_and(|t| t == OutputTarget::Stdout) {
         eprintln!("wrote {}", args.mcap.display());
@@ -60,32 +76,60 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
     Ok(())
 }
 
-/// Each lidar reading's distance by the calibration's lidar model (the distance whose mean
-/// reading it is); NaN for an invalid reading.
+/// The calibration's lidar model inverted: a reading's distance (the distance whose mean
+/// reading it is), searched up to past the farthest reading of the recording.
 fn calibrated_ranges(
-    recording: &Recording,
+    recording: &RecordingDir,
     calibration: &hilsim_calibrator::Calibration,
     path: &Path,
-) -> Result<Vec<f64>> {
+) -> Result<Inverse> {
+    // The recording is checked (as a whole read would, its errors first) on the way.
+    let mut farthest = Farthest(1.0);
+    recording.check(&mut farthest)?;
     let model = calibration
         .sensors
         .get(&Sensor::Lidar)
         .with_context(|| format!("{}: no lidar model", path.display()))?;
-    let lidar = recording.lidar.as_deref().unwrap_or_default();
     // Search up to past the farthest reading: a lidar model is fitted below 100 m.
-    let farthest = lidar.iter().map(|s| s.range_m).fold(1.0, f64::max);
-    let inverse = Inverse::new(&model.alpha, [0.0, 2.0 * farthest + 100.0])
-        .with_context(|| format!("{}: the lidar model", path.display()))?;
-    Ok(lidar
-        .iter()
-        .map(|s| {
-            if s.invalid {
-                f64::NAN
-            } else {
-                inverse.distance(s.range_m)
-            }
-        })
-        .collect())
+    Inverse::new(&model.alpha, [0.0, 2.0 * farthest.0 + 100.0])
+        .with_context(|| format!("{}: the lidar model", path.display()))
+}
+
+/// The farthest lidar reading, at least 1 m.
+struct Farthest(f64);
+
+impl SampleSink for Farthest {
+    type Error = Infallible;
+    fn lidar(&mut self, r: &LidarSample) -> Result<(), Infallible> {
+        self.0 = self.0.max(r.range_m);
+        Ok(())
+    }
+    fn command(&mut self, _: &CommandSample) -> Result<(), Infallible> {
+        Ok(())
+    }
+    fn odometry(&mut self, _: &OdometrySample) -> Result<(), Infallible> {
+        Ok(())
+    }
+    fn sonar(&mut self, _: &SonarSample) -> Result<(), Infallible> {
+        Ok(())
+    }
+    fn truth(&mut self, _: &TruthSample) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// Writes the recording directory `dir` as MCAP at `path`, reading it as streams.
+pub fn write_mcap_of_dir(
+    dir: &Path,
+    world: Option<&hilsim_ros2::World>,
+    path: &Path,
+) -> Result<()> {
+    let options = hilsim_ros2::ExportOptions {
+        world,
+        ..hilsim_ros2::ExportOptions::default()
+    };
+    hilsim_ros2::export_dir(&RecordingDir::open(dir)?, &options, path)?;
+    Ok(())
 }
 
 /// Checks, before any work, that `path` may take an MCAP file: nothing there, a previous MCAP

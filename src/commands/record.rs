@@ -21,10 +21,9 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     emulation.record_into(&mut sink)?;
     sink.finish()?;
     if let Some(mcap) = &args.mcap {
-        // The recording as written (it streamed to disk, so it is read back).
+        // The recording as written (it streamed to disk, so it is read back, as streams).
         let world = super::export::world(&scenario);
-        let recording = hilsim_recording::Recording::read_dir(&args.out)?;
-        super::export::write_mcap(&recording, Some(&world), mcap)?;
+        super::export::write_mcap_of_dir(&args.out, Some(&world), mcap)?;
     }
     Ok(())
 }

@@ -113,3 +113,26 @@ mod tests {
         assert_eq!(size(1000), "1000 bytes");
     }
 }
+
+/// Which directory `dir` is now (device and inode). A writer replaces a recording by renaming a
+/// whole new directory over it, so a reader that opens its files one after another by path can
+/// take some from the old recording and some from the new: a reader notes the identity before
+/// its first open and checks it after its last ([`check_same_dir`]), which catches every mix.
+pub(crate) fn dir_identity(dir: &Path) -> Result<(u64, u64), Error> {
+    use std::os::unix::fs::MetadataExt;
+    let meta = fs::metadata(dir).map_err(|err| Error::io(dir, err))?;
+    Ok((meta.dev(), meta.ino()))
+}
+
+/// Refuses what was read from `dir` when `dir` is no longer the directory it was
+/// (`identity`, from [`dir_identity`]) once every file was opened.
+pub(crate) fn check_same_dir(dir: &Path, identity: (u64, u64)) -> Result<(), Error> {
+    match dir_identity(dir) {
+        Ok(now) if now == identity => Ok(()),
+        _ => Err(Error::format(
+            dir,
+            None,
+            "was replaced by another recording while it was being read; read it again",
+        )),
+    }
+}

@@ -26,16 +26,19 @@ impl Recording {
         if !dir.is_dir() {
             return Err(Error::format(dir, None, "not a recording directory"));
         }
+        let identity = input::dir_identity(dir)?;
         let meta = read_meta(&dir.join("meta.toml"))?;
         let commands = read_whole(&dir.join("commands.csv"), commands)?;
-        Ok(Self {
+        let recording = Self {
             meta,
             commands,
             odometry: optional(dir, "odometry.csv", odometry)?,
             lidar: optional(dir, "lidar.csv", lidar)?,
             sonar: optional(dir, "sonar.csv", sonar)?,
             truth: optional(dir, "truth.csv", truth)?,
-        })
+        };
+        input::check_same_dir(dir, identity)?;
+        Ok(recording)
     }
 }
 

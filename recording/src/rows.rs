@@ -6,6 +6,7 @@ use std::convert::Infallible;
 use std::path::{Path, PathBuf};
 
 use crate::csv::{read_table, Header, Parse, TableRows};
+use crate::input;
 use crate::read::{self, is_present};
 use crate::{
     CommandSample, Error, LidarSample, Meta, OdometrySample, SampleSink, SonarSample, Tables,
@@ -29,6 +30,8 @@ use crate::{
 #[derive(Debug, Clone)]
 pub struct RecordingDir {
     path: PathBuf,
+    /// The directory's device and inode when opened.
+    identity: (u64, u64),
     meta: Meta,
     tables: Tables,
 }
@@ -44,10 +47,12 @@ impl RecordingDir {
         if !dir.is_dir() {
             return Err(Error::format(dir, None, "not a recording directory"));
         }
+        let identity = input::dir_identity(dir)?;
         let meta = read::read_meta(&dir.join("meta.toml"))?;
         let present = |name: &str| is_present(&dir.join(name));
         Ok(Self {
             path: dir.to_path_buf(),
+            identity,
             meta,
             tables: Tables {
                 odometry: present("odometry.csv"),
@@ -106,7 +111,7 @@ impl RecordingDir {
         if self.tables.truth {
             read_table(&path("truth.csv"), read::truth, |p| ok(sink.truth(&p)))?;
         }
-        Ok(())
+        self.still_the_same()
     }
 
     /// `commands.csv`, one row at a time.
@@ -114,7 +119,9 @@ impl RecordingDir {
     /// # Errors
     /// The file cannot be opened, or its header lacks a column.
     pub fn commands(&self) -> Result<Rows<CommandSample>, Error> {
-        Rows::open(&self.path.join("commands.csv"), read::commands)
+        let rows = Rows::open(&self.path.join("commands.csv"), read::commands)?;
+        self.still_the_same()?;
+        Ok(rows)
     }
 
     /// `odometry.csv`, one row at a time; `None` without one.
@@ -155,9 +162,17 @@ impl RecordingDir {
         name: &str,
         parse: fn(&Header) -> Result<Parse<T>, Error>,
     ) -> Result<Option<Rows<T>>, Error> {
-        present
+        let rows = present
             .then(|| Rows::open(&self.path.join(name), parse))
-            .transpose()
+            .transpose()?;
+        self.still_the_same()?;
+        Ok(rows)
+    }
+
+    /// Refuses to go on when the directory is no longer the one opened: a table opened after
+    /// another recording was put in its place would be that recording's.
+    fn still_the_same(&self) -> Result<(), Error> {
+        input::check_same_dir(&self.path, self.identity)
     }
 }
 
@@ -242,5 +257,34 @@ mod tests {
             err.ends_with("sonar.csv:3: column `range_m`: expected a finite number, found `abc`"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_recording_replaced_while_it_is_read_is_refused_not_mixed() {
+        let dir = tempfile::tempdir().unwrap();
+        let run_dir = dir.path().join("run");
+        let mut first = Recording::new(crate::Meta::default());
+        first.commands.push(CommandSample {
+            t_s: 0.0,
+            left_mps: 0.1,
+            right_mps: 0.1,
+        });
+        first.write_dir(&run_dir).unwrap();
+        let run = RecordingDir::open(&run_dir).unwrap();
+        // Another writer puts a new recording in its place before the tables are read.
+        let mut second = first.clone();
+        second.commands[0].left_mps = 0.2;
+        second.write_dir(&run_dir).unwrap();
+        let err = run.commands().err().expect("refused").to_string();
+        assert!(err.contains("was replaced by another recording"), "{err}");
+        let err = run
+            .check(&mut Recording::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("was replaced by another recording"), "{err}");
+        // Opened anew, it is the new one, whole.
+        let again = RecordingDir::open(&run_dir).unwrap();
+        let commands: Vec<_> = again.commands().unwrap().collect::<Result<_, _>>().unwrap();
+        assert_eq!(commands, second.commands);
     }
 }

@@ -288,7 +288,11 @@ fn write_file(
 ) -> Result<ExportReport, Error> {
     extent.check_stamps()?;
     let file = AtomicFile::create(out)?;
-    let fail = |err: mcap::McapError| Error::bag(out, err.to_string());
+    // The system's words ("No space left on device"), not the mcap crate's wrapper's.
+    let fail = |err: mcap::McapError| match err {
+        mcap::McapError::Io(io) => Error::bag(out, io.to_string()),
+        other => Error::bag(out, other.to_string()),
+    };
     let writer = WriteOptions::new()
         .profile("ros2")
         .library(concat!("hilsim ", env!("CARGO_PKG_VERSION")))

@@ -27,7 +27,7 @@ impl Report {
         writeln!(
             out,
             "scenario {} (seed {}): {:.2} s simulated, robot travelled {:.3} m, {} collision(s)",
-            self.scenario.name,
+            hilsim_recording::printable(&self.scenario.name),
             self.scenario.seed,
             get("sim.duration_s"),
             get("sim.distance_m"),

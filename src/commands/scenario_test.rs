@@ -70,8 +70,8 @@ pub fn test(args: &ScenarioTestArgs, out: &mut dyn Write) -> Result<ExitCode> {
                 out,
                 "{} {} ({}, {} assertion(s))",
                 if report.passed() { "PASS" } else { "FAIL" },
-                report.scenario.name,
-                path,
+                hilsim_recording::printable(&report.scenario.name),
+                hilsim_recording::printable(path),
                 report.outcomes.len()
             )?;
             for o in report.outcomes.iter().filter(|o| !o.passed) {

@@ -1,6 +1,8 @@
 //! The bad-input corpus (`tests/data/bad-scenarios/`): every malformed scenario fails before any
 //! work with exit code 2 and one line naming the file, the line and what was expected.
 
+use std::path::Path;
+
 use super::common::*;
 
 /// (file, line, a fragment of what was expected).
@@ -243,4 +245,26 @@ fn a_self_test_report_without_a_trial_is_refused() {
         "{err}"
     );
     assert!(!tmp.path().join("rep").exists());
+}
+
+#[test]
+fn a_full_device_is_named_in_the_systems_words() {
+    if !Path::new("/dev/full").exists() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_file("scenarios/straight-board.toml");
+    let out = hilsim(
+        tmp.path(),
+        &["record", scenario.to_str().unwrap(), "--out", "rec"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["export", "rec", "--mcap", "/dev/full"],
+    ));
+    assert!(
+        err.contains("/dev/full: No space left on device (os error 28)"),
+        "{err}"
+    );
 }

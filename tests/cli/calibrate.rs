@@ -444,3 +444,134 @@ fn issue_16_a_prior_on_the_sonar_scale_recovers_the_lidar_model() {
         assert!(stderr(&o).contains(says), "{}", stderr(&o));
     }
 }
+
+#[test]
+fn calibration_messages_name_the_method_run_and_the_range_expected() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    let run = |args: &[&str]| assert_bad_input(&hilsim(tmp.path(), args));
+    // Absurd options are refused before the data are blamed for them.
+    for (flag, value, says) in [
+        (
+            "--prior",
+            "sonar.alpha1=1e300±1e-300",
+            "the value must be from -100 to 100",
+        ),
+        (
+            "--prior",
+            "sonar.alpha1=1±1e-300",
+            "the sd must be positive: from 1e-6 to 100",
+        ),
+        (
+            "--start-distance",
+            "1e300",
+            "expected a distance from 0.01 to 1000 m, found 1e300",
+        ),
+        (
+            "--start-distance",
+            "1e-300",
+            "expected a distance from 0.01 to 1000 m, found 1e-300",
+        ),
+    ] {
+        let err = run(&["calibrate", "rec", "--method", "em", flag, value]);
+        assert!(err.contains(says), "{flag} {value}: {err}");
+        assert!(!err.contains("singular"), "{err}");
+    }
+    // A recording without a lidar: each method's message names that method once, and no other.
+    let nolidar = tmp.path().join("nolidar");
+    std::fs::create_dir(&nolidar).unwrap();
+    for entry in std::fs::read_dir(tmp.path().join("rec")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.file_name().unwrap() != "lidar.csv" {
+            std::fs::copy(&path, nolidar.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    for method in ["landmarks", "groundtruth", "em"] {
+        let err = run(&["calibrate", "nolidar", "--method", method]);
+        assert!(
+            err.starts_with(&format!(
+                "hilsim: nolidar: {method}: the recording has no lidar.csv"
+            )),
+            "{err}"
+        );
+        assert_eq!(err.matches(method).count(), 1, "{err}");
+        assert!(!err.contains("EM") || method == "em", "{err}");
+    }
+}
+
+#[test]
+fn a_byte_order_mark_before_a_csv_header_or_a_calibration_is_skipped() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    let plain = hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "em", "--json"],
+    );
+    let lidar = tmp.path().join("rec/lidar.csv");
+    let mut marked = "\u{feff}".as_bytes().to_vec();
+    marked.extend(std::fs::read(&lidar).unwrap());
+    std::fs::write(&lidar, marked).unwrap();
+    let with_mark = hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "em", "--json"],
+    );
+    assert_eq!(json(&with_mark), json(&plain));
+    let cal = format!("\u{feff}{}", stdout(&plain));
+    std::fs::write(tmp.path().join("cal.json"), cal).unwrap();
+    let o = hilsim(
+        tmp.path(),
+        &[
+            "smooth",
+            "rec",
+            "--calibration",
+            "cal.json",
+            "--csv",
+            "d.csv",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+#[test]
+fn smooth_refuses_a_calibration_that_is_ambiguous_or_not_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    let cal = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "em", "--json"],
+    ));
+    let text = cal.to_string();
+    let mut sd = cal.clone();
+    sd["sensors"]["lidar"]["alpha_sd"] = serde_json::json!([0.1]);
+    let mut method = cal.clone();
+    method["method"] = serde_json::json!("<script>");
+    for (name, content, says) in [
+        (
+            "dup-keys.json",
+            format!("{},\"sensors\":{{}}}}", &text[..text.len() - 1]),
+            "the key `sensors` appears twice",
+        ),
+        (
+            "method.json",
+            method.to_string(),
+            r#"`method` must be em, landmarks or groundtruth, found "<script>""#,
+        ),
+        (
+            "results.json",
+            serde_json::json!({"scenario": "x", "calibrations": [cal]}).to_string(),
+            "a run's results (a `calibrations` list), not one calibration",
+        ),
+        (
+            "sd.json",
+            sd.to_string(),
+            "sensors.lidar.alpha_sd has 1 standard errors for 3 alpha coefficients",
+        ),
+    ] {
+        std::fs::write(tmp.path().join(name), content).unwrap();
+        let err = assert_bad_input(&hilsim(
+            tmp.path(),
+            &["smooth", "rec", "--calibration", name],
+        ));
+        assert!(err.contains(says), "{name}: {err}");
+    }
+}

@@ -103,3 +103,28 @@ fn an_empty_directory_is_bad_input() {
     let err = assert_bad_input(&out);
     assert!(err.contains("no scenario files"), "{err}");
 }
+
+#[test]
+fn a_scenario_name_with_control_characters_is_printed_escaped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo_file("scenarios/straight-board.toml")).unwrap();
+    let hostile = text.replacen(
+        "name = \"straight-board\"",
+        r#"name = "bell\u0007\nnext\u001b[31mred""#,
+        1,
+    );
+    assert_ne!(hostile, text, "the scenario's name line");
+    std::fs::write(tmp.path().join("ctrl.toml"), hostile).unwrap();
+    let shown = r"bell\u{7}\nnext\e[31mred";
+    let run = hilsim(tmp.path(), &["run", "ctrl.toml"]);
+    let test = hilsim(tmp.path(), &["scenario", "test", "ctrl.toml"]);
+    for (out, first) in [
+        (&run, format!("scenario {shown} (seed ")),
+        (&test, format!("PASS {shown} (ctrl.toml, ")),
+    ] {
+        let text = stdout(out);
+        assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(out));
+        assert!(text.starts_with(&first), "{text}");
+        assert!(!text.contains(['\u{7}', '\u{1b}']), "{text}");
+    }
+}

@@ -2,11 +2,11 @@
 //! their assertions.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Result;
-use hilsim_recording::write_file_atomically;
+use hilsim_recording::{check_output_file, write_file_atomically, FileKind};
 use hilsim_scenarios::Report;
 use hilsim_sim::Scenario;
 
@@ -29,6 +29,10 @@ pub fn test(args: &ScenarioTestArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .collect::<Result<_, _>>()?;
     if scenarios.is_empty() {
         anyhow::bail!("{}: no scenario files (*.toml) found", display(&roots));
+    }
+    if let Some(file) = &args.junit {
+        let inputs: Vec<&Path> = scenarios.iter().map(|(path, _)| path.as_path()).collect();
+        check_output_file(file, JUNIT_XML, &inputs)?;
     }
     // On all cores; the reports come back in the input order.
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -87,18 +91,26 @@ pub fn test(args: &ScenarioTestArgs, out: &mut dyn Write) -> Result<ExitCode> {
     })
 }
 
+/// How the JUnit file starts: the XML declaration and the suites' element with its name.
+const JUNIT_START: &str =
+    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"hilsim scenario test\"";
+
+/// `--junit`'s file, as a previous one is recognised.
+const JUNIT_XML: FileKind = FileKind {
+    name: "a JUnit XML file of hilsim scenario tests",
+    starts_with: JUNIT_START.as_bytes(),
+};
+
 /// JUnit XML (the Ant schema CI systems read): a `testsuite` per scenario, a `testcase` per
 /// assertion, failed ones with a `failure`, skipped ones with `skipped`.
 fn junit(reports: &[(&String, Report)]) -> String {
-    let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let mut xml = String::from(JUNIT_START);
     let total: usize = reports.iter().map(|(_, r)| r.outcomes.len()).sum();
     let failures: usize = reports
         .iter()
         .map(|(_, r)| r.outcomes.iter().filter(|o| !o.passed).count())
         .sum();
-    xml.push_str(&format!(
-        "<testsuites name=\"hilsim scenario test\" tests=\"{total}\" failures=\"{failures}\">\n"
-    ));
+    xml.push_str(&format!(" tests=\"{total}\" failures=\"{failures}\">\n"));
     for (path, report) in reports {
         let failed = report.outcomes.iter().filter(|o| !o.passed).count();
         let skipped = report

@@ -128,3 +128,31 @@ fn a_scenario_name_with_control_characters_is_printed_escaped() {
         assert!(!text.contains(['\u{7}', '\u{1b}']), "{text}");
     }
 }
+
+#[test]
+fn junit_replaces_a_previous_report_but_never_a_scenario_or_a_users_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    std::fs::copy(
+        repo_file("scenarios/straight-board.toml"),
+        cwd.join("s.toml"),
+    )
+    .unwrap();
+    for _ in 0..2 {
+        let o = hilsim(cwd, &["scenario", "test", "s.toml", "--junit", "j.xml"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    std::fs::write(cwd.join("notes.txt"), "mine").unwrap();
+    for target in ["s.toml", "notes.txt"] {
+        let args = ["scenario", "test", "s.toml", "--junit", target];
+        let err = assert_bad_input(&hilsim(cwd, &args));
+        assert!(err.contains("refusing"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(cwd.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert!(std::fs::read_to_string(cwd.join("s.toml"))
+        .unwrap()
+        .contains("[robot]"));
+}

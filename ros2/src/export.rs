@@ -96,7 +96,7 @@ struct Bag<'p, W: Write> {
 
 impl<W: Write> Bag<'_, W> {
     fn fail(&self, err: mcap::McapError) -> Error {
-        Error::bag(self.out, err.to_string())
+        mcap_failure(self.out, err)
     }
 
     fn channel(&mut self, topic: &'static str, type_name: &str) -> Result<u16, mcap::McapError> {
@@ -280,6 +280,19 @@ pub fn export_dir(
     write_file(source, &extent, options, out)
 }
 
+/// Writing `out` failed: an I/O error in the system's words ("No space left on device", a pipe
+/// whose reader left), as the recording crate reports one, not the mcap crate's wrapper's.
+fn mcap_failure(out: &Path, err: mcap::McapError) -> Error {
+    match err {
+        mcap::McapError::Io(io) => Error::Recording(hilsim_recording::Error {
+            path: out.to_path_buf(),
+            line: None,
+            kind: hilsim_recording::ErrorKind::Io(io),
+        }),
+        other => Error::bag(out, other.to_string()),
+    }
+}
+
 fn write_file(
     source: Source<'_>,
     extent: &Extent,
@@ -288,11 +301,7 @@ fn write_file(
 ) -> Result<ExportReport, Error> {
     extent.check_stamps()?;
     let file = AtomicFile::create(out)?;
-    // The system's words ("No space left on device"), not the mcap crate's wrapper's.
-    let fail = |err: mcap::McapError| match err {
-        mcap::McapError::Io(io) => Error::bag(out, io.to_string()),
-        other => Error::bag(out, other.to_string()),
-    };
+    let fail = |err: mcap::McapError| mcap_failure(out, err);
     let writer = WriteOptions::new()
         .profile("ros2")
         .library(concat!("hilsim ", env!("CARGO_PKG_VERSION")))

@@ -361,6 +361,9 @@ fn standard_output_as_the_output_file_appends_where_the_shell_said_and_feeds_a_p
         "\"$H\" decode {cap} --csv /dev/stdout | head -c 1 >/dev/null; exit ${{PIPESTATUS[0]}}"
     );
     assert_eq!(shell(cwd, &closed), Some(0));
+    let export_closed =
+        "\"$H\" export R --mcap /dev/stdout 2>/dev/null | head -c 1 >/dev/null; exit ${PIPESTATUS[0]}";
+    assert_eq!(shell(cwd, export_closed), Some(0));
 }
 
 #[test]

@@ -22,14 +22,12 @@ pub fn printable_cut(text: &str, max_chars: usize) -> Cow<'_, str> {
         return Cow::Borrowed(text);
     }
     let mut out = String::with_capacity(text.len().min(4 * max_chars) + 8);
-    let mut shown = 0;
-    for c in text.chars() {
+    for (shown, c) in text.chars().enumerate() {
         if shown == max_chars {
             let rest = text.chars().count() - shown;
             let _ = write!(out, "… ({rest} more characters)");
             return Cow::Owned(out);
         }
-        shown += 1;
         match c {
             '\n' => out.push_str("\\n"),
             '\r' => out.push_str("\\r"),
@@ -67,7 +65,10 @@ mod tests {
 
     #[test]
     fn plain_names_are_borrowed_unchanged() {
-        assert!(matches!(printable("/scan_front"), Cow::Borrowed("/scan_front")));
+        assert!(matches!(
+            printable("/scan_front"),
+            Cow::Borrowed("/scan_front")
+        ));
         assert_eq!(printable("bière à 4 m"), "bière à 4 m");
     }
 

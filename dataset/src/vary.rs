@@ -103,7 +103,7 @@ impl FromStr for Vary {
         // `1...2` would read as 1..0.2: a bound beside the two dots has a digit there.
         if lo.trim_end().ends_with('.') || hi.trim_start().starts_with('.') {
             return Err(bad(&format!(
-                "`{range}`: more than two dots between the bounds (write .5 as 0.5); {SYNTAX}"
+                "more than two dots between the bounds (write .5 as 0.5); {SYNTAX}"
             )));
         }
         let number = |s: &str| {
@@ -369,7 +369,7 @@ mod tests {
             ("robot.start.x=2..1", "expected LO ≤ HI"),
             (
                 "robot.start.y=1...2",
-                "`1...2`: more than two dots between the bounds",
+                "`robot.start.y=1...2`: more than two dots between the bounds",
             ),
             ("robot.start.y=1. ..2", "more than two dots"),
             ("robot.start.y=0.5..-.5", "expected LO ≤ HI"),

@@ -134,7 +134,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
         if !(args.strength.is_finite() && args.strength > 0.0 && args.strength <= 5.0) {
             bail!(
-                "--strength: expected a factor in (0, 5], found {}",
+                "--strength: expected a factor in (0, 5], found {:?}",
                 args.strength
             );
         }

@@ -756,11 +756,17 @@ fn sqlite_channels(path: &Path) -> Result<Vec<Channel>, Error> {
                 ),
             )
         })?;
+        if found.len() == CHANNEL_LIMIT {
+            return Err(Error::bag(
+                path,
+                format!("table topics: more than {CHANNEL_LIMIT} topics: not a bag's"),
+            ));
+        }
         found.push(Channel {
             id,
-            topic,
-            type_name,
-            message_encoding,
+            topic: bounded_name(path, "topic", id, "name", topic)?,
+            type_name: bounded_name(path, "topic", id, "type name", type_name)?,
+            message_encoding: bounded_name(path, "topic", id, "encoding", message_encoding)?,
         });
     }
     Ok(found)

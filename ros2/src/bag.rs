@@ -785,40 +785,52 @@ fn sqlite_stream_while(
     }
     let db = open_sqlite(path)?;
     let fail = |err: rusqlite::Error| sqlite_error(path, &err);
+    // A blob's length is known without reading it: one beyond the record limit is never
+    // loaded.
     let mut query = db
-        .prepare("SELECT topic_id, timestamp, data, id FROM messages ORDER BY timestamp, id")
+        .prepare(
+            "SELECT topic_id, timestamp, \
+             CASE WHEN typeof(data) = 'blob' AND length(data) <= ?1 THEN data END, id, \
+             length(data) FROM messages ORDER BY timestamp, id",
+        )
         .map_err(fail)?;
-    let mut rows = query.query([]).map_err(fail)?;
+    let mut rows = query.query([RECORD_LENGTH_LIMIT as i64]).map_err(fail)?;
     let mut message = Vec::new();
     while let Some(row) = rows.next().map_err(fail)? {
-        let in_row = |err: rusqlite::Error| {
-            let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
-            let table = id.map_or("messages".to_string(), |id| format!("messages, id {id}"));
-            sqlite_row_error(path, &table, &err)
-        };
+        let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
+        let table = id.map_or("messages".to_string(), |id| format!("messages, id {id}"));
+        let in_row = |err: rusqlite::Error| sqlite_row_error(path, &table, &err);
         let topic_id: i64 = row.get(0).map_err(in_row)?;
         let timestamp: i64 = row.get(1).map_err(in_row)?;
         let data = match row.get_ref(2).map_err(in_row)? {
             rusqlite::types::ValueRef::Blob(data) => data,
-            other => {
-                let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
-                return Err(Error::bag(
-                    path,
+            _ => {
+                let length: Option<i64> = row.get(4).map_err(in_row)?;
+                // Not a blob, or one too large to have been read.
+                let found: String = db
+                    .query_row(
+                        "SELECT typeof(data) FROM messages WHERE id = ?1",
+                        [id],
+                        |r| r.get(0),
+                    )
+                    .unwrap_or_default();
+                let what = if found == "blob" {
                     format!(
-                        "table messages, id {}: column data holds {}, expected a blob (the \
-                         message's bytes)",
-                        id.map_or("?".to_string(), |id| id.to_string()),
-                        sqlite_type(other.data_type())
-                    ),
-                ));
+                        "a message of {} bytes, beyond the {} MiB any record may have",
+                        length.unwrap_or(0),
+                        RECORD_LENGTH_LIMIT >> 20
+                    )
+                } else {
+                    let found = match found.as_str() {
+                        "integer" => "an integer",
+                        "real" => "a real number",
+                        other => other,
+                    };
+                    format!("column data holds {found}, expected a blob (the message's bytes)")
+                };
+                return Err(Error::bag(path, format!("table {table}: {what}")));
             }
         };
-        if data.len() > RECORD_LENGTH_LIMIT {
-            return Err(Error::bag(
-                path,
-                format!("a message of {} bytes, beyond any scan's", data.len()),
-            ));
-        }
         let data = if data.starts_with(&ZSTD_MAGIC) {
             decompress_message(path, data, &mut message)?;
             &message[..]

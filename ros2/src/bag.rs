@@ -42,7 +42,7 @@ const SUMMARY_LIMIT: u64 = 16 << 20;
 const CHANNEL_LIMIT: usize = 1 << 16;
 
 /// A topic of one MCAP file.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Channel {
     /// The channel's id in its file.
     pub id: u16,
@@ -251,25 +251,22 @@ pub fn channels(path: &Path) -> Result<Vec<Channel>, Error> {
             return Ok(found);
         }
     }
-    // Channel records repeat (one per chunk, in some writers): each distinct one is kept once.
-    let mut found = Vec::new();
-    let mut seen = std::collections::HashSet::new();
+    // Channel records repeat (one per chunk, in some writers): each distinct one is kept once,
+    // in the order of their ids (as the summary's).
+    let mut found = std::collections::BTreeSet::new();
     stream(path, |item| {
         if let Item::Channel(channel) = item {
-            if !seen.contains(&channel) {
-                if seen.len() == CHANNEL_LIMIT {
-                    return Err(Error::bag(
-                        path,
-                        format!("more than {CHANNEL_LIMIT} different channels: not a bag's"),
-                    ));
-                }
-                seen.insert(channel.clone());
-                found.push(channel);
+            if found.len() == CHANNEL_LIMIT && !found.contains(&channel) {
+                return Err(Error::bag(
+                    path,
+                    format!("more than {CHANNEL_LIMIT} different channels: not a bag's"),
+                ));
             }
+            found.insert(channel);
         }
         Ok(())
     })?;
-    Ok(found)
+    Ok(found.into_iter().collect())
 }
 
 /// The summary's channels; `None` when there is no summary or it cannot be read (the full pass

@@ -55,7 +55,7 @@ pub struct ExportReport {
     pub messages: BTreeMap<String, u64>,
 }
 
-/// A recording's t_s as a stamp (within [`check_stamps`]' range).
+/// A recording's t_s as a stamp (within the range [`check_stamps`] allows).
 fn stamp_ns(t_s: f64) -> i64 {
     START_NS + (t_s * 1e9).round() as i64
 }
@@ -66,19 +66,27 @@ fn stamp_ns(t_s: f64) -> i64 {
 /// # Errors
 /// The table and row of the first such time.
 fn check_stamps(rec: &Recording) -> Result<(), Error> {
-    let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
-    let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
-    let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+    // In the integers `stamp_ns` makes (an f64 near 2³¹ s is coarser than a nanosecond).
+    let fits = |t_s: f64| {
+        let ns = i128::from(START_NS).saturating_add((t_s * 1e9).round() as i128);
+        let range = i128::from(i32::MIN) * 1_000_000_000
+            ..=i128::from(i32::MAX) * 1_000_000_000 + 999_999_999;
+        t_s.is_finite() && range.contains(&ns)
+    };
+    let (earliest, latest) = (
+        i64::from(i32::MIN) - START_NS / 1_000_000_000,
+        i64::from(i32::MAX) - START_NS / 1_000_000_000,
+    );
     let beyond = |table: &str, t: Box<dyn Iterator<Item = f64> + '_>| match t
         .enumerate()
-        .find(|(_, t)| !(earliest..=latest).contains(t))
+        .find(|(_, t)| !fits(*t))
     {
         None => Ok(()),
         Some((row, t_s)) => Err(Error::bag(
             Path::new(table),
             format!(
                 "row {}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
-                     int32: t_s from {earliest:.0} to {latest:.0} s)",
+                     int32: t_s from {earliest} to {latest} s)",
                 row + 1
             ),
         )),
@@ -769,6 +777,9 @@ mod tests {
         // The last second a stamp holds, from t = 0 stamped at START_NS.
         rec.truth = Some(vec![pose(0.0), pose(2_147_483_646.5)]);
         export(&rec, None, &out).unwrap();
+        // One second later the seconds would be 2³¹: refused, at the nanosecond.
+        rec.truth = Some(vec![pose(2_147_483_647.0)]);
+        assert!(export(&rec, None, &out).is_err());
         rec.truth = Some(vec![pose(0.0), pose(1.0), pose(3.7e292)]);
         let err = export(&rec, None, &out).unwrap_err().to_string();
         assert!(

@@ -42,7 +42,7 @@ const SUMMARY_LIMIT: u64 = 16 << 20;
 const CHANNEL_LIMIT: usize = 1 << 16;
 
 /// A topic of one MCAP file.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Channel {
     /// The channel's id in its file.
     pub id: u16,
@@ -251,25 +251,22 @@ pub fn channels(path: &Path) -> Result<Vec<Channel>, Error> {
             return Ok(found);
         }
     }
-    // Channel records repeat (one per chunk, in some writers): each distinct one is kept once.
-    let mut found = Vec::new();
-    let mut seen = std::collections::HashSet::new();
+    // Channel records repeat (one per chunk, in some writers): each distinct one is kept once,
+    // in the order of their ids (as the summary's).
+    let mut found = std::collections::BTreeSet::new();
     stream(path, |item| {
         if let Item::Channel(channel) = item {
-            if !seen.contains(&channel) {
-                if seen.len() == CHANNEL_LIMIT {
-                    return Err(Error::bag(
-                        path,
-                        format!("more than {CHANNEL_LIMIT} different channels: not a bag's"),
-                    ));
-                }
-                seen.insert(channel.clone());
-                found.push(channel);
+            if found.len() == CHANNEL_LIMIT && !found.contains(&channel) {
+                return Err(Error::bag(
+                    path,
+                    format!("more than {CHANNEL_LIMIT} different channels: not a bag's"),
+                ));
             }
+            found.insert(channel);
         }
         Ok(())
     })?;
-    Ok(found)
+    Ok(found.into_iter().collect())
 }
 
 /// The summary's channels; `None` when there is no summary or it cannot be read (the full pass
@@ -756,11 +753,17 @@ fn sqlite_channels(path: &Path) -> Result<Vec<Channel>, Error> {
                 ),
             )
         })?;
+        if found.len() == CHANNEL_LIMIT {
+            return Err(Error::bag(
+                path,
+                format!("table topics: more than {CHANNEL_LIMIT} topics: not a bag's"),
+            ));
+        }
         found.push(Channel {
             id,
-            topic,
-            type_name,
-            message_encoding,
+            topic: bounded_name(path, "topic", id, "name", topic)?,
+            type_name: bounded_name(path, "topic", id, "type name", type_name)?,
+            message_encoding: bounded_name(path, "topic", id, "encoding", message_encoding)?,
         });
     }
     Ok(found)
@@ -779,40 +782,52 @@ fn sqlite_stream_while(
     }
     let db = open_sqlite(path)?;
     let fail = |err: rusqlite::Error| sqlite_error(path, &err);
+    // A blob's length is known without reading it: one beyond the record limit is never
+    // loaded.
     let mut query = db
-        .prepare("SELECT topic_id, timestamp, data, id FROM messages ORDER BY timestamp, id")
+        .prepare(
+            "SELECT topic_id, timestamp, \
+             CASE WHEN typeof(data) = 'blob' AND length(data) <= ?1 THEN data END, id, \
+             length(data) FROM messages ORDER BY timestamp, id",
+        )
         .map_err(fail)?;
-    let mut rows = query.query([]).map_err(fail)?;
+    let mut rows = query.query([RECORD_LENGTH_LIMIT as i64]).map_err(fail)?;
     let mut message = Vec::new();
     while let Some(row) = rows.next().map_err(fail)? {
-        let in_row = |err: rusqlite::Error| {
-            let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
-            let table = id.map_or("messages".to_string(), |id| format!("messages, id {id}"));
-            sqlite_row_error(path, &table, &err)
-        };
+        let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
+        let table = id.map_or("messages".to_string(), |id| format!("messages, id {id}"));
+        let in_row = |err: rusqlite::Error| sqlite_row_error(path, &table, &err);
         let topic_id: i64 = row.get(0).map_err(in_row)?;
         let timestamp: i64 = row.get(1).map_err(in_row)?;
         let data = match row.get_ref(2).map_err(in_row)? {
             rusqlite::types::ValueRef::Blob(data) => data,
-            other => {
-                let id = row.get_ref(3).ok().and_then(|v| v.as_i64().ok());
-                return Err(Error::bag(
-                    path,
+            _ => {
+                let length: Option<i64> = row.get(4).map_err(in_row)?;
+                // Not a blob, or one too large to have been read.
+                let found: String = db
+                    .query_row(
+                        "SELECT typeof(data) FROM messages WHERE id = ?1",
+                        [id],
+                        |r| r.get(0),
+                    )
+                    .unwrap_or_default();
+                let what = if found == "blob" {
                     format!(
-                        "table messages, id {}: column data holds {}, expected a blob (the \
-                         message's bytes)",
-                        id.map_or("?".to_string(), |id| id.to_string()),
-                        sqlite_type(other.data_type())
-                    ),
-                ));
+                        "a message of {} bytes, beyond the {} MiB any record may have",
+                        length.unwrap_or(0),
+                        RECORD_LENGTH_LIMIT >> 20
+                    )
+                } else {
+                    let found = match found.as_str() {
+                        "integer" => "an integer",
+                        "real" => "a real number",
+                        other => other,
+                    };
+                    format!("column data holds {found}, expected a blob (the message's bytes)")
+                };
+                return Err(Error::bag(path, format!("table {table}: {what}")));
             }
         };
-        if data.len() > RECORD_LENGTH_LIMIT {
-            return Err(Error::bag(
-                path,
-                format!("a message of {} bytes, beyond any scan's", data.len()),
-            ));
-        }
         let data = if data.starts_with(&ZSTD_MAGIC) {
             decompress_message(path, data, &mut message)?;
             &message[..]

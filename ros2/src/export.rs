@@ -60,7 +60,7 @@ pub struct ExportReport {
     pub messages: BTreeMap<String, u64>,
 }
 
-/// A recording's t_s as a stamp (within [`check_stamps`]' range).
+/// A recording's t_s as a stamp (within the range [`check_stamps`] allows).
 fn stamp_ns(t_s: f64) -> i64 {
     START_NS + (t_s * 1e9).round() as i64
 }
@@ -369,6 +369,16 @@ impl Default for Extent {
     }
 }
 
+/// Whether a stamp holds time `t_s`: `builtin_interfaces/Time`'s `sec` is an int32, so a stamp
+/// ends 2³¹ s (68 years) after the epoch, and a time beyond would wrap. Checked in the integers
+/// `stamp_ns` makes (an f64 near 2³¹ s is coarser than a nanosecond).
+fn stamp_holds(t_s: f64) -> bool {
+    let ns = i128::from(START_NS).saturating_add((t_s * 1e9).round() as i128);
+    let range =
+        i128::from(i32::MIN) * 1_000_000_000..=i128::from(i32::MAX) * 1_000_000_000 + 999_999_999;
+    t_s.is_finite() && range.contains(&ns)
+}
+
 /// The tables, in the order [`Extent`] counts their rows.
 const TABLES: [&str; 5] = [
     "commands.csv",
@@ -383,28 +393,26 @@ impl Extent {
     /// cannot hold.
     fn note_time(&mut self, k: usize, t_s: f64) {
         self.rows[k] += 1;
-        let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
-        let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
-        let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
-        if self.beyond_stamp.is_none() && !(earliest..=latest).contains(&t_s) {
+        if self.beyond_stamp.is_none() && !stamp_holds(t_s) {
             self.beyond_stamp = Some((TABLES[k], self.rows[k], t_s));
         }
     }
 
-    /// Refuses a recording with a time that a ROS 2 stamp cannot hold (its seconds are an
-    /// int32), naming the table and row, rather than wrapping it to another century.
+    /// Refuses a recording with a time that a ROS 2 stamp cannot hold, naming the table and
+    /// row, rather than wrapping it to another century.
     fn check_stamps(&self) -> Result<(), Error> {
         let Some((table, row, t_s)) = self.beyond_stamp else {
             return Ok(());
         };
-        let seconds = |ns: i64| (ns - START_NS) as f64 / 1e9;
-        let earliest = seconds(i64::from(i32::MIN) * 1_000_000_000);
-        let latest = seconds(i64::from(i32::MAX) * 1_000_000_000 + 999_999_999);
+        let (earliest, latest) = (
+            i64::from(i32::MIN) - START_NS / 1_000_000_000,
+            i64::from(i32::MAX) - START_NS / 1_000_000_000,
+        );
         Err(Error::bag(
             Path::new(table),
             format!(
                 "row {row}: t_s {t_s:e} s, beyond what a ROS 2 stamp holds (its seconds are an \
-                 int32: t_s from {earliest:.0} to {latest:.0} s)"
+                 int32: t_s from {earliest} to {latest} s)"
             ),
         ))
     }
@@ -1078,6 +1086,9 @@ mod tests {
         // The last second a stamp holds, from t = 0 stamped at START_NS.
         rec.truth = Some(vec![pose(0.0), pose(2_147_483_646.5)]);
         export(&rec, None, &out).unwrap();
+        // One second later the seconds would be 2³¹: refused, at the nanosecond.
+        rec.truth = Some(vec![pose(2_147_483_647.0)]);
+        assert!(export(&rec, None, &out).is_err());
         rec.truth = Some(vec![pose(0.0), pose(1.0), pose(3.7e292)]);
         let err = export(&rec, None, &out).unwrap_err().to_string();
         assert!(

@@ -990,6 +990,13 @@ impl Converter {
             (angles[0] - start[0]) * radius,
             (angles[1] - start[1]) * radius,
         );
+        if !(left_m.is_finite() && right_m.is_finite()) {
+            return Err(Fault::Message(format!(
+                "wheel angles ({:e}, {:e}) rad so far from the first ones that the wheel travel \
+                 is beyond any number",
+                angles[0], angles[1]
+            )));
+        }
         let t_s = self.seconds(Role::Odometry, ns, 0.0);
         self.count(Role::Odometry, 1);
         Ok(sink.odometry(&OdometrySample {

@@ -251,3 +251,85 @@ fn wheel_joints_are_two_names() {
         );
     }
 }
+
+/// A bag's topic holding terminal sequences reaches stdout as visible escapes, not as the
+/// sequences themselves.
+#[test]
+fn topic_names_reach_the_terminal_escaped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let string = |b: &[u8]| [&u32::try_from(b.len()).unwrap().to_le_bytes()[..], b].concat();
+    let record =
+        |op: u8, body: &[u8]| [&[op][..], &(body.len() as u64).to_le_bytes(), body].concat();
+    // A LaserScan of no readings: stamp 1 s, frame "", pad to 4, 7 float32 zeros, two empty
+    // sequences.
+    let mut scan = vec![0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0];
+    scan.extend_from_slice(&[0; 36]);
+    let mut message = [1u16.to_le_bytes().to_vec(), 0u32.to_le_bytes().to_vec()].concat();
+    message.extend_from_slice(&1_000_000_000u64.to_le_bytes());
+    message.extend_from_slice(&1_000_000_000u64.to_le_bytes());
+    message.extend_from_slice(&scan);
+    let magic = b"\x89MCAP0\r\n";
+    let bag = [
+        magic.to_vec(),
+        record(1, &[string(b"ros2"), string(b"test")].concat()),
+        record(
+            3,
+            &[
+                &1u16.to_le_bytes()[..],
+                &string(b"sensor_msgs/msg/LaserScan"),
+                &string(b"ros2msg"),
+                &string(b""),
+            ]
+            .concat(),
+        ),
+        record(
+            4,
+            &[
+                &1u16.to_le_bytes()[..],
+                &1u16.to_le_bytes(),
+                &string(b"/scan\x1b[31m\x1b]0;x\x07"),
+                &string(b"cdr"),
+                &string(b""),
+            ]
+            .concat(),
+        ),
+        record(5, &message),
+        record(0x0F, &0u32.to_le_bytes()),
+        record(2, &[0u8; 20]),
+        magic.to_vec(),
+    ]
+    .concat();
+    fs::write(tmp.path().join("escapes.mcap"), bag).unwrap();
+    let out = hilsim(tmp.path(), &["import", "escapes.mcap", "--out", "r"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shown = stdout(&out);
+    assert!(
+        shown.contains("lidar     /scan\\e[31m\\e]0;x\\u{7} (sensor_msgs/msg/LaserScan): 0 rows"),
+        "{shown}"
+    );
+    assert!(!shown.contains('\u{1b}'), "{shown}");
+}
+
+/// A recording time beyond what a ROS 2 stamp holds is refused in one line, not exported
+/// wrapped.
+#[test]
+fn export_refuses_times_no_stamp_holds() {
+    use hilsim_recording::{Meta, Recording, TruthSample};
+    let tmp = tempfile::tempdir().unwrap();
+    let mut rec = Recording::new(Meta::default());
+    let pose = |t_s| TruthSample {
+        t_s,
+        x_m: 0.0,
+        y_m: 0.0,
+        yaw_rad: 0.0,
+    };
+    rec.truth = Some(vec![pose(0.0), pose(3.7e292)]);
+    rec.write_dir(&tmp.path().join("far")).unwrap();
+    let out = hilsim(tmp.path(), &["export", "far", "--mcap", "far.mcap"]);
+    let err = assert_bad_input(&out);
+    assert!(
+        err.contains("truth.csv: row 2: t_s 3.7e292 s, beyond what a ROS 2 stamp holds"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("far.mcap").exists());
+}

@@ -31,6 +31,7 @@ mod read;
 mod rows;
 mod samples;
 mod stream;
+mod thin;
 mod write;
 
 pub use atomic::{
@@ -50,6 +51,7 @@ pub use samples::{
     CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
 };
 pub use stream::{RecordingStream, SampleSink, Tables};
+pub use thin::Thinning;
 
 /// A whole recording: the metadata and one table per sensor.
 ///

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use hilsim_recording::{write_owned_file_atomically, Recording};
+use hilsim_recording::{write_owned_file_atomically, RecordingDir};
 use hilsim_report::Inputs;
 use hilsim_sim::Scenario;
 
@@ -16,7 +16,9 @@ use crate::cli::ReportArgs;
 pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     check_report_dir(&args.out, &[])?;
     let scenario = args.scenario.as_deref().map(Scenario::load).transpose()?;
-    let recording = Recording::read_dir(&args.recording)?;
+    // Read as streams, holding at most `MAX_ROWS` rows of a table whatever the recording's length.
+    let (recording, thinning) =
+        RecordingDir::open(&args.recording)?.read_thinned(hilsim_report::MAX_ROWS)?;
     let beside = args.recording.join("results.json");
     let calibration_file = args
         .calibration
@@ -31,7 +33,7 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let html = hilsim_report::render(Inputs {
         title: &title,
         recording: &recording,
-        recording_name: &name,
+        recording_name: &hilsim_report::drawn_name(&name, &thinning),
         scenario: scenario.as_ref(),
         calibrations: &calibrations,
         truth_estimated: false,

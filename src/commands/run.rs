@@ -49,10 +49,12 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     if let Some(dir) = &args.report {
         let title = format!("hilsim run: {}", report.scenario.name);
+        let (recording, thinning) = report.run.recording.thinned(hilsim_report::MAX_ROWS);
+        let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
         let html = hilsim_report::render(hilsim_report::Inputs {
             title: &title,
-            recording: &report.run.recording,
-            recording_name: &format!("{origin} (seed {}, in memory)", report.scenario.seed),
+            recording: &recording,
+            recording_name: &hilsim_report::drawn_name(&name, &thinning),
             scenario: Some(&report.scenario),
             calibrations: &report.calibrations,
             truth_estimated: false,

@@ -1,0 +1,296 @@
+//! A recording too long to hold whole, kept as every k-th part of it: what a command that
+//! draws a recording (a report) holds, so that its memory is bounded whatever the recording's
+//! length. A recording within the bound is kept whole, sample for sample.
+
+use std::borrow::Cow;
+use std::convert::Infallible;
+
+use crate::{
+    CommandSample, Error, LidarSample, OdometrySample, Recording, RecordingDir, SampleSink,
+    SonarSample, TruthSample,
+};
+
+/// Which part of a recording is kept: every `lidar_revolutions`-th lidar revolution (whole
+/// revolutions, so that a scan drawn is a scan), and every `rows[t]`-th row of the other tables
+/// (commands, odometry, sonar, truth). All 1: the whole recording.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Thinning {
+    /// Every how many lidar revolutions one is kept.
+    pub lidar_revolutions: u64,
+    /// Every how many rows one is kept, of the commands, odometry, sonar and truth.
+    pub rows: [u64; 4],
+}
+
+impl Thinning {
+    /// The whole recording.
+    pub const WHOLE: Self = Self {
+        lidar_revolutions: 1,
+        rows: [1; 4],
+    };
+
+    /// Whether nothing is left out.
+    #[must_use]
+    pub fn is_whole(&self) -> bool {
+        *self == Self::WHOLE
+    }
+
+    /// What was kept, in words ("every 8th lidar revolution, every 4th odometry row"), for a
+    /// page that draws a thinned recording; empty when whole.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let every = |k: u64, what: &str| (k > 1).then(|| format!("every {k}th {what}"));
+        [
+            every(self.lidar_revolutions, "lidar revolution"),
+            every(self.rows[0], "command"),
+            every(self.rows[1], "odometry row"),
+            every(self.rows[2], "sonar ping"),
+            every(self.rows[3], "true pose"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect::<Vec<_>>()
+        .join(", ")
+    }
+
+    /// The thinning that keeps at most about `max_rows` rows of each table of a recording of
+    /// `counts` rows (lidar revolutions kept whole: its rows are bounded as the revolutions are
+    /// alike).
+    fn of(counts: &Counts, max_rows: u64) -> Self {
+        let every = |rows: u64| rows.div_ceil(max_rows.max(1)).max(1);
+        Self {
+            lidar_revolutions: every(counts.lidar),
+            rows: [
+                every(counts.rows[0]),
+                every(counts.rows[1]),
+                every(counts.rows[2]),
+                every(counts.rows[3]),
+            ],
+        }
+    }
+}
+
+/// Rows of each table: the lidar's, and the commands', odometry's, sonar's and truth's.
+#[derive(Debug, Default)]
+struct Counts {
+    lidar: u64,
+    rows: [u64; 4],
+}
+
+impl SampleSink for Counts {
+    type Error = Infallible;
+    fn command(&mut self, _: &CommandSample) -> Result<(), Infallible> {
+        self.rows[0] += 1;
+        Ok(())
+    }
+    fn odometry(&mut self, _: &OdometrySample) -> Result<(), Infallible> {
+        self.rows[1] += 1;
+        Ok(())
+    }
+    fn lidar(&mut self, _: &LidarSample) -> Result<(), Infallible> {
+        self.lidar += 1;
+        Ok(())
+    }
+    fn sonar(&mut self, _: &SonarSample) -> Result<(), Infallible> {
+        self.rows[2] += 1;
+        Ok(())
+    }
+    fn truth(&mut self, _: &TruthSample) -> Result<(), Infallible> {
+        self.rows[3] += 1;
+        Ok(())
+    }
+}
+
+/// Whether the `index`-th row (0-based) of a table thinned to every `k`-th is kept.
+fn kept(index: usize, k: u64) -> bool {
+    index as u64 % k == 0
+}
+
+fn thin<T: Copy>(rows: &[T], k: u64) -> Vec<T> {
+    rows.iter()
+        .enumerate()
+        .filter(|(i, _)| kept(*i, k))
+        .map(|(_, r)| *r)
+        .collect()
+}
+
+impl Recording {
+    /// The recording, or every k-th part of it when a table holds more than `max_rows` rows
+    /// (see [`Thinning`]); borrowed when whole.
+    #[must_use]
+    pub fn thinned(&self, max_rows: u64) -> (Cow<'_, Self>, Thinning) {
+        let len = |n: usize| n as u64;
+        let counts = Counts {
+            lidar: len(self.lidar.as_ref().map_or(0, Vec::len)),
+            rows: [
+                len(self.commands.len()),
+                len(self.odometry.as_ref().map_or(0, Vec::len)),
+                len(self.sonar.as_ref().map_or(0, Vec::len)),
+                len(self.truth.as_ref().map_or(0, Vec::len)),
+            ],
+        };
+        let thinning = Thinning::of(&counts, max_rows);
+        if thinning.is_whole() {
+            return (Cow::Borrowed(self), thinning);
+        }
+        let k = thinning.rows;
+        let lidar = self.lidar.as_ref().map(|rows| {
+            rows.iter()
+                .filter(|r| r.rev % thinning.lidar_revolutions == 0)
+                .copied()
+                .collect()
+        });
+        let thinned = Self {
+            meta: self.meta.clone(),
+            commands: thin(&self.commands, k[0]),
+            odometry: self.odometry.as_deref().map(|r| thin(r, k[1])),
+            lidar,
+            sonar: self.sonar.as_deref().map(|r| thin(r, k[2])),
+            truth: self.truth.as_deref().map(|r| thin(r, k[3])),
+        };
+        (Cow::Owned(thinned), thinning)
+    }
+}
+
+impl RecordingDir {
+    /// Reads the recording as [`Recording::thinned`] keeps it, holding at most about
+    /// `max_rows` rows of each table: the tables are checked and counted first (the errors of
+    /// [`Recording::read_dir`]), then read again keeping every k-th part. A recording within
+    /// the bound is read whole, sample for sample as `read_dir` reads it.
+    ///
+    /// # Errors
+    /// A malformed table, naming the file and line.
+    pub fn read_thinned(&self, max_rows: u64) -> Result<(Recording, Thinning), Error> {
+        let mut counts = Counts::default();
+        self.check(&mut counts)?;
+        let thinning = Thinning::of(&counts, max_rows);
+        let k = thinning.rows;
+        let keep = |index: usize, k: u64| kept(index, k);
+        let mut rec = Recording::new(self.meta().clone());
+        for (i, c) in self.commands()?.enumerate() {
+            let c = c?;
+            if keep(i, k[0]) {
+                rec.commands.push(c);
+            }
+        }
+        if let Some(rows) = self.odometry()? {
+            let mut kept_rows = Vec::new();
+            for (i, o) in rows.enumerate() {
+                let o = o?;
+                if keep(i, k[1]) {
+                    kept_rows.push(o);
+                }
+            }
+            rec.odometry = Some(kept_rows);
+        }
+        if let Some(rows) = self.lidar()? {
+            let mut kept_rows = Vec::new();
+            for r in rows {
+                let r = r?;
+                if r.rev % thinning.lidar_revolutions == 0 {
+                    kept_rows.push(r);
+                }
+            }
+            rec.lidar = Some(kept_rows);
+        }
+        if let Some(rows) = self.sonar()? {
+            let mut kept_rows = Vec::new();
+            for (i, s) in rows.enumerate() {
+                let s = s?;
+                if keep(i, k[2]) {
+                    kept_rows.push(s);
+                }
+            }
+            rec.sonar = Some(kept_rows);
+        }
+        if let Some(rows) = self.truth()? {
+            let mut kept_rows = Vec::new();
+            for (i, p) in rows.enumerate() {
+                let p = p?;
+                if keep(i, k[3]) {
+                    kept_rows.push(p);
+                }
+            }
+            rec.truth = Some(kept_rows);
+        }
+        Ok((rec, thinning))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Meta;
+
+    fn recording(revolutions: u64, per_rev: u64) -> Recording {
+        let mut rec = Recording::new(Meta::default());
+        let mut lidar = Vec::new();
+        for rev in 0..revolutions {
+            for k in 0..per_rev {
+                let t_s = (rev * per_rev + k) as f64 * 0.001;
+                lidar.push(LidarSample {
+                    t_s,
+                    rev,
+                    angle_deg: k as f64,
+                    range_m: 1.0,
+                    strength: 100,
+                    invalid: false,
+                    warning: false,
+                    true_range_m: None,
+                });
+            }
+        }
+        rec.lidar = Some(lidar);
+        rec.truth = Some(
+            (0..1000)
+                .map(|i| TruthSample {
+                    t_s: f64::from(i) * 0.01,
+                    x_m: 0.0,
+                    y_m: 0.0,
+                    yaw_rad: 0.0,
+                })
+                .collect(),
+        );
+        rec.commands.push(CommandSample {
+            t_s: 0.0,
+            left_mps: 0.1,
+            right_mps: 0.1,
+        });
+        rec
+    }
+
+    #[test]
+    fn a_recording_within_the_bound_is_kept_whole_and_read_as_read_dir_reads_it() {
+        let rec = recording(10, 36);
+        let (kept, thinning) = rec.thinned(1000);
+        assert!(thinning.is_whole());
+        assert!(matches!(kept, Cow::Borrowed(_)));
+        let dir = tempfile::tempdir().unwrap();
+        rec.write_dir(&dir.path().join("r")).unwrap();
+        let opened = RecordingDir::open(&dir.path().join("r")).unwrap();
+        let (read, thinning) = opened.read_thinned(1000).unwrap();
+        assert!(thinning.is_whole());
+        assert_eq!(read, Recording::read_dir(&dir.path().join("r")).unwrap());
+    }
+
+    #[test]
+    fn a_longer_recording_keeps_whole_revolutions_and_at_most_the_bound_of_each_table() {
+        let rec = recording(100, 36);
+        let (kept, thinning) = rec.thinned(500);
+        assert_eq!(thinning.lidar_revolutions, 8, "3600 readings into 500");
+        assert_eq!(thinning.rows[3], 2, "1000 poses into 500");
+        let lidar = kept.lidar.as_ref().unwrap();
+        assert!(lidar.len() <= 500 + 36, "{}", lidar.len());
+        assert!(lidar.iter().all(|r| r.rev % 8 == 0));
+        assert_eq!(lidar.len() % 36, 0, "whole revolutions");
+        assert_eq!(kept.truth.as_ref().unwrap().len(), 500);
+        assert!(thinning.describe().contains("every 8th lidar revolution"));
+        // Read from a directory as streams, the same part is kept.
+        let dir = tempfile::tempdir().unwrap();
+        rec.write_dir(&dir.path().join("r")).unwrap();
+        let opened = RecordingDir::open(&dir.path().join("r")).unwrap();
+        let (read, read_thinning) = opened.read_thinned(500).unwrap();
+        assert_eq!(read_thinning, thinning);
+        assert_eq!(read.lidar, kept.lidar);
+        assert_eq!(read.truth, kept.truth);
+    }
+}

@@ -51,7 +51,7 @@ pub use samples::{
     CommandSample, LidarDecimals, LidarSample, OdometrySample, SonarSample, TruthSample,
 };
 pub use stream::{RecordingStream, SampleSink, Tables};
-pub use thin::Thinning;
+pub use thin::{ThinnedSink, Thinning, MAX_ROWS_HELD};
 
 /// A whole recording: the metadata and one table per sensor.
 ///

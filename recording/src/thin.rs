@@ -10,6 +10,13 @@ use crate::{
     SonarSample, TruthSample,
 };
 
+/// The most rows of one table a command that holds a recording to draw or calibrate from keeps
+/// in memory (`hilsim report`, `hilsim run`): a longer recording is thinned ([`Thinning`]), so
+/// that the command's memory is bounded whatever the recording's length. Half a million rows is
+/// about four and a half minutes of an XV-11's 1,800 readings a second, and some 14 hours of
+/// truth at 10 Hz; a report's charts thin far below it anyway.
+pub const MAX_ROWS_HELD: u64 = 500_000;
+
 /// Which part of a recording is kept: every `lidar_revolutions`-th lidar revolution (whole
 /// revolutions, so that a scan drawn is a scan), and every `rows[t]`-th row of the other tables
 /// (commands, odometry, sonar, truth). All 1: the whole recording.
@@ -56,7 +63,9 @@ impl Thinning {
     /// `counts` rows (lidar revolutions kept whole: its rows are bounded as the revolutions are
     /// alike).
     fn of(counts: &Counts, max_rows: u64) -> Self {
-        let every = |rows: u64| rows.div_ceil(max_rows.max(1)).max(1);
+        // A power of two, as a sink that thins while the rows arrive doubles it
+        // ([`ThinnedSink`]): the same part of a recording is kept either way.
+        let every = |rows: u64| rows.div_ceil(max_rows.max(1)).max(1).next_power_of_two();
         Self {
             lidar_revolutions: every(counts.lidar),
             rows: [
@@ -216,6 +225,124 @@ impl RecordingDir {
     }
 }
 
+/// A [`SampleSink`] that keeps a recording as [`Recording::thinned`] would keep it, while the
+/// samples arrive: every table whole until it passes `max_rows`, then every 2nd, 4th… row (whole
+/// lidar revolutions) of it. It holds at most `max_rows` rows of a table, plus one revolution.
+#[derive(Debug)]
+pub struct ThinnedSink {
+    recording: Recording,
+    max_rows: usize,
+    thinning: Thinning,
+    /// Rows seen of the commands, odometry, sonar and truth.
+    seen: [u64; 4],
+}
+
+impl ThinnedSink {
+    /// An empty recording with `meta` and the `tables` given, to keep at most `max_rows` rows
+    /// of each.
+    #[must_use]
+    pub fn new(meta: crate::Meta, tables: crate::Tables, max_rows: u64) -> Self {
+        let mut recording = Recording::new(meta);
+        recording.odometry = tables.odometry.then(Vec::new);
+        recording.lidar = tables.lidar.then(Vec::new);
+        recording.sonar = tables.sonar.then(Vec::new);
+        recording.truth = tables.truth.then(Vec::new);
+        Self {
+            recording,
+            max_rows: usize::try_from(max_rows.max(1)).unwrap_or(usize::MAX),
+            thinning: Thinning::WHOLE,
+            seen: [0; 4],
+        }
+    }
+
+    /// The part kept, and which part it is.
+    #[must_use]
+    pub fn finish(self) -> (Recording, Thinning) {
+        (self.recording, self.thinning)
+    }
+}
+
+/// Keeps `row`, the `seen`-th of its table, in `rows` thinned to every `k`-th row; past `max`
+/// rows, every other row kept is dropped and `k` doubled.
+fn keep_row<T: Copy>(rows: &mut Vec<T>, row: &T, seen: &mut u64, k: &mut u64, max: usize) {
+    if *seen % *k == 0 {
+        rows.push(*row);
+        if rows.len() > max {
+            let mut position = 0;
+            rows.retain(|_| {
+                position += 1;
+                position % 2 == 1
+            });
+            *k *= 2;
+        }
+    }
+    *seen += 1;
+}
+
+fn table<T>(rows: &mut Option<Vec<T>>) -> &mut Vec<T> {
+    rows.get_or_insert_with(Vec::new)
+}
+
+impl SampleSink for ThinnedSink {
+    type Error = Infallible;
+    fn command(&mut self, c: &CommandSample) -> Result<(), Infallible> {
+        let (rows, seen, k) = (
+            &mut self.recording.commands,
+            &mut self.seen[0],
+            &mut self.thinning.rows[0],
+        );
+        keep_row(rows, c, seen, k, self.max_rows);
+        Ok(())
+    }
+    fn odometry(&mut self, o: &OdometrySample) -> Result<(), Infallible> {
+        let rows = table(&mut self.recording.odometry);
+        keep_row(
+            rows,
+            o,
+            &mut self.seen[1],
+            &mut self.thinning.rows[1],
+            self.max_rows,
+        );
+        Ok(())
+    }
+    fn lidar(&mut self, r: &LidarSample) -> Result<(), Infallible> {
+        let rows = table(&mut self.recording.lidar);
+        let k = &mut self.thinning.lidar_revolutions;
+        if r.rev % *k == 0 {
+            rows.push(*r);
+            // Whole revolutions: a revolution is only ever dropped whole, at its first reading.
+            if rows.len() > self.max_rows && rows.first().is_some_and(|f| f.rev != r.rev) {
+                *k *= 2;
+                let k = *k;
+                rows.retain(|x| x.rev % k == 0);
+            }
+        }
+        Ok(())
+    }
+    fn sonar(&mut self, s: &SonarSample) -> Result<(), Infallible> {
+        let rows = table(&mut self.recording.sonar);
+        keep_row(
+            rows,
+            s,
+            &mut self.seen[2],
+            &mut self.thinning.rows[2],
+            self.max_rows,
+        );
+        Ok(())
+    }
+    fn truth(&mut self, p: &TruthSample) -> Result<(), Infallible> {
+        let rows = table(&mut self.recording.truth);
+        keep_row(
+            rows,
+            p,
+            &mut self.seen[3],
+            &mut self.thinning.rows[3],
+            self.max_rows,
+        );
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -292,5 +419,37 @@ mod tests {
         assert_eq!(read_thinning, thinning);
         assert_eq!(read.lidar, kept.lidar);
         assert_eq!(read.truth, kept.truth);
+    }
+
+    #[test]
+    fn a_sink_thinning_as_rows_arrive_holds_the_bound_and_keeps_what_the_whole_thinning_keeps() {
+        let rec = recording(100, 36);
+        let tables = crate::Tables {
+            odometry: false,
+            lidar: true,
+            sonar: false,
+            truth: true,
+        };
+        let mut sink = ThinnedSink::new(rec.meta.clone(), tables, 512);
+        let mut most = 0;
+        for r in rec.lidar.as_ref().unwrap() {
+            let Ok(()) = sink.lidar(r);
+            most = most.max(sink.recording.lidar.as_ref().map_or(0, Vec::len));
+        }
+        for p in rec.truth.as_ref().unwrap() {
+            let Ok(()) = sink.truth(p);
+        }
+        let Ok(()) = sink.command(&rec.commands[0]);
+        assert!(most <= 512 + 36, "held {most} rows");
+        let (kept, thinning) = sink.finish();
+        let (whole, whole_thinning) = rec.thinned(512);
+        assert_eq!(thinning, whole_thinning);
+        assert_eq!(kept, *whole);
+        // Within the bound, every sample is kept.
+        let mut sink = ThinnedSink::new(rec.meta.clone(), tables, 1_000_000);
+        for r in rec.lidar.as_ref().unwrap() {
+            let Ok(()) = sink.lidar(r);
+        }
+        assert!(sink.finish().1.is_whole());
     }
 }

@@ -21,11 +21,8 @@ pub use map::Overlay;
 pub use page::{is_report, map_svg, render, render_with, GENERATOR};
 pub use view::Inputs;
 
-/// The most rows of one table a report draws from: a longer recording is drawn from every k-th
-/// lidar revolution and row ([`hilsim_recording::Thinning`]), so that a report's memory is
-/// bounded whatever the recording's length. Half a million rows is about four and a half minutes
-/// of an XV-11's 1,800 readings a second; the page's charts thin far below it anyway.
-pub const MAX_ROWS: u64 = 500_000;
+/// The most rows of one table a report draws from ([`hilsim_recording::MAX_ROWS_HELD`]).
+pub const MAX_ROWS: u64 = hilsim_recording::MAX_ROWS_HELD;
 
 /// The recording's name as a page gives it: with which part was drawn, when not all of it.
 #[must_use]

@@ -12,4 +12,4 @@ mod summary;
 
 pub use discover::{scenario_files, DiscoverError};
 pub use metrics::{Metrics, Outcome};
-pub use pipeline::{execute, execute_all, Report, RunError, Via};
+pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};

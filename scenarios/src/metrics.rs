@@ -5,6 +5,9 @@ use std::collections::BTreeMap;
 
 use hilsim_hil::hil_run::HilReport;
 use hilsim_lidar_emulator::Run;
+use hilsim_recording::{
+    CommandSample, LidarSample, OdometrySample, Recording, SampleSink, SonarSample, TruthSample,
+};
 use hilsim_sim::scenario::{self, Expect, ExpectWhen};
 
 /// Metric name → value. Only metrics that could be computed are present.
@@ -14,72 +17,192 @@ pub type Metrics = BTreeMap<String, f64>;
 #[must_use]
 pub fn of_run(run: &Run) -> Metrics {
     let rec = &run.recording;
-    let mut m = Metrics::new();
-    let mut put = |name: &str, value: f64| {
-        if value.is_finite() {
-            m.insert(name.to_string(), value);
-        }
-    };
-    if let Some(truth) = &rec.truth {
-        if let (Some(first), Some(last)) = (truth.first(), truth.last()) {
+    let mut m = RunMetrics::default();
+    let Ok(()) = feed(rec, &mut m);
+    m.finish(run.collisions.len())
+}
+
+/// Hands every sample of `rec` to `sink`, table after table.
+fn feed<S: SampleSink>(rec: &Recording, sink: &mut S) -> Result<(), S::Error> {
+    for c in &rec.commands {
+        sink.command(c)?;
+    }
+    for o in rec.odometry.iter().flatten() {
+        sink.odometry(o)?;
+    }
+    for r in rec.lidar.iter().flatten() {
+        sink.lidar(r)?;
+    }
+    for p in rec.sonar.iter().flatten() {
+        sink.sonar(p)?;
+    }
+    for p in rec.truth.iter().flatten() {
+        sink.truth(p)?;
+    }
+    Ok(())
+}
+
+/// The metrics of a run, taken as its samples arrive (a [`SampleSink`]), so that a run of any
+/// length is measured in bounded memory: sums, counts and the last samples, nothing a table
+/// long. Sums are taken in the samples' order, so a run measured as it goes and measured from
+/// its recording give the same numbers to the bit.
+#[derive(Debug, Default)]
+pub struct RunMetrics {
+    tables: Tables,
+    truth: Option<(TruthSample, TruthSample)>,
+    /// The true path's length, and its length up to the latest odometry reading (each true
+    /// step whose start is before that reading's time), with the steps after it.
+    path: Option<f64>,
+    path_to_odometry: Option<f64>,
+    steps_after_odometry: std::collections::VecDeque<(f64, f64)>,
+    last_odometry: Option<OdometrySample>,
+    odometry: usize,
+    lidar: usize,
+    lidar_valid: usize,
+    lidar_last: Option<LidarSample>,
+    lidar_error: (f64, usize),
+    sonar: usize,
+    sonar_error: (f64, usize),
+}
+
+/// Whether each optional table was seen.
+#[derive(Debug, Default)]
+struct Tables {
+    odometry: bool,
+    lidar: bool,
+    sonar: bool,
+}
+
+impl RunMetrics {
+    /// The metrics, with the run's count of `collisions`.
+    #[must_use]
+    pub fn finish(mut self, collisions: usize) -> Metrics {
+        let mut m = Metrics::new();
+        let mut put = |name: &str, value: f64| {
+            if value.is_finite() {
+                m.insert(name.to_string(), value);
+            }
+        };
+        let empty_sum = || std::iter::empty::<f64>().sum::<f64>();
+        if let Some((first, last)) = self.truth {
             put("sim.duration_s", last.t_s - first.t_s);
             put("sim.final_x_m", last.x_m);
             put("sim.final_y_m", last.y_m);
             put("sim.final_yaw_deg", last.yaw_rad.to_degrees());
         }
-        let path: f64 = truth
-            .windows(2)
-            .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
-            .sum();
-        put("sim.distance_m", path);
-    }
-    put("sim.collisions", run.collisions.len() as f64);
-    if let Some(lidar) = &rec.lidar {
-        put("lidar.readings", lidar.len() as f64);
-        let revs = lidar
-            .last()
-            .map_or(0, |r| r.rev + u64::from(r.angle_deg == 359.0));
-        put("lidar.revolutions", revs as f64);
-        let valid: Vec<_> = lidar.iter().filter(|r| !r.invalid).collect();
-        if !lidar.is_empty() {
-            put(
-                "lidar.valid_fraction",
-                valid.len() as f64 / lidar.len() as f64,
-            );
+        if self.truth.is_some() || self.path.is_some() {
+            put("sim.distance_m", self.path.unwrap_or_else(empty_sum));
         }
-        put(
-            "lidar.rmse_m",
-            rms(valid
-                .iter()
-                .filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
-        );
-    }
-    if let Some(sonar) = &rec.sonar {
-        put("sonar.readings", sonar.len() as f64);
-        put(
-            "sonar.rmse_m",
-            rms(sonar
-                .iter()
-                .filter_map(|r| r.true_range_m.map(|t| r.range_m - t))),
-        );
-    }
-    if let Some(odometry) = &rec.odometry {
-        put("odometer.readings", odometry.len() as f64);
-        if let (Some(last), Some(truth)) = (odometry.last(), &rec.truth) {
-            // True wheel travel is not in the recording; the mean of the wheels' reported travel
-            // over the true path length is the scale for straight runs (turns cancel out).
-            let reported = (last.left_m.abs() + last.right_m.abs()) / 2.0;
-            let true_path: f64 = truth
-                .windows(2)
-                .take_while(|w| w[0].t_s < last.t_s)
-                .map(|w| (w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m))
-                .sum();
-            if true_path > 0.01 {
-                put("odometer.scale", reported / true_path);
+        put("sim.collisions", collisions as f64);
+        if self.tables.lidar {
+            put("lidar.readings", self.lidar as f64);
+            let revs = self
+                .lidar_last
+                .map_or(0, |r| r.rev + u64::from(r.angle_deg == 359.0));
+            put("lidar.revolutions", revs as f64);
+            if self.lidar > 0 {
+                put(
+                    "lidar.valid_fraction",
+                    self.lidar_valid as f64 / self.lidar as f64,
+                );
+            }
+            put("lidar.rmse_m", rms(self.lidar_error));
+        }
+        if self.tables.sonar {
+            put("sonar.readings", self.sonar as f64);
+            put("sonar.rmse_m", rms(self.sonar_error));
+        }
+        if self.tables.odometry {
+            put("odometer.readings", self.odometry as f64);
+            if let (Some(last), Some(_)) = (self.last_odometry, self.truth) {
+                // True wheel travel is not in the recording; the mean of the wheels' reported
+                // travel over the true path length is the scale for straight runs (turns cancel
+                // out).
+                self.catch_up_to_odometry();
+                let reported = (last.left_m.abs() + last.right_m.abs()) / 2.0;
+                let true_path = self.path_to_odometry.unwrap_or_else(empty_sum);
+                if true_path > 0.01 {
+                    put("odometer.scale", reported / true_path);
+                }
             }
         }
+        m
     }
-    m
+
+    /// Counts into the path to the latest odometry reading every true step that starts before
+    /// it, in order.
+    fn catch_up_to_odometry(&mut self) {
+        let Some(t) = self.last_odometry.map(|o| o.t_s) else {
+            return;
+        };
+        while let Some(&(start, d)) = self.steps_after_odometry.front() {
+            if start >= t {
+                break;
+            }
+            self.steps_after_odometry.pop_front();
+            add(&mut self.path_to_odometry, d);
+        }
+    }
+}
+
+/// `sum + d`, the sum starting as an empty sum of floats does.
+fn add(sum: &mut Option<f64>, d: f64) {
+    let s = sum.get_or_insert_with(|| std::iter::empty::<f64>().sum::<f64>());
+    *s += d;
+}
+
+impl SampleSink for RunMetrics {
+    type Error = std::convert::Infallible;
+    fn command(&mut self, _: &CommandSample) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    fn odometry(&mut self, o: &OdometrySample) -> Result<(), Self::Error> {
+        self.tables.odometry = true;
+        self.odometry += 1;
+        self.last_odometry = Some(*o);
+        self.catch_up_to_odometry();
+        Ok(())
+    }
+    fn lidar(&mut self, r: &LidarSample) -> Result<(), Self::Error> {
+        self.tables.lidar = true;
+        self.lidar += 1;
+        self.lidar_last = Some(*r);
+        if !r.invalid {
+            self.lidar_valid += 1;
+            if let Some(t) = r.true_range_m {
+                let e = r.range_m - t;
+                self.lidar_error = (self.lidar_error.0 + e * e, self.lidar_error.1 + 1);
+            }
+        }
+        Ok(())
+    }
+    fn sonar(&mut self, p: &SonarSample) -> Result<(), Self::Error> {
+        self.tables.sonar = true;
+        self.sonar += 1;
+        if let Some(t) = p.true_range_m {
+            let e = p.range_m - t;
+            self.sonar_error = (self.sonar_error.0 + e * e, self.sonar_error.1 + 1);
+        }
+        Ok(())
+    }
+    fn truth(&mut self, p: &TruthSample) -> Result<(), Self::Error> {
+        match &mut self.truth {
+            None => self.truth = Some((*p, *p)),
+            Some((_, last)) => {
+                let d = (p.x_m - last.x_m).hypot(p.y_m - last.y_m);
+                let start = last.t_s;
+                *last = *p;
+                add(&mut self.path, d);
+                let before_odometry = self.last_odometry.is_some_and(|o| start < o.t_s);
+                if self.steps_after_odometry.is_empty() && before_odometry {
+                    add(&mut self.path_to_odometry, d);
+                } else {
+                    self.steps_after_odometry.push_back((start, d));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The metrics of one calibration: `<method>.lidar.mse_ratio` and friends (see the catalogue).
@@ -112,8 +235,8 @@ pub fn of_calibration(c: &hilsim_calibrator::Calibration) -> Metrics {
     m
 }
 
-fn rms(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+/// The root mean square of errors summed as (sum of squares, count); NaN for none.
+fn rms((sum, n): (f64, usize)) -> f64 {
     if n == 0 {
         f64::NAN
     } else {

@@ -65,6 +65,13 @@ impl Report {
         }
         if self.calibrations.is_empty() {
             writeln!(out, "  calibration: none requested by the scenario")?;
+        } else if !self.thinning.is_whole() {
+            writeln!(
+                out,
+                "  calibrated from {} (the run is longer than a run holds in memory; the \
+                 figures above count every sample)",
+                self.thinning.describe()
+            )?;
         }
         for calibration in &self.calibrations {
             for line in calibration.describe().lines() {

@@ -1,10 +1,12 @@
 //! `hilsim run [SCENARIO] [--out DIR] [--seed N] [--via memory|serial] [--json]`: the main job.
 
 use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Result;
-use hilsim_recording::write_file_atomically;
+use anyhow::{Context, Result};
+use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::{write_file_atomically, RecordingStream};
 use hilsim_scenarios::{builtin, Via};
 
 use crate::cli::{self, RunArgs};
@@ -20,6 +22,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     if let Some(dir) = &args.out {
         hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
+        hilsim_recording::tidy_after_killed_writers(dir)?;
     }
     if let Some(mcap) = &args.mcap {
         super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
@@ -30,31 +33,61 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         cli::Via::Serial => Via::Serial,
     };
     let world = super::export::world(&scenario);
-    let report = hilsim_scenarios::execute(scenario, &origin, via)?;
+    // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
+    // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
+    // its length; through the serial path the run is held whole and written from memory.
+    let scratch = match (&args.out, &args.mcap, via) {
+        (None, Some(mcap), Via::Memory) => Some(scratch_dir(mcap)?),
+        _ => None,
+    };
+    let streamed_to: Option<PathBuf> = match via {
+        Via::Memory => args
+            .out
+            .clone()
+            .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
+        Via::Serial => None,
+    };
+    let (report, stream) = match &streamed_to {
+        Some(dir) => {
+            let emulation = Emulation::new(&scenario, scenario.seed)
+                .with_context(|| format!("{origin}: sensor model"))?;
+            let mut stream =
+                RecordingStream::create(dir, emulation.meta().clone(), emulation.tables())?;
+            drop(emulation);
+            let report = hilsim_scenarios::execute_into(scenario, &origin, via, &mut stream)?;
+            (report, Some(stream))
+        }
+        None => (hilsim_scenarios::execute(scenario, &origin, via)?, None),
+    };
     if args.json {
         out.write_all(report.results_json().as_bytes())?;
     } else {
         out.write_all(report.summary().as_bytes())?;
     }
-    if let Some(dir) = &args.out {
-        let results = report.results_json();
-        hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
+    let results = report.results_json();
+    let add_results = |tmp: &Path| -> Result<()> {
+        write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
+        Ok(())
+    };
+    match (stream, &args.out) {
+        (Some(stream), Some(_)) => stream.finish_with(add_results)?,
+        (Some(stream), None) => stream.finish()?,
+        (None, Some(dir)) => hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
             report.run.recording.write_files(tmp)?;
-            write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
-            Ok(())
-        })?;
-        if !args.json {
-            writeln!(out, "wrote {}", dir.display())?;
-        }
+            add_results(tmp)
+        })?,
+        (None, None) => {}
+    }
+    if let (Some(dir), false) = (&args.out, args.json) {
+        writeln!(out, "wrote {}", dir.display())?;
     }
     if let Some(dir) = &args.report {
         let title = format!("hilsim run: {}", report.scenario.name);
-        let (recording, thinning) = report.run.recording.thinned(hilsim_report::MAX_ROWS);
         let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
         let html = hilsim_report::render(hilsim_report::Inputs {
             title: &title,
-            recording: &recording,
-            recording_name: &hilsim_report::drawn_name(&name, &thinning),
+            recording: &report.run.recording,
+            recording_name: &hilsim_report::drawn_name(&name, &report.thinning),
             scenario: Some(&report.scenario),
             calibrations: &report.calibrations,
             truth_estimated: false,
@@ -65,14 +98,37 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
     }
     if let Some(mcap) = &args.mcap {
-        super::export::write_mcap(&report.run.recording, Some(&world), mcap)?;
+        match &streamed_to {
+            Some(dir) => super::export::write_mcap_of_dir(dir, Some(&world), mcap)?,
+            None => super::export::write_mcap(&report.run.recording, Some(&world), mcap)?,
+        }
         if !args.json {
             writeln!(out, "wrote {}", mcap.display())?;
         }
     }
+    drop(scratch);
     Ok(if report.passed() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     })
+}
+
+/// A temporary directory beside `mcap` (the same file system, removed when dropped) for the
+/// recording an MCAP file is exported from.
+fn scratch_dir(mcap: &Path) -> Result<tempfile::TempDir> {
+    let parent = mcap
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    // Standard output or a device has no directory of its own to put it beside.
+    let parent = if parent.starts_with("/dev") || parent.starts_with("/proc") {
+        std::env::temp_dir()
+    } else {
+        parent.to_path_buf()
+    };
+    tempfile::Builder::new()
+        .prefix(".hilsim-run.")
+        .tempdir_in(&parent)
+        .with_context(|| format!("{}: cannot make a temporary directory", parent.display()))
 }

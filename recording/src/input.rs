@@ -101,19 +101,6 @@ pub fn read_small_text(path: &Path, max_bytes: u64, what: &str) -> Result<String
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sizes_read_as_people_write_them() {
-        assert_eq!(size(MAX_LINE_BYTES as u64), "64 KiB");
-        assert_eq!(size(MAX_META_BYTES), "1 MiB");
-        assert_eq!(size(MAX_TABLE_BYTES), "16 GiB");
-        assert_eq!(size(1000), "1000 bytes");
-    }
-}
-
 /// Which directory `dir` is now (device and inode). A writer replaces a recording by renaming a
 /// whole new directory over it, so a reader that opens its files one after another by path can
 /// take some from the old recording and some from the new: a reader notes the identity before
@@ -134,5 +121,18 @@ pub(crate) fn check_same_dir(dir: &Path, identity: (u64, u64)) -> Result<(), Err
             None,
             "was replaced by another recording while it was being read; read it again",
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_read_as_people_write_them() {
+        assert_eq!(size(MAX_LINE_BYTES as u64), "64 KiB");
+        assert_eq!(size(MAX_META_BYTES), "1 MiB");
+        assert_eq!(size(MAX_TABLE_BYTES), "16 GiB");
+        assert_eq!(size(1000), "1000 bytes");
     }
 }

@@ -186,14 +186,19 @@ mod tests {
 
     #[test]
     fn every_key_hilsim_writes_is_known() {
-        let mut meta = Meta::default();
-        meta.lidar = Some(Mount::default());
-        meta.world.landmark_radius_m = Some(0.12);
-        meta.source = Some(SourceMeta {
-            generator: "hilsim".into(),
-            scenario: Some("s".into()),
-            seed: Some(7),
-        });
+        let meta = Meta {
+            lidar: Some(Mount::default()),
+            world: WorldMeta {
+                landmark_radius_m: Some(0.12),
+                target_start_distance_m: None,
+            },
+            source: Some(SourceMeta {
+                generator: "hilsim".into(),
+                scenario: Some("s".into()),
+                seed: Some(7),
+            }),
+            ..Meta::default()
+        };
         let text = toml::to_string(&meta).unwrap();
         assert!(Meta::unknown_keys(&text).is_empty(), "{text}");
         assert!(Meta::unknown_keys("not = = toml").is_empty());

@@ -29,7 +29,7 @@ pub(crate) const MAX_LINE_BYTES: usize = 64 * 1024;
 pub(crate) const MAX_TABLE_BYTES: u64 = 16 << 30;
 
 /// The largest `meta.toml` a recording may have, in bytes.
-pub(crate) const MAX_META_BYTES: u64 = 1 << 20;
+pub const MAX_META_BYTES: u64 = 1 << 20;
 
 /// Opens a file of a recording: a regular file (after following links) no larger than
 /// `max_bytes`, described as `what` when it is larger.

@@ -41,7 +41,7 @@ pub use atomic::{
 };
 pub use background::BackgroundStream;
 pub use error::{Error, ErrorKind};
-pub use input::read_small_text;
+pub use input::{read_small_text, MAX_META_BYTES};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
 pub use pose::{wrap_angle, Pose};

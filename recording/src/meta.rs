@@ -123,3 +123,84 @@ pub struct SourceMeta {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
 }
+
+impl Meta {
+    /// The keys of a `meta.toml` text that the format does not define, as dotted paths
+    /// (`bogus`, `lidar.x_mm`). Reading ignores them, so that other tools may add their own; but
+    /// a misspelt key reads as absent, so a calibration notes them. Empty for text that is not
+    /// TOML (reading it reports that).
+    #[must_use]
+    pub fn unknown_keys(text: &str) -> Vec<String> {
+        let Ok(given) = text.parse::<toml::Table>() else {
+            return Vec::new();
+        };
+        // Every key the format defines: a `Meta` with every optional part present.
+        let full = Meta {
+            lidar: Some(Mount::default()),
+            sonar: Some(SonarMount {
+                x_m: 0.0,
+                y_m: 0.0,
+                yaw_deg: 0.0,
+                half_angle_deg: 0.0,
+            }),
+            world: WorldMeta {
+                landmark_radius_m: Some(0.0),
+                target_start_distance_m: Some(0.0),
+            },
+            source: Some(SourceMeta {
+                generator: String::new(),
+                scenario: Some(String::new()),
+                seed: Some(0),
+            }),
+            ..Meta::default()
+        };
+        let known = toml::Table::try_from(full).unwrap_or_default();
+        let mut unknown = Vec::new();
+        unknown_in(&given, &known, "", &mut unknown);
+        unknown
+    }
+}
+
+fn unknown_in(given: &toml::Table, known: &toml::Table, prefix: &str, out: &mut Vec<String>) {
+    for (key, value) in given {
+        match (value, known.get(key)) {
+            (_, None) => out.push(format!("{prefix}{key}")),
+            (toml::Value::Table(inner), Some(toml::Value::Table(defined))) => {
+                unknown_in(inner, defined, &format!("{prefix}{key}."), out);
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_the_format_does_not_define_are_listed_as_paths() {
+        let text = "format = \"hilsim-recording/1\"\n[robot]\nwheel_base_m = 0.23\n\
+                    [lidar]\nx_mm = 5\n[world]\ntarget_start_distance_m = 0.5\n[bogus]\nx = 1\n";
+        assert_eq!(Meta::unknown_keys(text), ["bogus", "lidar.x_mm"]);
+    }
+
+    #[test]
+    fn every_key_hilsim_writes_is_known() {
+        let meta = Meta {
+            lidar: Some(Mount::default()),
+            world: WorldMeta {
+                landmark_radius_m: Some(0.12),
+                target_start_distance_m: None,
+            },
+            source: Some(SourceMeta {
+                generator: "hilsim".into(),
+                scenario: Some("s".into()),
+                seed: Some(7),
+            }),
+            ..Meta::default()
+        };
+        let text = toml::to_string(&meta).unwrap();
+        assert!(Meta::unknown_keys(&text).is_empty(), "{text}");
+        assert!(Meta::unknown_keys("not = = toml").is_empty());
+    }
+}

@@ -11,7 +11,7 @@ use hilsim_calibrator::landmarks::StopOptions;
 use hilsim_calibrator::smoothing;
 use hilsim_calibrator::{em, Method, SampleOptions, Settings};
 use hilsim_recording::{
-    check_output_file, write_file_atomically, FileKind, OutputTarget, Recording,
+    check_output_file, write_file_atomically, FileKind, Meta, OutputTarget, Recording,
 };
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
@@ -58,8 +58,20 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     };
     let rec = Recording::read_dir(&args.recording)?;
     let method = args.method;
-    let calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
+    let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
         .with_context(|| format!("{}: {}", args.recording.display(), method.name()))?;
+    // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
+    let meta = args.recording.join("meta.toml");
+    if let Ok(text) =
+        hilsim_recording::read_small_text(&meta, hilsim_recording::MAX_META_BYTES, "meta.toml")
+    {
+        for key in Meta::unknown_keys(&text) {
+            calibration.notes.push(format!(
+                "meta.toml: `{}` is not a key of the recording format; ignored",
+                hilsim_recording::printable(&key)
+            ));
+        }
+    }
     if args.json {
         writeln!(out, "{}", calibration.to_json())?;
     } else {

@@ -37,8 +37,9 @@ pub struct DiagnoseArgs {
     pub report: Option<PathBuf>,
     /// Run N blind trials: each draws an effect (or none) and its parameters, records a "real"
     /// run with it, diagnoses it against the nominal scenario and scores the answer.
+    // Wide enough for any count typed, so that the range check below says what is expected.
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
-    pub self_test: Option<i64>,
+    pub self_test: Option<i128>,
     /// Seed of the self-test's draws (default 1).
     #[arg(long, value_name = "S", requires = "self_test")]
     pub seed: Option<u64>,
@@ -122,16 +123,16 @@ fn options(args: &DiagnoseArgs) -> Result<Options> {
 
 pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(n) = args.self_test {
+        if n < 1 {
+            bail!("--self-test: expected at least one trial, found {n}");
+        }
         let n = match u64::try_from(n) {
-            Ok(n) if n > 0 => n,
-            _ => bail!("--self-test: expected at least one trial, found {n}"),
-        };
-        if n > self_test::MAX_TRIALS {
-            bail!(
+            Ok(n) if n <= self_test::MAX_TRIALS => n,
+            _ => bail!(
                 "--self-test: expected at most {} trials, found {n}",
                 self_test::MAX_TRIALS
-            );
-        }
+            ),
+        };
         if !(args.strength.is_finite() && args.strength > 0.0 && args.strength <= 5.0) {
             bail!(
                 "--strength: expected a factor in (0, 5], found {:?}",

@@ -575,3 +575,26 @@ fn smooth_refuses_a_calibration_that_is_ambiguous_or_not_one() {
         assert!(err.contains(says), "{name}: {err}");
     }
 }
+
+#[test]
+fn a_key_meta_toml_does_not_define_is_noted() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path(), "straight-board.toml", "rec");
+    let meta = tmp.path().join("rec/meta.toml");
+    let text = std::fs::read_to_string(&meta).unwrap();
+    std::fs::write(&meta, text + "[bogus]\nx = 1\n").unwrap();
+    let cal = json(&hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "em", "--json"],
+    ));
+    let notes: Vec<&str> = cal["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n.as_str())
+        .collect();
+    assert!(
+        notes.contains(&"meta.toml: `bogus` is not a key of the recording format; ignored"),
+        "{notes:?}"
+    );
+}

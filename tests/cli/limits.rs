@@ -35,7 +35,7 @@ fn issue_18_a_negative_start_distance_is_a_value_not_a_flag() {
         args.extend(["--start-distance", "-1"]);
         let err = assert_bad_input(&hilsim(tmp.path(), &args));
         assert!(
-            err.contains("--start-distance: expected a positive distance"),
+            err.contains("--start-distance: expected a distance from 0.01 to 1000 m, found -1.0"),
             "{command}: {err}"
         );
     }

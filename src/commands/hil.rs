@@ -112,8 +112,8 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
             .split_whitespace()
             .collect::<Vec<_>>()
             .join(" "),
-        scenario.name,
-        origin,
+        hilsim_recording::printable(&scenario.name),
+        hilsim_recording::printable(&origin),
         duration.as_secs_f64()
     )?;
     out.flush()?;

@@ -45,8 +45,8 @@ impl Thinning {
     /// page that draws a thinned recording; empty when whole.
     #[must_use]
     pub fn describe(&self) -> String {
-        let every = |k: u64, what: &str| (k > 1).then(|| format!("every {k}th {what}"));
-        [
+        let every = |k: u64, what: &str| (k > 1).then(|| format!("every {} {what}", ordinal(k)));
+        let parts: Vec<String> = [
             every(self.lidar_revolutions, "lidar revolution"),
             every(self.rows[0], "command"),
             every(self.rows[1], "odometry row"),
@@ -55,8 +55,11 @@ impl Thinning {
         ]
         .into_iter()
         .flatten()
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+        match parts.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => parts.concat(),
+        }
     }
 
     /// The thinning that keeps at most about `max_rows` rows of each table of a recording of
@@ -76,6 +79,18 @@ impl Thinning {
             ],
         }
     }
+}
+
+/// `k` as an English ordinal: 2nd, 3rd, 4th, 11th, 21st.
+fn ordinal(k: u64) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
 }
 
 /// Rows of each table: the lidar's, and the commands', odometry's, sonar's and truth's.
@@ -410,7 +425,17 @@ mod tests {
         assert!(lidar.iter().all(|r| r.rev % 8 == 0));
         assert_eq!(lidar.len() % 36, 0, "whole revolutions");
         assert_eq!(kept.truth.as_ref().unwrap().len(), 500);
-        assert!(thinning.describe().contains("every 8th lidar revolution"));
+        assert_eq!(
+            thinning.describe(),
+            "every 8th lidar revolution and every 2nd true pose"
+        );
+        assert_eq!(
+            [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111].map(ordinal),
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st",
+                "111th"
+            ]
+        );
         // Read from a directory as streams, the same part is kept.
         let dir = tempfile::tempdir().unwrap();
         rec.write_dir(&dir.path().join("r")).unwrap();

@@ -31,7 +31,7 @@ pub fn drawn_name(name: &str, thinning: &hilsim_recording::Thinning) -> String {
         name.to_string()
     } else {
         format!(
-            "{name}, drawn from {} of it (longer than a report draws whole)",
+            "{name}, drawn from {} (longer than a report draws whole)",
             thinning.describe()
         )
     }

@@ -232,7 +232,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     };
     let options = options(args)?;
     if let Some(dir) = &args.report {
-        super::report::check_report_dir(dir, &[MAP_FILE])?;
+        super::report_dir::check_report_dir(dir, &[MAP_FILE])?;
     }
     let scenario = super::load_scenario(Some(sim), None)?;
     let recording = Recording::read_dir(real)?;
@@ -288,7 +288,7 @@ fn write_report(
         .collect();
     let mut own: Vec<&str> = files.iter().map(String::as_str).collect();
     own.push(MAP_FILE);
-    super::report::check_report_dir(dir, &own)?;
+    super::report_dir::check_report_dir(dir, &own)?;
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     for (name, p) in files.iter().zip(&d.plots) {
         write_owned_file_atomically(&dir.join(name), show::svg(p).as_bytes())?;

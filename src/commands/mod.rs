@@ -10,6 +10,7 @@ pub mod hil;
 pub mod import;
 pub mod record;
 pub mod report;
+mod report_dir;
 pub mod run;
 mod scenario_file;
 pub mod scenario_test;

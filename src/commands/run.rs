@@ -18,7 +18,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     );
     // Every output is checked before the run, so that a refused one costs nothing.
     if let Some(dir) = &args.report {
-        super::report::check_report_dir(dir, &[])?;
+        super::report_dir::check_report_dir(dir, &[])?;
     }
     if let Some(dir) = &args.out {
         hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
@@ -92,7 +92,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             calibrations: &report.calibrations,
             truth_estimated: false,
         });
-        super::report::write_report_page(dir, &html)?;
+        super::report_dir::write_report_page(dir, &html)?;
         if !args.json {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
         }

@@ -2,7 +2,8 @@
 # A real cluster: the README's Slurm job-array example ("Datasets", Sharding) run on a
 # single-node Slurm cluster, and the merged dataset compared byte for byte with the unsharded one.
 #
-# Usage, as root:  tests/cluster/slurm.sh [HILSIM]     (HILSIM: default target/release/hilsim)
+# Usage, as root:  tests/cluster/slurm.sh [HILSIM]     (HILSIM: default the release binary, built
+# and found through cargo: .ci/hilsim-binary --release)
 #
 # Installs Debian's slurm-wlm and munge when slurmctld is missing. Everything else lives in a
 # temporary directory: munge's key, socket and seed, slurm.conf (SLURM_CONF), the state, spool
@@ -12,7 +13,7 @@
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-HILSIM=${1:-$ROOT/target/release/hilsim}
+HILSIM=${1:-$(bash "$ROOT/.ci/hilsim-binary" --release)}
 SCENARIO=$ROOT/scenarios/landmarks-5.toml
 RUNS=8
 TASKS=4

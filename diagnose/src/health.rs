@@ -40,19 +40,8 @@ pub(crate) fn dead_or_stuck(ctx: &Context<'_>) -> Vec<Evidence> {
 
 fn lidar(ctx: &Context<'_>) -> Option<Evidence> {
     let declared = ctx.physics.declared().lidar?;
-    let rows: Vec<_> = ctx
-        .recording
-        .lidar
-        .as_ref()?
-        .iter()
-        .filter(|s| s.t_s <= ctx.end_s)
-        .collect();
-    if rows.len() < MIN_READINGS {
-        return None;
-    }
-    let step = rows.len().div_ceil(MAX_CHECKED);
+    let checked = looked_at(ctx.recording.lidar.as_ref()?, |s| s.t_s, ctx.end_s)?;
     let period = 60.0 / (declared.rpm * 360.0);
-    let checked: Vec<_> = rows.iter().step_by(step).collect();
     let queries: Vec<LidarQuery> = checked
         .iter()
         .map(|s| LidarQuery {
@@ -78,18 +67,7 @@ fn lidar(ctx: &Context<'_>) -> Option<Evidence> {
 
 fn sonar(ctx: &Context<'_>) -> Option<Evidence> {
     ctx.physics.declared().sonar_half_angle_deg?;
-    let rows: Vec<_> = ctx
-        .recording
-        .sonar
-        .as_ref()?
-        .iter()
-        .filter(|s| s.t_s <= ctx.end_s)
-        .collect();
-    if rows.len() < MIN_READINGS {
-        return None;
-    }
-    let step = rows.len().div_ceil(MAX_CHECKED);
-    let checked: Vec<_> = rows.iter().step_by(step).collect();
+    let checked = looked_at(ctx.recording.sonar.as_ref()?, |s| s.t_s, ctx.end_s)?;
     let times: Vec<f64> = checked.iter().map(|s| s.t_s).collect();
     let predicted = ctx
         .physics
@@ -104,6 +82,17 @@ fn sonar(ctx: &Context<'_>) -> Option<Evidence> {
         })
         .collect();
     judge(Sensor::Sonar, &expected, checked.len())
+}
+
+/// The rows up to `end_s` a check looks at, evenly thinned to at most [`MAX_CHECKED`]; `None`
+/// with too few to judge.
+fn looked_at<T>(rows: &[T], t_s: impl Fn(&T) -> f64, end_s: f64) -> Option<Vec<&T>> {
+    let rows: Vec<&T> = rows.iter().filter(|r| t_s(r) <= end_s).collect();
+    if rows.len() < MIN_READINGS {
+        return None;
+    }
+    let step = rows.len().div_ceil(MAX_CHECKED);
+    Some(rows.into_iter().step_by(step).collect())
 }
 
 /// `expected`: each reading the simulation expects valid, as (the reading, NaN when the sensor

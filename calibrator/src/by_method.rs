@@ -15,6 +15,8 @@ pub struct Settings {
     pub stops: landmarks::StopOptions,
     /// Priors on bias coefficients (EM).
     pub priors: em::Priors,
+    /// Scan matching and intervals (odometry).
+    pub odometry: crate::odometry::RecordingOptions,
 }
 
 /// Calibrates `rec` with `method`, each method with its default options but the target (the beam
@@ -70,6 +72,7 @@ pub fn calibrate_with(
                 ..landmarks::Options::default()
             },
         ),
+        Method::Odometry => crate::odometry::calibrate(rec, &settings.odometry),
     }
 }
 

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The calibration methods and the sensors they calibrate (one definition each, shared with
 /// the scenario files: `hilsim_recording::names`).
@@ -36,6 +36,52 @@ impl SensorModel {
             alpha_sd: Vec::new(),
             beta_sd: Vec::new(),
         }
+    }
+}
+
+/// A differential drive's wheels and the lidar's pose on it, as `--method odometry` estimates
+/// them (Censi, Franchi, Marchionni, Oriolo, IEEE T-RO 29(2), 2013).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OdometryModel {
+    /// The left wheel's radius, metres.
+    pub left_wheel_radius_m: f64,
+    /// The right wheel's radius, metres.
+    pub right_wheel_radius_m: f64,
+    /// The distance between the wheels' contact points, metres.
+    pub wheel_base_m: f64,
+    /// The lidar's position on the robot, forward of the axle's centre, metres.
+    pub lidar_x_m: f64,
+    /// The lidar's position on the robot, left of the axle's centre, metres.
+    pub lidar_y_m: f64,
+    /// The lidar's yaw on the robot, counter-clockwise, radians.
+    pub lidar_yaw_rad: f64,
+    /// The estimate's covariance, in the order of the fields above (m², m·rad, rad²).
+    pub covariance: [[f64; 6]; 6],
+    /// Each wheel's radius over the nominal one the recording's travel was reported with
+    /// (`meta.toml`'s `[robot] wheel_radius_m`): the factor the recorded travel is short by.
+    /// Absent for tuples, whose wheel speeds are angular already.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wheel_scale: Option<[f64; 2]>,
+}
+
+impl OdometryModel {
+    /// The standard deviations, in the covariance's order.
+    #[must_use]
+    pub fn standard_deviations(&self) -> [f64; 6] {
+        std::array::from_fn(|i| self.covariance[i][i].max(0.0).sqrt())
+    }
+
+    /// The parameters, in the covariance's order.
+    #[must_use]
+    pub fn parameters(&self) -> [f64; 6] {
+        [
+            self.left_wheel_radius_m,
+            self.right_wheel_radius_m,
+            self.wheel_base_m,
+            self.lidar_x_m,
+            self.lidar_y_m,
+            self.lidar_yaw_rad,
+        ]
     }
 }
 
@@ -130,6 +176,9 @@ pub struct Calibration {
     /// recording (x forward, y left) (landmarks).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub landmarks: Option<Vec<[f64; 2]>>,
+    /// The wheels and the lidar's mount (odometry).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub odometry: Option<OdometryModel>,
     /// The method's assumptions tested on the data ([`crate::checks`]); a failed one makes
     /// `hilsim calibrate` exit 1 with the result still printed.
     pub checks: Vec<crate::checks::Check>,

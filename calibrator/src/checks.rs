@@ -127,6 +127,35 @@ pub fn ljung_box(x: &[f64], lags: usize) -> Option<f64> {
     Some(nf * (nf + 2.0) * q)
 }
 
+/// How much a series' correlation in time inflates the variance of an estimate from it:
+/// `1 + 2 Σ_{k=1..lags} ρ_k`, the factor by which `n` correlated values carry less information
+/// than `n` independent ones (the "effective sample size" of time-series analysis, e.g.
+/// Shumway & Stoffer, Time Series Analysis, 4th ed., Sec. 1.5). At least 1: a negative sum is
+/// read as white. `None` with fewer than `4 lags` values.
+#[must_use]
+pub fn variance_inflation(x: &[f64], lags: usize) -> Option<f64> {
+    let n = x.len();
+    if n < 4 * lags || lags == 0 {
+        return None;
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let c0: f64 = x.iter().map(|v| (v - mean).powi(2)).sum();
+    if !(c0.is_finite() && c0 > 0.0) {
+        return None;
+    }
+    let sum: f64 = (1..=lags)
+        .map(|k| {
+            x[k..]
+                .iter()
+                .zip(x)
+                .map(|(a, b)| (a - mean) * (b - mean))
+                .sum::<f64>()
+                / c0
+        })
+        .sum();
+    Some((1.0 + 2.0 * sum).max(1.0))
+}
+
 /// Whiteness of a standardised residual series, as a check named `name`.
 #[must_use]
 pub fn white(name: &str, what: &str, residuals: &[f64]) -> Option<Check> {

@@ -5,7 +5,8 @@ use std::fmt::Write;
 
 use crate::checks::Check;
 use crate::{
-    Calibration, CalibrationError, LidarModelMetrics, Method, Metrics, Sensor, SensorModel,
+    Calibration, CalibrationError, LidarModelMetrics, Method, Metrics, OdometryModel, Sensor,
+    SensorModel,
 };
 
 impl Calibration {
@@ -42,6 +43,9 @@ impl Calibration {
         if let Some(order) = self.order {
             writeln!(s, "  order {order}")?;
         }
+        if let Some(o) = &self.odometry {
+            write_odometry(s, o)?;
+        }
         if let Some(landmarks) = &self.landmarks {
             for (i, [x, y]) in landmarks.iter().enumerate() {
                 writeln!(s, "  landmark {i}: ({x:.3}, {y:.3}) m")?;
@@ -52,7 +56,7 @@ impl Calibration {
             // paper's comparison), which fuses every sensor and the commands.
             let what = match self.method {
                 Method::Em => "smoothed distance (all sensors and commands)",
-                Method::Landmarks | Method::Groundtruth => "lidar distance",
+                Method::Landmarks | Method::Groundtruth | Method::Odometry => "lidar distance",
             };
             writeln!(
                 s,
@@ -145,7 +149,7 @@ impl Calibration {
                 .get("method")
                 .map_or_else(|| "none".to_string(), shown);
             return Err(invalid(format!(
-                "{origin}: `method` must be em, landmarks or groundtruth, found {found}"
+                "{origin}: `method` must be em, landmarks, groundtruth or odometry, found {found}"
             )));
         };
         let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
@@ -249,6 +253,12 @@ impl Calibration {
             order: value["order"]
                 .as_u64()
                 .and_then(|n| usize::try_from(n).ok()),
+            odometry: match value.get("odometry") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(v) => Some(serde_json::from_value(v.clone()).map_err(|e| {
+                    invalid(format!("{origin}: `odometry`: {e}"))
+                })?),
+            },
             landmarks: value["landmarks"].as_array().and_then(|list| {
                 list.iter()
                     .map(|p| Some([p.get(0)?.as_f64()?, p.get(1)?.as_f64()?]))
@@ -450,4 +460,41 @@ mod tests {
         let three = one.replace("[0.1]", "[0.1, 0.1, 0.1]");
         assert!(Calibration::from_json(&three, "cal.json").is_ok());
     }
+}
+
+/// The wheels and the mount with their standard deviations, in millimetres and milliradians
+/// (the sizes a robot's owner measures them in).
+fn write_odometry(s: &mut String, o: &OdometryModel) -> std::fmt::Result {
+    let sd = o.standard_deviations();
+    writeln!(
+        s,
+        "  wheel radius   left {:.3} ± {:.3} mm   right {:.3} ± {:.3} mm",
+        o.left_wheel_radius_m * 1e3,
+        sd[0] * 1e3,
+        o.right_wheel_radius_m * 1e3,
+        sd[1] * 1e3
+    )?;
+    if let Some([left, right]) = o.wheel_scale {
+        writeln!(
+            s,
+            "  wheel scale    left {left:.5}   right {right:.5}   (real travel over recorded)"
+        )?;
+    }
+    writeln!(
+        s,
+        "  wheel base     {:.3} ± {:.3} mm",
+        o.wheel_base_m * 1e3,
+        sd[2] * 1e3
+    )?;
+    writeln!(
+        s,
+        "  lidar mount    x {:.2} ± {:.2} mm   y {:.2} ± {:.2} mm   yaw {:.2} ± {:.2} mrad ({:.3}°)",
+        o.lidar_x_m * 1e3,
+        sd[3] * 1e3,
+        o.lidar_y_m * 1e3,
+        sd[4] * 1e3,
+        o.lidar_yaw_rad * 1e3,
+        sd[5] * 1e3,
+        o.lidar_yaw_rad.to_degrees()
+    )
 }

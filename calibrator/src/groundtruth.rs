@@ -412,6 +412,7 @@ pub fn calibrate(rec: &Recording, opts: &Options) -> Result<Calibration, Calibra
         converged: true,
         metrics,
         order: Some(lidar.order()),
+        odometry: None,
         landmarks: None,
         checks,
         notes,

@@ -16,11 +16,14 @@ pub mod error;
 pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
+pub mod odometry;
 pub mod smoothing;
 pub mod stats;
 pub mod target_samples;
 
 pub use by_method::{calibrate, calibrate_with, em_options, Settings};
-pub use calibration::{Calibration, LidarModelMetrics, Method, Metrics, Sensor, SensorModel};
+pub use calibration::{
+    Calibration, LidarModelMetrics, Method, Metrics, OdometryModel, Sensor, SensorModel,
+};
 pub use error::CalibrationError;
 pub use target_samples::{SampleOptions, START_DISTANCE_RANGE_M};

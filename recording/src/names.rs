@@ -42,11 +42,19 @@ pub enum Method {
     Landmarks,
     /// Maximum-likelihood fit against the true pose (Alhashimi et al., ICINCO 2016).
     Groundtruth,
+    /// The wheels' radii, the wheel base and the lidar's pose on the robot from an ordinary drive
+    /// (Censi, Franchi, Marchionni, Oriolo, IEEE T-RO 29(2), 2013).
+    Odometry,
 }
 
 impl Method {
     /// Every method.
-    pub const ALL: [Method; 3] = [Method::Em, Method::Landmarks, Method::Groundtruth];
+    pub const ALL: [Method; 4] = [
+        Method::Em,
+        Method::Landmarks,
+        Method::Groundtruth,
+        Method::Odometry,
+    ];
 
     /// The method's name as written in files and on the command line.
     #[must_use]
@@ -55,6 +63,7 @@ impl Method {
             Method::Em => "em",
             Method::Landmarks => "landmarks",
             Method::Groundtruth => "groundtruth",
+            Method::Odometry => "odometry",
         }
     }
 

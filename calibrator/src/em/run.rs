@@ -108,6 +108,7 @@ pub fn run_samples(
         converged: fit.converged,
         metrics,
         order: None,
+        odometry: None,
         landmarks: None,
         checks,
         notes,

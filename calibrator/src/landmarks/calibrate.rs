@@ -124,6 +124,7 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
         converged: model.converged,
         metrics,
         order: Some(model.order),
+        odometry: None,
         landmarks: Some(model.positions.into_iter().flatten().collect()),
         checks,
         notes,

@@ -143,7 +143,13 @@ pub struct DecodeArgs {
 #[derive(Debug, clap::Args)]
 pub struct CalibrateArgs {
     /// A recording directory.
-    pub recording: PathBuf,
+    #[arg(required_unless_present = "tuples")]
+    pub recording: Option<PathBuf>,
+    /// Odometry: the paper's tuples instead of a recording (a stream of JSON objects, each an
+    /// interval's `T`, wheel speeds `phi_l`, `phi_r` in rad/s and the lidar's scan-matched
+    /// motion `sm`: [x, y, theta]).
+    #[arg(long, value_name = "FILE", conflicts_with = "recording")]
+    pub tuples: Option<PathBuf>,
     /// The calibration method.
     #[arg(long, value_parser = method_parser())]
     pub method: Method,
@@ -181,6 +187,8 @@ fn method_parser() -> impl clap::builder::TypedValueParser<Value = Method> {
         PossibleValue::new(Method::Em.name()).help("Ground-truth-less EM with a Kalman smoother"),
         PossibleValue::new(Method::Landmarks.name()).help("Cylinders in unknown positions"),
         PossibleValue::new(Method::Groundtruth.name()).help("Fit against truth.csv"),
+        PossibleValue::new(Method::Odometry.name())
+            .help("Wheel radii, wheel base and the lidar's mount from an ordinary drive"),
     ])
     .try_map(|name| Method::from_name(&name).ok_or("not a method"))
 }

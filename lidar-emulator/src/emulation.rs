@@ -299,6 +299,7 @@ fn meta(scenario: &Scenario, seed: u64, sim: &Simulation, lidar: Option<&Lidar>)
         format: hilsim_recording::FORMAT.to_string(),
         robot: RobotMeta {
             wheel_base_m: scenario.robot.wheel_base_m,
+            wheel_radius_m: Some(scenario.robot.wheel_radius_m),
         },
         lidar: s.lidar.as_ref().map(|l| l.mount.into()),
         sonar: s.sonar.as_ref().map(|u| SonarMount {

@@ -97,6 +97,7 @@ pub fn record(
         meta: Meta {
             robot: RobotMeta {
                 wheel_base_m: scenario.robot.wheel_base_m,
+                wheel_radius_m: Some(scenario.robot.wheel_radius_m),
             },
             lidar: s.lidar.as_ref().map(|l| Mount::from(l.mount)),
             sonar: s.sonar.as_ref().map(|u| SonarMount {

@@ -33,7 +33,10 @@ impl Default for Meta {
     fn default() -> Self {
         Self {
             format: FORMAT.to_string(),
-            robot: RobotMeta { wheel_base_m: 0.23 },
+            robot: RobotMeta {
+                wheel_base_m: 0.23,
+                wheel_radius_m: None,
+            },
             lidar: None,
             sonar: None,
             world: WorldMeta::default(),
@@ -47,6 +50,10 @@ impl Default for Meta {
 pub struct RobotMeta {
     /// Distance between the wheels, metres.
     pub wheel_base_m: f64,
+    /// The wheels' nominal radius, metres: what the encoders' turns were multiplied by to give
+    /// `odometry.csv`'s travel. Absent when not known (a bag's `/odom`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wheel_radius_m: Option<f64>,
 }
 
 /// A sensor's mount pose in the robot frame (x forward, y left), as files write it: `meta.toml`'s

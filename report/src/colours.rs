@@ -28,5 +28,6 @@ pub fn method(method: hilsim_calibrator::Method) -> &'static str {
         hilsim_calibrator::Method::Em => CALIBRATED,
         hilsim_calibrator::Method::Groundtruth => "#12a4b6",
         hilsim_calibrator::Method::Landmarks => "#9b59b6",
+        hilsim_calibrator::Method::Odometry => "#2e8b57",
     }
 }

@@ -121,6 +121,12 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         ));
         meta
     });
+    let mut meta = meta;
+    // Travel from joint angles is their angle times this radius: a calibration of the wheels
+    // reads it back to give radii.
+    if let Some(radius) = options.wheel_radius_m {
+        meta.robot.wheel_radius_m = Some(radius);
+    }
     let mut chosen = chosen;
     match chosen.get(&Role::Odometry) {
         Some((topic, Kind::JointState)) if options.wheel_radius_m.is_none() => {

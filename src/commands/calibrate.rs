@@ -1,4 +1,5 @@
-//! `hilsim calibrate RECORDING --method em|landmarks|groundtruth [--json]` and
+//! `hilsim calibrate RECORDING --method em|landmarks|groundtruth|odometry [--json]`,
+//! `hilsim calibrate --method odometry --tuples FILE` and
 //! `hilsim smooth RECORDING --calibration FILE [--csv OUT]` (the EM paper's Sec. V reuse).
 
 use std::fmt::Write as _;
@@ -8,7 +9,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
-use hilsim_calibrator::smoothing;
+use hilsim_calibrator::{odometry, smoothing};
 use hilsim_calibrator::{em, Method, SampleOptions, Settings};
 use hilsim_recording::{
     check_output_file, write_file_atomically, FileKind, Meta, OutputTarget, Recording,
@@ -55,23 +56,38 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
             ..StopOptions::default()
         },
         priors: em::Priors::new(&priors)?,
+        odometry: odometry::RecordingOptions::default(),
     };
-    let rec = Recording::read_dir(&args.recording)?;
     let method = args.method;
-    let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
-        .with_context(|| format!("{}: {}", args.recording.display(), method.name()))?;
-    // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
-    let meta = args.recording.join("meta.toml");
-    if let Ok(text) =
-        hilsim_recording::read_small_text(&meta, hilsim_recording::MAX_META_BYTES, "meta.toml")
-    {
-        for key in Meta::unknown_keys(&text) {
-            calibration.notes.push(format!(
-                "meta.toml: `{}` is not a key of the recording format; ignored",
-                hilsim_recording::printable(&key)
-            ));
+    let (calibration, input) = match (&args.recording, &args.tuples) {
+        (_, Some(tuples)) => {
+            if method != Method::Odometry {
+                bail!("--tuples: tuples are for --method odometry");
+            }
+            (calibrate_tuples(tuples)?, tuples.as_path())
         }
-    }
+        (Some(recording), None) => {
+            let rec = Recording::read_dir(recording)?;
+            let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
+                .with_context(|| format!("{}: {}", recording.display(), method.name()))?;
+            // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
+            let meta = recording.join("meta.toml");
+            if let Ok(text) = hilsim_recording::read_small_text(
+                &meta,
+                hilsim_recording::MAX_META_BYTES,
+                "meta.toml",
+            ) {
+                for key in Meta::unknown_keys(&text) {
+                    calibration.notes.push(format!(
+                        "meta.toml: `{}` is not a key of the recording format; ignored",
+                        hilsim_recording::printable(&key)
+                    ));
+                }
+            }
+            (calibration, recording.as_path())
+        }
+        (None, None) => bail!("a recording or --tuples is needed"),
+    };
     if args.json {
         writeln!(out, "{}", calibration.to_json())?;
     } else {
@@ -87,11 +103,22 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     eprintln!(
         "hilsim: {}: {}: the recording does not fit the method's assumptions ({}); the result \
          above is not to be trusted",
-        args.recording.display(),
+        input.display(),
         method.name(),
         failed.join(", ")
     );
     Ok(ExitCode::from(1))
+}
+
+/// Most bytes of a tuples file: 128 MiB, a million tuples of the paper's format.
+const MAX_TUPLES_BYTES: u64 = 128 << 20;
+
+/// The odometry calibration of a tuples file.
+fn calibrate_tuples(path: &Path) -> Result<hilsim_calibrator::Calibration> {
+    let text = hilsim_recording::read_small_text(path, MAX_TUPLES_BYTES, "tuples file")?;
+    let origin = path.display().to_string();
+    let (tuples, unsound) = odometry::parse_tuples(&text, &origin)?;
+    odometry::calibrate_tuples(&tuples, unsound).with_context(|| format!("{origin}: odometry"))
 }
 
 fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions> {

@@ -1,19 +1,342 @@
 //! A recording's drive as tuples: the lidar's revolutions matched scan to scan, the encoders'
-//! travel over the same intervals.
+//! travel over the same intervals, then the estimate of [`calibrate_tuples`].
 
-use hilsim_recording::Recording;
+use hilsim_recording::{LidarSample, OdometrySample, Pose, Recording};
+use rayon::prelude::*;
 
+use super::estimate::calibrate_tuples;
+use super::kinematics::Geometry;
+use super::tuples::Tuple;
+use crate::checks::Check;
+use crate::scan_match::{match_scans, MatchFailure, MatchOptions, Scan};
 use crate::{Calibration, CalibrationError};
 
 /// What a user sets of the calibration of a recording.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RecordingOptions {}
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordingOptions {
+    /// Revolutions from an interval's first scan to its last: 1 matches consecutive ones.
+    pub revolutions_per_interval: usize,
+    /// The wheels' nominal radius, metres, when `meta.toml` does not give it (or to override
+    /// it): the radius the encoders' turns were multiplied by to report travel.
+    pub nominal_wheel_radius_m: Option<f64>,
+}
 
-/// Calibrates the wheels and the lidar's mount from `rec`'s encoders and lidar.
+impl Default for RecordingOptions {
+    fn default() -> Self {
+        Self {
+            revolutions_per_interval: 1,
+            nominal_wheel_radius_m: None,
+        }
+    }
+}
+
+/// Least readings for a revolution to be matched: 30. Below that a scan holds one or two
+/// surfaces' worth of points, too few to fix three degrees of freedom with any margin.
+const MIN_SCAN_POINTS: usize = 30;
+
+/// Longest interval, seconds: 2. Longer ones are gaps in the data (a revolution lost), over
+/// which the wheels' speeds cannot be taken as constant, the model's assumption.
+const MAX_INTERVAL_S: f64 = 2.0;
+
+/// An interval is standing still when each wheel moved less than this: 0.5 mm (half the
+/// XV-11 robot encoders' millimetre). Its scan match measures only the matcher's noise.
+const STILL_M: f64 = 0.0005;
+
+/// Largest share of intervals whose scans could not be matched: 20 %. More means the room
+/// does not fix the lidar's motion (a corridor, open space) for much of the drive, and the
+/// rest may not be a random sample of it.
+pub const MAX_FAILED_MATCH_SHARE: f64 = 0.20;
+
+/// Calibrates the wheels and the lidar's mount from `rec`'s encoders and lidar: each interval's
+/// lidar motion from scan-to-scan matching (point-to-line ICP, [`crate::scan_match`]), its wheel
+/// speeds from the encoders' travel over it.
 ///
 /// # Errors
-/// A table the method needs is missing, or the estimate's errors.
-pub fn calibrate(rec: &Recording, options: &RecordingOptions) -> Result<Calibration, CalibrationError> {
-    let _ = (rec, options);
-    Err(CalibrationError::Missing("odometry from a recording: scan matching not yet wired".into()))
+/// A table or a `meta.toml` key the method needs is missing, too few intervals could be
+/// matched, or the estimate's errors.
+pub fn calibrate(
+    rec: &Recording,
+    options: &RecordingOptions,
+) -> Result<Calibration, CalibrationError> {
+    let lidar = rec
+        .lidar
+        .as_deref()
+        .filter(|l| !l.is_empty())
+        .ok_or_else(|| CalibrationError::Missing("odometry: the recording has no lidar.csv".into()))?;
+    let odometry = rec
+        .odometry
+        .as_deref()
+        .filter(|o| o.len() >= 2)
+        .ok_or_else(|| {
+            CalibrationError::Missing(
+                "odometry: the recording has no odometry.csv (wheel travel) of two rows or more"
+                    .into(),
+            )
+        })?;
+    let nominal_radius = options
+        .nominal_wheel_radius_m
+        .or(rec.meta.robot.wheel_radius_m)
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .ok_or_else(|| {
+            CalibrationError::Missing(
+                "odometry: meta.toml gives no nominal wheel radius ([robot] wheel_radius_m), \
+                 which the encoders' travel was reported with; give it (calibrate \
+                 --wheel-radius M)"
+                    .into(),
+            )
+        })?;
+    if options.revolutions_per_interval == 0 {
+        return Err(CalibrationError::Invalid(
+            "odometry: revolutions per interval must be at least 1".into(),
+        ));
+    }
+    let mut notes = Vec::new();
+    let mount = rec.meta.lidar.unwrap_or_else(|| {
+        notes.push("meta.toml gives no lidar mount: the scans are de-skewed as if the lidar sat on the axle's centre".into());
+        hilsim_recording::Mount::default()
+    });
+    let nominal = Geometry {
+        left_radius_m: nominal_radius,
+        right_radius_m: nominal_radius,
+        wheel_base_m: rec.meta.robot.wheel_base_m,
+        lidar: [mount.x_m, mount.y_m, mount.yaw_rad()],
+    };
+    let path = Path::new(odometry, nominal.wheel_base_m);
+    let scans = revolutions(lidar, &path, &nominal);
+    let step = options.revolutions_per_interval;
+    let pairs: Vec<(usize, usize)> = (0..scans.len().saturating_sub(step))
+        .map(|k| (k, k + step))
+        .collect();
+    let matching = MatchOptions::default();
+    let outcomes: Vec<Interval> = pairs
+        .par_iter()
+        .map(|&(a, b)| interval(&scans[a], &scans[b], &path, &nominal, &matching))
+        .collect();
+    let mut tuples = Vec::new();
+    let (mut still, mut gaps, mut sparse) = (0usize, 0usize, 0usize);
+    let mut failed: Vec<MatchFailure> = Vec::new();
+    for outcome in outcomes {
+        match outcome {
+            Interval::Matched(t) => tuples.push(t),
+            Interval::Still => still += 1,
+            Interval::Gap => gaps += 1,
+            Interval::Sparse => sparse += 1,
+            Interval::Failed(f) => failed.push(f),
+        }
+    }
+    let attempted = tuples.len() + failed.len();
+    if tuples.len() < 12 {
+        return Err(CalibrationError::TooFewSamples(format!(
+            "odometry: {} interval(s) of the drive could be matched ({} revolutions; {} failed \
+             to match, {still} standing still, {gaps} gaps, {sparse} with fewer than \
+             {MIN_SCAN_POINTS} readings); at least 12 are needed",
+            tuples.len(),
+            scans.len(),
+            failed.len()
+        )));
+    }
+    let mut calibration = calibrate_tuples(&tuples, 0)?;
+    if let Some(model) = calibration.odometry.as_mut() {
+        model.wheel_scale = Some([
+            model.left_wheel_radius_m / nominal_radius,
+            model.right_wheel_radius_m / nominal_radius,
+        ]);
+    }
+    let share = failed.len() as f64 / attempted.max(1) as f64;
+    let mut kinds: Vec<(String, usize)> = Vec::new();
+    for f in &failed {
+        let kind = match f {
+            MatchFailure::TooFewPoints { .. } => "too few points",
+            MatchFailure::NotConverged { .. } => "did not settle",
+            MatchFailure::Degenerate { .. } => "geometry did not fix the motion",
+            _ => "other",
+        };
+        match kinds.iter_mut().find(|(k, _)| k == kind) {
+            Some((_, n)) => *n += 1,
+            None => kinds.push((kind.to_string(), 1)),
+        }
+    }
+    calibration.checks.push(Check::at_most(
+        "odometry.failed_match_share",
+        share,
+        MAX_FAILED_MATCH_SHARE,
+        format!(
+            "{} of {attempted} intervals' scans could not be matched{}; they are left out, and \
+             many mean the room does not fix the lidar's motion for much of the drive",
+            failed.len(),
+            if kinds.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " ({})",
+                    kinds
+                        .iter()
+                        .map(|(k, n)| format!("{n} {k}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        ),
+    ));
+    notes.push(format!(
+        "{} lidar revolutions, intervals of {step} revolution(s): {} matched, {} failed to \
+         match, {still} standing still, {gaps} longer than {MAX_INTERVAL_S} s, {sparse} with \
+         fewer than {MIN_SCAN_POINTS} readings",
+        scans.len(),
+        tuples.len(),
+        failed.len()
+    ));
+    notes.push(format!(
+        "wheel speeds from the encoders' travel over the nominal radius {:.4} m; the radii are \
+         that radius times each wheel's scale",
+        nominal_radius
+    ));
+    calibration.notes.splice(0..0, notes);
+    Ok(calibration)
+}
+
+/// One interval's outcome.
+enum Interval {
+    Matched(Tuple),
+    Still,
+    Gap,
+    Sparse,
+    Failed(MatchFailure),
+}
+
+/// One revolution, de-skewed to its middle instant.
+struct Revolution {
+    t_s: f64,
+    scan: Scan,
+}
+
+/// The robot's dead-reckoned path with the nominal geometry: each odometry row's pose, for the
+/// scan matcher's guesses and the de-skewing within a revolution.
+struct Path<'a> {
+    odometry: &'a [OdometrySample],
+    poses: Vec<Pose>,
+}
+
+impl<'a> Path<'a> {
+    fn new(odometry: &'a [OdometrySample], wheel_base_m: f64) -> Self {
+        let mut poses = Vec::with_capacity(odometry.len());
+        let mut pose = Pose::default();
+        let mut last = (odometry[0].left_m, odometry[0].right_m);
+        for o in odometry {
+            pose = pose.drive(o.left_m - last.0, o.right_m - last.1, wheel_base_m);
+            last = (o.left_m, o.right_m);
+            poses.push(pose);
+        }
+        Self { odometry, poses }
+    }
+
+    /// The index `i` and fraction `u` with `t` between rows `i` and `i + 1`; `None` outside
+    /// the odometry's span.
+    fn locate(&self, t: f64) -> Option<(usize, f64)> {
+        let o = self.odometry;
+        if !(t >= o[0].t_s && t <= o[o.len() - 1].t_s) {
+            return None;
+        }
+        let i = o.partition_point(|s| s.t_s <= t).clamp(1, o.len() - 1) - 1;
+        let span = o[i + 1].t_s - o[i].t_s;
+        let u = if span > 0.0 { (t - o[i].t_s) / span } else { 0.0 };
+        Some((i, u.clamp(0.0, 1.0)))
+    }
+
+    fn pose_at(&self, t: f64) -> Option<Pose> {
+        let (i, u) = self.locate(t)?;
+        Some(self.poses[i].lerp(&self.poses[i + 1], u))
+    }
+
+    fn travel_at(&self, t: f64) -> Option<(f64, f64)> {
+        let (i, u) = self.locate(t)?;
+        let (a, b) = (self.odometry[i], self.odometry[i + 1]);
+        Some((
+            a.left_m + (b.left_m - a.left_m) * u,
+            a.right_m + (b.right_m - a.right_m) * u,
+        ))
+    }
+}
+
+/// The lidar's motion from `from` to `to` on the dead-reckoned path, in its own frame at `from`.
+fn lidar_motion(path: &Path, nominal: &Geometry, from: f64, to: f64) -> Option<[f64; 3]> {
+    let robot = path.pose_at(to)?.relative_to(&path.pose_at(from)?);
+    Some(nominal.lidar_motion([robot.x, robot.y, robot.yaw]))
+}
+
+/// The recording's revolutions, each de-skewed to its middle instant along the dead-reckoned
+/// path: a revolution of the XV-11 takes 0.2 s, over which a robot at 0.3 m/s moves 6 cm.
+fn revolutions(lidar: &[LidarSample], path: &Path, nominal: &Geometry) -> Vec<Revolution> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < lidar.len() {
+        let rev = lidar[start].rev;
+        let end = start + lidar[start..].iter().take_while(|s| s.rev == rev).count();
+        let readings: Vec<&LidarSample> = lidar[start..end]
+            .iter()
+            .filter(|s| !s.invalid && s.range_m > 0.0 && s.range_m.is_finite() && s.t_s.is_finite())
+            .collect();
+        start = end;
+        if readings.is_empty() {
+            continue;
+        }
+        let (first, last) = (readings[0].t_s, readings[readings.len() - 1].t_s);
+        let t_s = (first + last) / 2.0;
+        let skewed = last > first;
+        let points = readings
+            .iter()
+            .map(|s| {
+                let (sin, cos) = s.angle_deg.to_radians().sin_cos();
+                let p = [s.range_m * cos, s.range_m * sin];
+                if !skewed {
+                    return p;
+                }
+                match lidar_motion(path, nominal, t_s, s.t_s) {
+                    Some([x, y, yaw]) => Pose::new(x, y, yaw).transform(p),
+                    None => p,
+                }
+            })
+            .collect();
+        out.push(Revolution {
+            t_s,
+            scan: Scan { points },
+        });
+    }
+    out
+}
+
+/// The tuple of the interval from revolution `a` to `b`.
+fn interval(
+    a: &Revolution,
+    b: &Revolution,
+    path: &Path,
+    nominal: &Geometry,
+    matching: &MatchOptions,
+) -> Interval {
+    let duration_s = b.t_s - a.t_s;
+    if !(duration_s > 0.0 && duration_s <= MAX_INTERVAL_S) {
+        return Interval::Gap;
+    }
+    let (Some(from), Some(to)) = (path.travel_at(a.t_s), path.travel_at(b.t_s)) else {
+        return Interval::Gap;
+    };
+    let (left_m, right_m) = (to.0 - from.0, to.1 - from.1);
+    if left_m.abs() < STILL_M && right_m.abs() < STILL_M {
+        return Interval::Still;
+    }
+    if a.scan.points.len() < MIN_SCAN_POINTS || b.scan.points.len() < MIN_SCAN_POINTS {
+        return Interval::Sparse;
+    }
+    let Some(guess) = lidar_motion(path, nominal, a.t_s, b.t_s) else {
+        return Interval::Gap;
+    };
+    match match_scans(&a.scan, &b.scan, guess, matching) {
+        Ok(m) => Interval::Matched(Tuple {
+            duration_s,
+            left_rad_s: left_m / nominal.left_radius_m / duration_s,
+            right_rad_s: right_m / nominal.right_radius_m / duration_s,
+            lidar_motion: m.motion,
+        }),
+        Err(f) => Interval::Failed(f),
+    }
 }

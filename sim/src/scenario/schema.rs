@@ -194,6 +194,11 @@ pub struct Robot {
     pub start: StartPose,
     /// Distance between the wheels, metres.
     pub wheel_base_m: f64,
+    /// The wheels' nominal radius, metres: what the encoders' turns are multiplied by to report
+    /// travel (`meta.toml` records it, so a calibration of the wheels can give radii); default
+    /// 0.033, a TurtleBot3's (ROBOTIS e-Manual, TurtleBot3 specifications).
+    #[serde(default = "default_wheel_radius")]
+    pub wheel_radius_m: f64,
     /// Radius of the robot's round body, metres; default 0.165 (a Neato robot is ~0.33 m wide).
     #[serde(default = "default_robot_radius")]
     pub radius_m: f64,
@@ -240,6 +245,10 @@ impl Default for Actuation {
 
 fn default_robot_radius() -> f64 {
     0.165
+}
+
+fn default_wheel_radius() -> f64 {
+    0.033
 }
 
 fn default_turn_rate() -> f64 {

@@ -263,6 +263,7 @@ fn robot(s: &Scenario) -> Check {
     angle(key_path!["robot", "start", "yaw_deg"], r.start.yaw_deg)?;
     size(key_path!["robot", "wheel_base_m"], r.wheel_base_m)?;
     size(key_path!["robot", "radius_m"], r.radius_m)?;
+    size(key_path!["robot", "wheel_radius_m"], r.wheel_radius_m)?;
     positive(key_path!["robot", "turn_rate_deg_s"], r.turn_rate_deg_s)?;
     let a = r.actuation;
     non_negative(key_path!["robot", "actuation", "scale_sd"], a.scale_sd)?;

@@ -16,6 +16,7 @@ pub mod error;
 pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
+pub mod scan_match;
 pub mod smoothing;
 pub mod stats;
 pub mod target_samples;

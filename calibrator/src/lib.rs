@@ -17,6 +17,7 @@ pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
 pub mod odometry;
+pub mod scan_match;
 pub mod smoothing;
 pub mod stats;
 pub mod target_samples;

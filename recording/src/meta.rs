@@ -159,6 +159,10 @@ impl Meta {
                 scenario: Some(String::new()),
                 seed: Some(0),
             }),
+            robot: RobotMeta {
+                wheel_base_m: 0.0,
+                wheel_radius_m: Some(0.0),
+            },
             ..Meta::default()
         };
         let known = toml::Table::try_from(full).unwrap_or_default();

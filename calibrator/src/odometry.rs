@@ -10,11 +10,13 @@ mod checks;
 mod closed_form;
 mod estimate;
 mod from_recording;
+pub mod interval;
 pub mod kinematics;
 mod likelihood;
 pub mod tuples;
 
-pub use estimate::calibrate_tuples;
+pub use estimate::{calibrate_intervals, calibrate_tuples};
+pub use interval::Interval;
 pub use from_recording::{calibrate, RecordingOptions};
 pub use kinematics::Geometry;
 pub use likelihood::OUTLIER_CHI2_3;

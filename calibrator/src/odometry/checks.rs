@@ -3,7 +3,7 @@
 //! useful precision, few intervals were outliers, and what is left is nearly white.
 
 use super::likelihood::Fit;
-use super::tuples::Tuple;
+use super::interval::Interval;
 use crate::checks::Check;
 use crate::OdometryModel;
 
@@ -17,8 +17,10 @@ pub const MIN_TURN_EACH_WAY_DEG: f64 = 90.0;
 /// of scale moves the lidar by a tenth of a base, well above a scan matcher's millimetres.
 pub const MIN_STRAIGHT_WHEEL_BASES: f64 = 10.0;
 
-/// An interval is straight when it turns by less than this: 3° (0.05 rad).
-pub const STRAIGHT_TURN_RAD: f64 = 0.05;
+/// An interval is straight when its path bends on a radius of at least this many wheel bases:
+/// 5 (a wheel then turns at least 80 % as fast as the other). Wheels a few per cent off bend a
+/// commanded straight line on a radius of tens of wheel bases, which still counts.
+pub const STRAIGHT_RADIUS_WHEEL_BASES: f64 = 5.0;
 
 /// Largest relative standard deviation of a wheel radius or the wheel base: 0.5 %. The errors
 /// the calibration exists to find are 1–5 % (a worn or soft tyre, an axle measured to its
@@ -41,20 +43,22 @@ pub const MAX_OUTLIER_SHARE: f64 = 0.10;
 /// understated twofold by the white model. The paper's own data inflate it about 2-fold.
 pub const MAX_VARIANCE_INFLATION: f64 = 4.0;
 
-/// The checks of a fit of `tuples`.
+/// The checks of a fit of `intervals`.
 #[must_use]
-pub fn odometry_checks(tuples: &[Tuple], fit: &Fit, model: &OdometryModel) -> Vec<Check> {
+pub fn odometry_checks(intervals: &[Interval], fit: &Fit, model: &OdometryModel) -> Vec<Check> {
     let mut checks = Vec::new();
     let (mut left, mut right, mut straight_m) = (0.0f64, 0.0f64, 0.0f64);
-    for t in tuples {
+    let base = model.wheel_base_m.abs().max(1e-9);
+    for t in intervals {
         let [x, y, turn] = t.lidar_motion;
         if turn > 0.0 {
             left += turn;
         } else {
             right -= turn;
         }
-        if turn.abs() < STRAIGHT_TURN_RAD {
-            straight_m += x.hypot(y);
+        let travel = x.hypot(y);
+        if turn.abs() * STRAIGHT_RADIUS_WHEEL_BASES * base <= travel {
+            straight_m += travel;
         }
     }
     for (name, turned) in [
@@ -72,7 +76,7 @@ pub fn odometry_checks(tuples: &[Tuple], fit: &Fit, model: &OdometryModel) -> Ve
             ),
         ));
     }
-    let bases = straight_m / model.wheel_base_m.abs().max(1e-9);
+    let bases = straight_m / base;
     checks.push(Check::at_least(
         "odometry.straight_wheel_bases",
         bases,

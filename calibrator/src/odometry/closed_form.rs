@@ -2,7 +2,7 @@
 //! maximum-likelihood one.
 //!
 //! 1. The lidar turns as the robot does, so each interval's turn is linear in the wheels' speeds:
-//!    `θ_k = T_k (J₂₁ φ_L + J₂₂ φ_R)` with `J₂₁ = −r_L / b`, `J₂₂ = r_R / b`: least squares.
+//!    `θ_k = J₂₁ Δφ_L + J₂₂ Δφ_R` (`Δφ` a wheel's turn over it, `T_k φ` in the paper) with `J₂₁ = −r_L / b`, `J₂₂ = r_R / b`: least squares.
 //! 2. With the turn known, the robot's translation over an interval is `b · c_k` (`c_k` its arc
 //!    for a unit wheel base), and `ℓ ⊕ s_k = r_k ⊕ ℓ` is linear in
 //!    `x = (b, ℓ_x, ℓ_y, cos ℓ_θ, sin ℓ_θ)`: `L_k x = 0`. Minimise `Σ |L_k x|²` subject to
@@ -13,24 +13,30 @@
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, Matrix5, SMatrix, Vector2};
 
 use super::kinematics::{arc_factors, Geometry};
-use super::tuples::Tuple;
+use super::interval::Interval;
 use crate::CalibrationError;
 
-/// The closed-form geometry of `tuples`.
+/// The closed-form geometry of `intervals`.
 ///
 /// # Errors
 /// [`CalibrationError::Unidentifiable`] when the drive does not turn, or turns so that the lidar's
 /// position cannot be separated from the wheel base (a singular system).
-pub fn closed_form(tuples: &[Tuple]) -> Result<Geometry, CalibrationError> {
-    let [j21, j22] = turn_gains(tuples)?;
+pub fn closed_form(intervals: &[Interval]) -> Result<Geometry, CalibrationError> {
+    let [j21, j22] = turn_gains(intervals)?;
     let mut m = Matrix5::<f64>::zeros();
-    for t in tuples {
-        let turn = t.duration_s * (j21 * t.left_rad_s + j22 * t.right_rad_s);
-        // Forward travel per metre of wheel base.
-        let forward = t.duration_s * (-j21 * t.left_rad_s + j22 * t.right_rad_s) / 2.0;
-        let [along, across] = arc_factors(turn);
-        let (cx, cy) = (forward * along, forward * across);
-        let (sin, cos) = turn.sin_cos();
+    for t in intervals {
+        // The robot's motion for a unit wheel base: each step's turn and translation.
+        let (mut cx, mut cy, mut turn) = (0.0, 0.0, 0.0);
+        for [left, right] in &t.wheel_turns_rad {
+            let step_turn = j21 * left + j22 * right;
+            let forward = (-j21 * left + j22 * right) / 2.0;
+            let [along, across] = arc_factors(step_turn);
+            let (sin, cos) = f64::sin_cos(turn);
+            cx += forward * (cos * along - sin * across);
+            cy += forward * (sin * along + cos * across);
+            turn += step_turn;
+        }
+        let (sin, cos) = f64::sin_cos(turn);
         let [sx, sy, _] = t.lidar_motion;
         let l = SMatrix::<f64, 2, 5>::new(
             -cx,
@@ -87,10 +93,11 @@ pub fn closed_form(tuples: &[Tuple]) -> Result<Geometry, CalibrationError> {
 }
 
 /// `J₂₁` and `J₂₂` of step 1.
-fn turn_gains(tuples: &[Tuple]) -> Result<[f64; 2], CalibrationError> {
+fn turn_gains(intervals: &[Interval]) -> Result<[f64; 2], CalibrationError> {
     let (mut ata, mut aty) = (Matrix2::<f64>::zeros(), Vector2::<f64>::zeros());
-    for t in tuples {
-        let row = Vector2::new(t.duration_s * t.left_rad_s, t.duration_s * t.right_rad_s);
+    for t in intervals {
+        let [left, right] = t.total_turns_rad();
+        let row = Vector2::new(left, right);
         ata += row * row.transpose();
         aty += row * t.lidar_motion[2];
     }

@@ -6,16 +6,32 @@ use std::collections::BTreeMap;
 use super::checks::odometry_checks;
 use super::closed_form::closed_form;
 use super::likelihood::maximum_likelihood;
+use super::interval::Interval;
 use super::tuples::Tuple;
 use crate::{Calibration, CalibrationError, Method, OdometryModel};
 
-/// Calibrates the wheels and the lidar's mount from `tuples`; `unsound` tuples (a non-finite
+/// Calibrates the wheels and the lidar's mount from the paper's `tuples`; `unsound` tuples (a non-finite
 /// number, an interval without a length) were left out before and are counted in a note.
 ///
 /// # Errors
 /// As the estimate's: too few tuples, a drive that does not inform every parameter, an estimate
 /// that diverged.
 pub fn calibrate_tuples(tuples: &[Tuple], unsound: usize) -> Result<Calibration, CalibrationError> {
+    let intervals: Vec<Interval> = tuples.iter().map(Interval::from).collect();
+    let mut calibration = calibrate_intervals(&intervals)?;
+    if unsound > 0 {
+        calibration.notes.push(format!(
+            "{unsound} tuple(s) left out before the estimate: a non-finite number or no length"
+        ));
+    }
+    Ok(calibration)
+}
+
+/// Calibrates the wheels and the lidar's mount from `intervals`.
+///
+/// # Errors
+/// As [`calibrate_tuples`].
+pub fn calibrate_intervals(tuples: &[Interval]) -> Result<Calibration, CalibrationError> {
     if tuples.len() < 12 {
         return Err(CalibrationError::TooFewSamples(format!(
             "{} intervals; at least 12 are needed for 6 parameters and the 6 of the scan \
@@ -37,7 +53,7 @@ pub fn calibrate_tuples(tuples: &[Tuple], unsound: usize) -> Result<Calibration,
         wheel_scale: None,
     };
     let used = fit.inlier.iter().filter(|&&i| i).count();
-    let mut notes = vec![
+    let notes = vec![
         format!(
             "closed form (the paper's): wheel radii {:.3} and {:.3} mm, wheel base {:.3} mm, \
              lidar at ({:.2}, {:.2}) mm, {:.2} mrad",
@@ -67,12 +83,6 @@ pub fn calibrate_tuples(tuples: &[Tuple], unsound: usize) -> Result<Calibration,
             fit.variance_inflation
         ),
     ];
-    if unsound > 0 {
-        notes.push(format!(
-            "{unsound} interval(s) left out before the estimate: a non-finite number or no \
-             length"
-        ));
-    }
     let checks = odometry_checks(tuples, &fit, &model);
     Ok(Calibration {
         method: Method::Odometry,

@@ -1,12 +1,12 @@
 //! A recording's drive as tuples: the lidar's revolutions matched scan to scan, the encoders'
-//! travel over the same intervals, then the estimate of [`calibrate_tuples`].
+//! travel over the same intervals, then the estimate of [`calibrate_intervals`].
 
 use hilsim_recording::{LidarSample, OdometrySample, Pose, Recording};
 use rayon::prelude::*;
 
-use super::estimate::calibrate_tuples;
+use super::estimate::calibrate_intervals;
 use super::kinematics::Geometry;
-use super::tuples::Tuple;
+use super::interval::Interval;
 use crate::checks::Check;
 use crate::scan_match::{match_scans, MatchFailure, MatchOptions, Scan};
 use crate::{Calibration, CalibrationError};
@@ -14,8 +14,11 @@ use crate::{Calibration, CalibrationError};
 /// What a user sets of the calibration of a recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RecordingOptions {
-    /// Revolutions from an interval's first scan to its last: 1 matches consecutive ones.
-    pub revolutions_per_interval: usize,
+    /// An interval's length, seconds: from each matched revolution to the first one at least
+    /// this much later. About the paper's (its tuples span 0.8 s): long enough that the
+    /// motion stands well above the scan matcher's millimetres, short enough for the odometry's
+    /// guess to bring the matcher within reach.
+    pub interval_s: f64,
     /// The wheels' nominal radius, metres, when `meta.toml` does not give it (or to override
     /// it): the radius the encoders' turns were multiplied by to report travel.
     pub nominal_wheel_radius_m: Option<f64>,
@@ -24,7 +27,7 @@ pub struct RecordingOptions {
 impl Default for RecordingOptions {
     fn default() -> Self {
         Self {
-            revolutions_per_interval: 1,
+            interval_s: 1.0,
             nominal_wheel_radius_m: None,
         }
     }
@@ -85,10 +88,10 @@ pub fn calibrate(
                     .into(),
             )
         })?;
-    if options.revolutions_per_interval == 0 {
-        return Err(CalibrationError::Invalid(
-            "odometry: revolutions per interval must be at least 1".into(),
-        ));
+    if !(options.interval_s > 0.0 && options.interval_s <= MAX_INTERVAL_S) {
+        return Err(CalibrationError::Invalid(format!(
+            "odometry: an interval must last more than 0 s and at most {MAX_INTERVAL_S} s"
+        )));
     }
     let mut notes = Vec::new();
     let mount = rec.meta.lidar.unwrap_or_else(|| {
@@ -103,39 +106,47 @@ pub fn calibrate(
     };
     let path = Path::new(odometry, nominal.wheel_base_m);
     let scans = revolutions(lidar, &path, &nominal);
-    let step = options.revolutions_per_interval;
-    let pairs: Vec<(usize, usize)> = (0..scans.len().saturating_sub(step))
-        .map(|k| (k, k + step))
-        .collect();
+    // A chain of intervals: each interval's last revolution is the next one's first, so no
+    // two intervals share a stretch of the drive (their errors would be counted twice).
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    let mut a = 0;
+    while a < scans.len() {
+        let until = scans[a].t_s + options.interval_s;
+        let Some(b) = (a + 1..scans.len()).find(|&b| scans[b].t_s >= until) else {
+            break;
+        };
+        pairs.push((a, b));
+        a = b;
+    }
     let matching = MatchOptions::default();
-    let outcomes: Vec<Interval> = pairs
+    let outcomes: Vec<Outcome> = pairs
         .par_iter()
         .map(|&(a, b)| interval(&scans[a], &scans[b], &path, &nominal, &matching))
         .collect();
-    let mut tuples = Vec::new();
+    let mut intervals = Vec::new();
     let (mut still, mut gaps, mut sparse) = (0usize, 0usize, 0usize);
     let mut failed: Vec<MatchFailure> = Vec::new();
     for outcome in outcomes {
         match outcome {
-            Interval::Matched(t) => tuples.push(t),
-            Interval::Still => still += 1,
-            Interval::Gap => gaps += 1,
-            Interval::Sparse => sparse += 1,
-            Interval::Failed(f) => failed.push(f),
+            Outcome::Matched(t) => intervals.push(t),
+            Outcome::Still => still += 1,
+            Outcome::Gap => gaps += 1,
+            Outcome::Sparse => sparse += 1,
+            Outcome::Failed(f) => failed.push(f),
         }
     }
-    let attempted = tuples.len() + failed.len();
-    if tuples.len() < 12 {
+    let attempted = intervals.len() + failed.len();
+    if intervals.len() < 12 {
         return Err(CalibrationError::TooFewSamples(format!(
             "odometry: {} interval(s) of the drive could be matched ({} revolutions; {} failed \
              to match, {still} standing still, {gaps} gaps, {sparse} with fewer than \
              {MIN_SCAN_POINTS} readings); at least 12 are needed",
-            tuples.len(),
+            intervals.len(),
             scans.len(),
             failed.len()
         )));
     }
-    let mut calibration = calibrate_tuples(&tuples, 0)?;
+    let mut calibration = calibrate_intervals(&intervals)?;
     if let Some(model) = calibration.odometry.as_mut() {
         model.wheel_scale = Some([
             model.left_wheel_radius_m / nominal_radius,
@@ -179,11 +190,12 @@ pub fn calibrate(
         ),
     ));
     notes.push(format!(
-        "{} lidar revolutions, intervals of {step} revolution(s): {} matched, {} failed to \
+        "{} lidar revolutions, intervals of {} s: {} matched, {} failed to \
          match, {still} standing still, {gaps} longer than {MAX_INTERVAL_S} s, {sparse} with \
          fewer than {MIN_SCAN_POINTS} readings",
         scans.len(),
-        tuples.len(),
+        options.interval_s,
+        intervals.len(),
         failed.len()
     ));
     notes.push(format!(
@@ -196,8 +208,8 @@ pub fn calibrate(
 }
 
 /// One interval's outcome.
-enum Interval {
-    Matched(Tuple),
+enum Outcome {
+    Matched(Interval),
     Still,
     Gap,
     Sparse,
@@ -246,6 +258,29 @@ impl<'a> Path<'a> {
     fn pose_at(&self, t: f64) -> Option<Pose> {
         let (i, u) = self.locate(t)?;
         Some(self.poses[i].lerp(&self.poses[i + 1], u))
+    }
+
+    /// The wheels' turns from `from` to `to`, step by step between the encoders' readings,
+    /// each travel over its nominal radius.
+    fn wheel_turns(&self, from: f64, to: f64, nominal: &Geometry) -> Option<Vec<[f64; 2]>> {
+        let mut last = self.travel_at(from)?;
+        let end = self.travel_at(to)?;
+        let o = self.odometry;
+        let inside = o.partition_point(|s| s.t_s <= from)..o.partition_point(|s| s.t_s < to);
+        let mut turns = Vec::with_capacity(inside.len() + 1);
+        for s in &o[inside] {
+            let here = (s.left_m, s.right_m);
+            turns.push([
+                (here.0 - last.0) / nominal.left_radius_m,
+                (here.1 - last.1) / nominal.right_radius_m,
+            ]);
+            last = here;
+        }
+        turns.push([
+            (end.0 - last.0) / nominal.left_radius_m,
+            (end.1 - last.1) / nominal.right_radius_m,
+        ]);
+        Some(turns)
     }
 
     fn travel_at(&self, t: f64) -> Option<(f64, f64)> {
@@ -305,38 +340,40 @@ fn revolutions(lidar: &[LidarSample], path: &Path, nominal: &Geometry) -> Vec<Re
     out
 }
 
-/// The tuple of the interval from revolution `a` to `b`.
+/// The interval from revolution `a` to `b`.
 fn interval(
     a: &Revolution,
     b: &Revolution,
     path: &Path,
     nominal: &Geometry,
     matching: &MatchOptions,
-) -> Interval {
+) -> Outcome {
     let duration_s = b.t_s - a.t_s;
     if !(duration_s > 0.0 && duration_s <= MAX_INTERVAL_S) {
-        return Interval::Gap;
+        return Outcome::Gap;
     }
-    let (Some(from), Some(to)) = (path.travel_at(a.t_s), path.travel_at(b.t_s)) else {
-        return Interval::Gap;
+    let Some(wheel_turns_rad) = path.wheel_turns(a.t_s, b.t_s, nominal) else {
+        return Outcome::Gap;
     };
-    let (left_m, right_m) = (to.0 - from.0, to.1 - from.1);
-    if left_m.abs() < STILL_M && right_m.abs() < STILL_M {
-        return Interval::Still;
+    let [left, right] = wheel_turns_rad
+        .iter()
+        .fold([0.0, 0.0], |[l, r], [x, y]| [l + x, r + y]);
+    if (left * nominal.left_radius_m).abs() < STILL_M
+        && (right * nominal.right_radius_m).abs() < STILL_M
+    {
+        return Outcome::Still;
     }
     if a.scan.points.len() < MIN_SCAN_POINTS || b.scan.points.len() < MIN_SCAN_POINTS {
-        return Interval::Sparse;
+        return Outcome::Sparse;
     }
     let Some(guess) = lidar_motion(path, nominal, a.t_s, b.t_s) else {
-        return Interval::Gap;
+        return Outcome::Gap;
     };
     match match_scans(&a.scan, &b.scan, guess, matching) {
-        Ok(m) => Interval::Matched(Tuple {
-            duration_s,
-            left_rad_s: left_m / nominal.left_radius_m / duration_s,
-            right_rad_s: right_m / nominal.right_radius_m / duration_s,
+        Ok(m) => Outcome::Matched(Interval {
+            wheel_turns_rad,
             lidar_motion: m.motion,
         }),
-        Err(f) => Interval::Failed(f),
+        Err(f) => Outcome::Failed(f),
     }
 }

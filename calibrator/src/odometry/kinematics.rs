@@ -46,13 +46,25 @@ impl Geometry {
         }
     }
 
-    /// The robot's motion over `duration_s` with the wheels at `left_rad_s` and `right_rad_s`,
-    /// in its own frame at the start.
+    /// The robot's motion over steps of wheel turns (left, right radians), each step an arc,
+    /// in its own frame at the start; the turn is not wrapped.
     #[must_use]
-    pub fn robot_motion(&self, left_rad_s: f64, right_rad_s: f64, duration_s: f64) -> [f64; 3] {
-        let left = self.left_radius_m * left_rad_s * duration_s;
-        let right = self.right_radius_m * right_rad_s * duration_s;
-        arc(left, right, self.wheel_base_m)
+    pub fn robot_motion(&self, wheel_turns_rad: &[[f64; 2]]) -> [f64; 3] {
+        let mut pose = [0.0f64, 0.0, 0.0];
+        for [left, right] in wheel_turns_rad {
+            let [dx, dy, dturn] = arc(
+                self.left_radius_m * left,
+                self.right_radius_m * right,
+                self.wheel_base_m,
+            );
+            let (sin, cos) = pose[2].sin_cos();
+            pose = [
+                pose[0] + cos * dx - sin * dy,
+                pose[1] + sin * dx + cos * dy,
+                pose[2] + dturn,
+            ];
+        }
+        pose
     }
 
     /// The lidar's motion in its own frame at the start, when the robot moves by `robot`.
@@ -116,7 +128,7 @@ mod tests {
             wheel_base_m: 0.09,
             lidar: [0.0, 0.0, 0.0],
         };
-        let r = g.robot_motion(1.0, 2.0, 0.5);
+        let r = g.robot_motion(&[[0.5, 1.0]]);
         let s = g.lidar_motion(r);
         for k in 0..3 {
             assert!((r[k] - s[k]).abs() < 1e-15);
@@ -136,11 +148,26 @@ mod tests {
         // Wheels opposite: a quarter turn to the left in place.
         let quarter = std::f64::consts::FRAC_PI_2;
         let speed = quarter * 0.1 / 2.0 / 0.02;
-        let s = g.lidar_motion(g.robot_motion(-speed, speed, 1.0));
+        let s = g.lidar_motion(g.robot_motion(&[[-speed, speed]]));
         // The lidar ends at (0, 0.1) of the robot's start frame, facing +y: in its own start
         // frame at (-0.1, 0.1).
         assert!((s[0] + 0.1).abs() < 1e-12 && (s[1] - 0.1).abs() < 1e-12, "{s:?}");
         assert!((s[2] - quarter).abs() < 1e-12);
+    }
+
+    #[test]
+    fn steps_of_one_arc_compose_to_that_arc() {
+        let g = Geometry {
+            left_radius_m: 0.021,
+            right_radius_m: 0.02,
+            wheel_base_m: 0.09,
+            lidar: [0.0, 0.0, 0.0],
+        };
+        let whole = g.robot_motion(&[[3.0, 5.0]]);
+        let steps = g.robot_motion(&[[1.0, 5.0 / 3.0]; 3]);
+        for k in 0..3 {
+            assert!((whole[k] - steps[k]).abs() < 1e-12, "{whole:?} {steps:?}");
+        }
     }
 
     #[test]

@@ -9,7 +9,7 @@
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use super::kinematics::{residual, Geometry, PARAMETERS};
-use super::tuples::Tuple;
+use super::interval::Interval;
 use crate::checks::{variance_inflation, LJUNG_BOX_LAGS};
 use crate::CalibrationError;
 
@@ -36,7 +36,7 @@ pub struct Fit {
     pub covariance: [[f64; PARAMETERS]; PARAMETERS],
     /// The scan matcher's error covariance, estimated from the inliers' residuals (x, y, θ).
     pub measurement_covariance: [[f64; 3]; 3],
-    /// Which tuples were used (false: left out as outliers).
+    /// Which intervals were used (false: left out as outliers).
     pub inlier: Vec<bool>,
     /// Each tuple's residual (observed − predicted lidar motion), whitened by `Σ`, in order.
     pub whitened: Vec<[f64; 3]>,
@@ -49,25 +49,25 @@ pub struct Fit {
     pub converged: bool,
 }
 
-/// The maximum-likelihood geometry of `tuples`, from the closed-form `start`.
+/// The maximum-likelihood geometry of `intervals`, from the closed-form `start`.
 ///
 /// # Errors
 /// [`CalibrationError::Unidentifiable`] when the information matrix is singular (a parameter the
 /// drive does not inform), [`CalibrationError::Diverged`] when the estimate leaves finite
-/// numbers, [`CalibrationError::TooFewSamples`] when fewer than a dozen tuples remain.
-pub fn maximum_likelihood(tuples: &[Tuple], start: Geometry) -> Result<Fit, CalibrationError> {
+/// numbers, [`CalibrationError::TooFewSamples`] when fewer than a dozen intervals remain.
+pub fn maximum_likelihood(intervals: &[Interval], start: Geometry) -> Result<Fit, CalibrationError> {
     let mut p = SVector::<f64, PARAMETERS>::from(start.to_array());
-    let mut inlier = vec![true; tuples.len()];
-    let mut sigma = residual_covariance(tuples, &inlier, &p)?;
+    let mut inlier = vec![true; intervals.len()];
+    let mut sigma = residual_covariance(intervals, &inlier, &p)?;
     let mut converged = false;
     let mut rounds = 0;
     while rounds < MAX_ROUNDS {
         rounds += 1;
         let weight = inverse(&sigma)?;
-        p = gauss_newton(tuples, &inlier, p, &weight)?;
-        sigma = residual_covariance(tuples, &inlier, &p)?;
+        p = gauss_newton(intervals, &inlier, p, &weight)?;
+        sigma = residual_covariance(intervals, &inlier, &p)?;
         let weight = inverse(&sigma)?;
-        let next: Vec<bool> = tuples
+        let next: Vec<bool> = intervals
             .iter()
             .map(|t| {
                 let e = residual_of(t, &p);
@@ -82,7 +82,7 @@ pub fn maximum_likelihood(tuples: &[Tuple], start: Geometry) -> Result<Fit, Cali
     }
     let weight = inverse(&sigma)?;
     let mut information = Information::zeros();
-    for (t, _) in tuples.iter().zip(&inlier).filter(|(_, &i)| i) {
+    for (t, _) in intervals.iter().zip(&inlier).filter(|(_, &i)| i) {
         let j = jacobian(t, &p);
         information += j.transpose() * weight * j;
     }
@@ -95,7 +95,7 @@ pub fn maximum_likelihood(tuples: &[Tuple], start: Geometry) -> Result<Fit, Cali
         .cholesky()
         .and_then(|c| c.l().try_inverse())
         .ok_or_else(|| CalibrationError::Diverged("the residuals' covariance is singular".into()))?;
-    let whitened: Vec<[f64; 3]> = tuples
+    let whitened: Vec<[f64; 3]> = intervals
         .iter()
         .map(|t| {
             let w = whitener * residual_of(t, &p);
@@ -137,7 +137,7 @@ fn inverse(sigma: &Matrix3<f64>) -> Result<Matrix3<f64>, CalibrationError> {
         .ok_or_else(|| {
             CalibrationError::Diverged(
                 "the scan matches' residuals have no spread in some direction (a singular \
-                 covariance): the tuples are not measurements"
+                 covariance): the intervals are not measurements"
                     .into(),
             )
         })
@@ -145,13 +145,13 @@ fn inverse(sigma: &Matrix3<f64>) -> Result<Matrix3<f64>, CalibrationError> {
 
 /// The covariance of the inliers' residuals at `p` (the ML estimate of `Σ`).
 fn residual_covariance(
-    tuples: &[Tuple],
+    intervals: &[Interval],
     inlier: &[bool],
     p: &SVector<f64, PARAMETERS>,
 ) -> Result<Matrix3<f64>, CalibrationError> {
     let mut sum = Matrix3::<f64>::zeros();
     let mut n = 0usize;
-    for (t, _) in tuples.iter().zip(inlier).filter(|(_, &i)| i) {
+    for (t, _) in intervals.iter().zip(inlier).filter(|(_, &i)| i) {
         let e = residual_of(t, p);
         sum += e * e.transpose();
         n += 1;
@@ -160,7 +160,7 @@ fn residual_covariance(
         return Err(CalibrationError::TooFewSamples(format!(
             "{n} intervals left of {}; at least 12 are needed for 6 parameters and the 6 of the \
              scan matcher's error",
-            tuples.len()
+            intervals.len()
         )));
     }
     let sigma = sum / n as f64;
@@ -173,14 +173,14 @@ fn residual_covariance(
     }
 }
 
-fn residual_of(t: &Tuple, p: &SVector<f64, PARAMETERS>) -> Vector3<f64> {
+fn residual_of(t: &Interval, p: &SVector<f64, PARAMETERS>) -> Vector3<f64> {
     let g = Geometry::from_array((*p).into());
-    let predicted = g.lidar_motion(g.robot_motion(t.left_rad_s, t.right_rad_s, t.duration_s));
+    let predicted = g.lidar_motion(g.robot_motion(&t.wheel_turns_rad));
     Vector3::from(residual(t.lidar_motion, predicted))
 }
 
 /// `∂e/∂p` by central differences, each step a millionth of the parameter's scale.
-fn jacobian(t: &Tuple, p: &SVector<f64, PARAMETERS>) -> Jacobian {
+fn jacobian(t: &Interval, p: &SVector<f64, PARAMETERS>) -> Jacobian {
     let mut j = Jacobian::zeros();
     for k in 0..PARAMETERS {
         // Radii and base in metres scale with themselves; the mount's offsets with the base;
@@ -203,13 +203,13 @@ fn jacobian(t: &Tuple, p: &SVector<f64, PARAMETERS>) -> Jacobian {
 
 /// Gauss–Newton on the inliers' Mahalanobis cost, each step halved until it lowers the cost.
 fn gauss_newton(
-    tuples: &[Tuple],
+    intervals: &[Interval],
     inlier: &[bool],
     mut p: SVector<f64, PARAMETERS>,
     weight: &Matrix3<f64>,
 ) -> Result<SVector<f64, PARAMETERS>, CalibrationError> {
     let cost = |p: &SVector<f64, PARAMETERS>| -> f64 {
-        tuples
+        intervals
             .iter()
             .zip(inlier)
             .filter(|(_, &i)| i)
@@ -222,7 +222,7 @@ fn gauss_newton(
     let mut current = cost(&p);
     for _ in 0..MAX_STEPS {
         let (mut h, mut g) = (Information::zeros(), SVector::<f64, PARAMETERS>::zeros());
-        for (t, _) in tuples.iter().zip(inlier).filter(|(_, &i)| i) {
+        for (t, _) in intervals.iter().zip(inlier).filter(|(_, &i)| i) {
             let j = jacobian(t, &p);
             let e = residual_of(t, &p);
             h += j.transpose() * weight * j;

@@ -15,7 +15,6 @@
 use hilsim_recording::wrap_angle;
 
 use super::estimate::ObservationSet;
-use super::monte_carlo::PAPER_ALPHA;
 use crate::checks::Check;
 
 /// The order the bias is taken to have at least, whatever order was selected: both papers'
@@ -230,6 +229,7 @@ fn span_check(
 mod tests {
     use super::*;
     use crate::landmarks::estimate::Observation;
+    use crate::landmarks::monte_carlo::PAPER_ALPHA;
 
     /// Two stops 0.3 m apart, landmarks at 1 m and 3 m ahead-left: wide across landmarks, narrow
     /// along each.

@@ -113,7 +113,7 @@ pub fn analyse(rec: &Recording, opts: &Options) -> Result<Analysis, CalibrationE
             alpha_sd: model.alpha_sd,
         },
     );
-    let mut checks = super::checks::landmark_checks(&set, &est.used, &model.positions);
+    let mut checks = super::checks::landmark_checks(&set, &est.used, &model.positions, model.order);
     if let Some(lidar) = sensors_out.get(&Sensor::Lidar) {
         checks.extend(crate::checks::bias_plausible("lidar", lidar));
     }

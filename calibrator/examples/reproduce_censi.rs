@@ -42,7 +42,11 @@ fn run(tuples: &str, results: &str) -> Result<bool, String> {
     let Some(ours) = calibration.odometry else {
         return Err("no odometry in the calibration".into());
     };
-    let number = |key: &str| published[key].as_f64().ok_or(format!("{results}: no `{key}`"));
+    let number = |key: &str| {
+        published[key]
+            .as_f64()
+            .ok_or(format!("{results}: no `{key}`"))
+    };
     // The published diameters halved: the covariance's first two entries are the radii's.
     let theirs = [
         number("l_diam")? / 2.0,

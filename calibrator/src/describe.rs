@@ -255,9 +255,10 @@ impl Calibration {
                 .and_then(|n| usize::try_from(n).ok()),
             odometry: match value.get("odometry") {
                 None | Some(serde_json::Value::Null) => None,
-                Some(v) => Some(serde_json::from_value(v.clone()).map_err(|e| {
-                    invalid(format!("{origin}: `odometry`: {e}"))
-                })?),
+                Some(v) => Some(
+                    serde_json::from_value(v.clone())
+                        .map_err(|e| invalid(format!("{origin}: `odometry`: {e}")))?,
+                ),
             },
             landmarks: value["landmarks"].as_array().and_then(|list| {
                 list.iter()

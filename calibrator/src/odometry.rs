@@ -16,8 +16,10 @@ mod likelihood;
 pub mod tuples;
 
 pub use estimate::{calibrate_intervals, calibrate_tuples};
+pub use from_recording::{
+    calibrate, drive_intervals, DriveIntervals, RecordingOptions, MAX_INTERVAL_S, MIN_SCAN_POINTS,
+};
 pub use interval::Interval;
-pub use from_recording::{calibrate, RecordingOptions};
 pub use kinematics::Geometry;
 pub use likelihood::OUTLIER_CHI2_3;
 pub use tuples::{parse_tuples, Tuple, MAX_TUPLES};

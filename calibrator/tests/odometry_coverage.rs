@@ -16,7 +16,10 @@ use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
-const DRIVE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/odometry-drive.toml");
+const DRIVE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../scenarios/odometry-drive.toml"
+);
 
 const NAMES: [&str; 6] = [
     "left radius",
@@ -88,7 +91,11 @@ fn each_parameter_lands_within_two_sigma_of_the_truth_in_most_drives() {
                 .run();
             // A robot that bumps into something moves as its wheels do not say: the drive is
             // laid out to keep clear of everything whatever the drawn errors.
-            assert!(run.collisions.is_empty(), "run {seed} collided: {:?}", run.collisions);
+            assert!(
+                run.collisions.is_empty(),
+                "run {seed} collided: {:?}",
+                run.collisions
+            );
             let rec = run.recording;
             let cal = calibrate(&rec, &RecordingOptions::default())
                 .unwrap_or_else(|e| panic!("run {seed}: {e}"));
@@ -99,7 +106,11 @@ fn each_parameter_lands_within_two_sigma_of_the_truth_in_most_drives() {
                 .failed_checks()
                 .map(|c| format!("run {seed}: {}: {}", c.name, c.detail))
                 .collect();
-            (std::array::from_fn(|i| sigmas[i].abs() <= 2.0), sigmas, failed)
+            (
+                std::array::from_fn(|i| sigmas[i].abs() <= 2.0),
+                sigmas,
+                failed,
+            )
         })
         .collect();
     let failed_checks: Vec<&String> = outcomes.iter().flat_map(|(_, _, f)| f).collect();
@@ -109,7 +120,10 @@ fn each_parameter_lands_within_two_sigma_of_the_truth_in_most_drives() {
         let within = outcomes.iter().filter(|(w, _, _)| w[i]).count();
         let share = within as f64 / runs as f64;
         let rms = (outcomes.iter().map(|(_, s, _)| s[i] * s[i]).sum::<f64>() / runs as f64).sqrt();
-        println!("  {name:<13} {within:>4}/{runs} ({:.1} %), rms error {rms:.2} sigma", share * 100.0);
+        println!(
+            "  {name:<13} {within:>4}/{runs} ({:.1} %), rms error {rms:.2} sigma",
+            share * 100.0
+        );
         worst = worst.min(share);
     }
     println!("  checks failed: {}", failed_checks.len());

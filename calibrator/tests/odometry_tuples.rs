@@ -24,7 +24,10 @@ const NOISE: [f64; 3] = [0.0008, 0.0005, 0.0018];
 /// speeds drawn around each kind's; the lidar's motion the truth's plus noise.
 fn drive(n: usize, seed: u64, turns: &[f64]) -> Vec<Tuple> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let noise: Vec<Normal<f64>> = NOISE.iter().map(|&s| Normal::new(0.0, s).unwrap()).collect();
+    let noise: Vec<Normal<f64>> = NOISE
+        .iter()
+        .map(|&s| Normal::new(0.0, s).unwrap())
+        .collect();
     (0..n)
         .map(|k| {
             let turn = turns[k % turns.len()];
@@ -63,7 +66,11 @@ fn noiseless_tuples_give_the_geometry_back() {
     let model = calibrate_tuples(&tuples, 0).unwrap().odometry.unwrap();
     let truth = TRUTH.to_array();
     for (i, v) in model.parameters().iter().enumerate() {
-        assert!((v - truth[i]).abs() < 1e-6, "parameter {i}: {v} against {}", truth[i]);
+        assert!(
+            (v - truth[i]).abs() < 1e-6,
+            "parameter {i}: {v} against {}",
+            truth[i]
+        );
     }
 }
 
@@ -105,7 +112,9 @@ fn gross_scan_match_failures_are_left_out_and_counted() {
         "{model:?}"
     );
     assert!(
-        cal.notes.iter().any(|n| n.contains("10 left out as outliers")),
+        cal.notes
+            .iter()
+            .any(|n| n.contains("10 left out as outliers")),
         "{:?}",
         cal.notes
     );
@@ -148,7 +157,10 @@ fn a_drive_that_only_turns_in_place_fails_its_straight_check() {
     // Turning alone cannot set the scale: refused, or a failed check.
     if let Ok(cal) = cal {
         let failed: Vec<&str> = cal.failed_checks().map(|c| c.name.as_str()).collect();
-        assert!(failed.contains(&"odometry.straight_wheel_bases"), "{failed:?}");
+        assert!(
+            failed.contains(&"odometry.straight_wheel_bases"),
+            "{failed:?}"
+        );
     }
 }
 

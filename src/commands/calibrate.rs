@@ -9,8 +9,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
-use hilsim_calibrator::{odometry, smoothing};
 use hilsim_calibrator::{em, Method, SampleOptions, Settings};
+use hilsim_calibrator::{odometry, smoothing};
 use hilsim_recording::{
     check_output_file, write_file_atomically, FileKind, Meta, OutputTarget, Recording,
 };

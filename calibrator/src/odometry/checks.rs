@@ -2,8 +2,8 @@
 //! and drove straight enough for every parameter to be observable, each parameter is known to a
 //! useful precision, few intervals were outliers, and what is left is nearly white.
 
-use super::likelihood::Fit;
 use super::interval::Interval;
+use super::likelihood::Fit;
 use crate::checks::Check;
 use crate::OdometryModel;
 

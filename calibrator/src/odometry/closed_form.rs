@@ -12,8 +12,8 @@
 
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, Matrix5, SMatrix, Vector2};
 
-use super::kinematics::{arc_factors, Geometry};
 use super::interval::Interval;
+use super::kinematics::{arc_factors, Geometry};
 use crate::CalibrationError;
 
 /// The closed-form geometry of `intervals`.
@@ -38,18 +38,8 @@ pub fn closed_form(intervals: &[Interval]) -> Result<Geometry, CalibrationError>
         }
         let (sin, cos) = f64::sin_cos(turn);
         let [sx, sy, _] = t.lidar_motion;
-        let l = SMatrix::<f64, 2, 5>::new(
-            -cx,
-            1.0 - cos,
-            sin,
-            sx,
-            -sy,
-            -cy,
-            -sin,
-            1.0 - cos,
-            sy,
-            sx,
-        );
+        let l =
+            SMatrix::<f64, 2, 5>::new(-cx, 1.0 - cos, sin, sx, -sy, -cy, -sin, 1.0 - cos, sy, sx);
         m += l.transpose() * l;
     }
     let a: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into();

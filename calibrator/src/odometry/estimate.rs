@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use super::checks::odometry_checks;
 use super::closed_form::closed_form;
-use super::likelihood::maximum_likelihood;
 use super::interval::Interval;
+use super::likelihood::maximum_likelihood;
 use super::tuples::Tuple;
 use crate::{Calibration, CalibrationError, Method, OdometryModel};
 

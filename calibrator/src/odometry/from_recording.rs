@@ -5,8 +5,8 @@ use hilsim_recording::{LidarSample, OdometrySample, Pose, Recording};
 use rayon::prelude::*;
 
 use super::estimate::calibrate_intervals;
-use super::kinematics::Geometry;
 use super::interval::Interval;
+use super::kinematics::Geometry;
 use crate::checks::Check;
 use crate::scan_match::{match_scans, MatchFailure, MatchOptions, Scan};
 use crate::{Calibration, CalibrationError};
@@ -35,11 +35,11 @@ impl Default for RecordingOptions {
 
 /// Least readings for a revolution to be matched: 30. Below that a scan holds one or two
 /// surfaces' worth of points, too few to fix three degrees of freedom with any margin.
-const MIN_SCAN_POINTS: usize = 30;
+pub const MIN_SCAN_POINTS: usize = 30;
 
 /// Longest interval, seconds: 2. Longer ones are gaps in the data (a revolution lost), over
 /// which the wheels' speeds cannot be taken as constant, the model's assumption.
-const MAX_INTERVAL_S: f64 = 2.0;
+pub const MAX_INTERVAL_S: f64 = 2.0;
 
 /// An interval is standing still when each wheel moved less than this: 0.5 mm (half the
 /// XV-11 robot encoders' millimetre). Its scan match measures only the matcher's noise.
@@ -50,22 +50,47 @@ const STILL_M: f64 = 0.0005;
 /// rest may not be a random sample of it.
 pub const MAX_FAILED_MATCH_SHARE: f64 = 0.20;
 
-/// Calibrates the wheels and the lidar's mount from `rec`'s encoders and lidar: each interval's
-/// lidar motion from scan-to-scan matching (point-to-line ICP, [`crate::scan_match`]), its wheel
-/// speeds from the encoders' travel over it.
+/// A recording's drive cut into intervals, with what could not be used and why.
+#[derive(Debug, Clone)]
+pub struct DriveIntervals {
+    /// The matched intervals, in time order.
+    pub intervals: Vec<Interval>,
+    /// Each matched interval's start and end, seconds.
+    pub spans_s: Vec<[f64; 2]>,
+    /// The geometry the recording declares (`meta.toml`'s wheel base and lidar mount, the
+    /// nominal wheel radius): the scan matcher's guesses and the de-skewing use it.
+    pub nominal: Geometry,
+    /// The lidar's revolutions.
+    pub revolutions: usize,
+    /// Intervals whose scans could not be matched, with why.
+    pub failed: Vec<MatchFailure>,
+    /// Intervals standing still.
+    pub still: usize,
+    /// Intervals longer than [`MAX_INTERVAL_S`] or outside the odometry's span.
+    pub gaps: usize,
+    /// Intervals with a revolution of fewer than [`MIN_SCAN_POINTS`] readings.
+    pub sparse: usize,
+    /// What was assumed, for people.
+    pub notes: Vec<String>,
+}
+
+/// `rec`'s drive as intervals: each one's lidar motion from scan-to-scan matching
+/// (point-to-line ICP, [`crate::scan_match`]) of revolutions de-skewed along the dead-reckoned
+/// path, its wheel turns from the encoders' travel over the nominal radius.
 ///
 /// # Errors
-/// A table or a `meta.toml` key the method needs is missing, too few intervals could be
-/// matched, or the estimate's errors.
-pub fn calibrate(
+/// A table or a `meta.toml` key the method needs is missing, or the options are out of range.
+pub fn drive_intervals(
     rec: &Recording,
     options: &RecordingOptions,
-) -> Result<Calibration, CalibrationError> {
+) -> Result<DriveIntervals, CalibrationError> {
     let lidar = rec
         .lidar
         .as_deref()
         .filter(|l| !l.is_empty())
-        .ok_or_else(|| CalibrationError::Missing("odometry: the recording has no lidar.csv".into()))?;
+        .ok_or_else(|| {
+            CalibrationError::Missing("odometry: the recording has no lidar.csv".into())
+        })?;
     let odometry = rec
         .odometry
         .as_deref()
@@ -84,7 +109,7 @@ pub fn calibrate(
             CalibrationError::Missing(
                 "odometry: meta.toml gives no nominal wheel radius ([robot] wheel_radius_m), \
                  which the encoders' travel was reported with; give it (calibrate \
-                 --wheel-radius M)"
+                 --wheel-radius-m R)"
                     .into(),
             )
         })?;
@@ -95,7 +120,11 @@ pub fn calibrate(
     }
     let mut notes = Vec::new();
     let mount = rec.meta.lidar.unwrap_or_else(|| {
-        notes.push("meta.toml gives no lidar mount: the scans are de-skewed as if the lidar sat on the axle's centre".into());
+        notes.push(
+            "meta.toml gives no lidar mount: the scans are de-skewed and matched from guesses \
+             as if the lidar sat on the axle's centre"
+                .into(),
+        );
         hilsim_recording::Mount::default()
     });
     let nominal = Geometry {
@@ -123,30 +152,67 @@ pub fn calibrate(
         .par_iter()
         .map(|&(a, b)| interval(&scans[a], &scans[b], &path, &nominal, &matching))
         .collect();
-    let mut intervals = Vec::new();
-    let (mut still, mut gaps, mut sparse) = (0usize, 0usize, 0usize);
-    let mut failed: Vec<MatchFailure> = Vec::new();
-    for outcome in outcomes {
+    let mut drive = DriveIntervals {
+        intervals: Vec::new(),
+        spans_s: Vec::new(),
+        nominal,
+        revolutions: scans.len(),
+        failed: Vec::new(),
+        still: 0,
+        gaps: 0,
+        sparse: 0,
+        notes,
+    };
+    for (outcome, (a, b)) in outcomes.into_iter().zip(pairs) {
         match outcome {
-            Outcome::Matched(t) => intervals.push(t),
-            Outcome::Still => still += 1,
-            Outcome::Gap => gaps += 1,
-            Outcome::Sparse => sparse += 1,
-            Outcome::Failed(f) => failed.push(f),
+            Outcome::Matched(t) => {
+                drive.intervals.push(t);
+                drive.spans_s.push([scans[a].t_s, scans[b].t_s]);
+            }
+            Outcome::Still => drive.still += 1,
+            Outcome::Gap => drive.gaps += 1,
+            Outcome::Sparse => drive.sparse += 1,
+            Outcome::Failed(f) => drive.failed.push(f),
         }
     }
+    Ok(drive)
+}
+
+/// Calibrates the wheels and the lidar's mount from `rec`'s encoders and lidar: the intervals
+/// of [`drive_intervals`], then the estimate of [`calibrate_intervals`], its wheel scales
+/// against the nominal radius, and a check of how many matches failed.
+///
+/// # Errors
+/// A table or a `meta.toml` key the method needs is missing, too few intervals could be
+/// matched, or the estimate's errors.
+pub fn calibrate(
+    rec: &Recording,
+    options: &RecordingOptions,
+) -> Result<Calibration, CalibrationError> {
+    let drive = drive_intervals(rec, options)?;
+    let DriveIntervals {
+        intervals,
+        nominal,
+        revolutions,
+        failed,
+        still,
+        gaps,
+        sparse,
+        mut notes,
+        ..
+    } = drive;
     let attempted = intervals.len() + failed.len();
     if intervals.len() < 12 {
         return Err(CalibrationError::TooFewSamples(format!(
-            "odometry: {} interval(s) of the drive could be matched ({} revolutions; {} failed \
-             to match, {still} standing still, {gaps} gaps, {sparse} with fewer than \
-             {MIN_SCAN_POINTS} readings); at least 12 are needed",
+            "odometry: {} interval(s) of the drive could be matched ({revolutions} \
+             revolutions; {} failed to match, {still} standing still, {gaps} gaps, {sparse} \
+             with fewer than {MIN_SCAN_POINTS} readings); at least 12 are needed",
             intervals.len(),
-            scans.len(),
             failed.len()
         )));
     }
     let mut calibration = calibrate_intervals(&intervals)?;
+    let nominal_radius = nominal.left_radius_m;
     if let Some(model) = calibration.odometry.as_mut() {
         model.wheel_scale = Some([
             model.left_wheel_radius_m / nominal_radius,
@@ -190,18 +256,16 @@ pub fn calibrate(
         ),
     ));
     notes.push(format!(
-        "{} lidar revolutions, intervals of {} s: {} matched, {} failed to \
-         match, {still} standing still, {gaps} longer than {MAX_INTERVAL_S} s, {sparse} with \
-         fewer than {MIN_SCAN_POINTS} readings",
-        scans.len(),
+        "{revolutions} lidar revolutions, intervals of {} s: {} matched, {} failed to match, \
+         {still} standing still, {gaps} longer than {MAX_INTERVAL_S} s or outside the \
+         odometry, {sparse} with fewer than {MIN_SCAN_POINTS} readings",
         options.interval_s,
         intervals.len(),
         failed.len()
     ));
     notes.push(format!(
-        "wheel speeds from the encoders' travel over the nominal radius {:.4} m; the radii are \
-         that radius times each wheel's scale",
-        nominal_radius
+        "wheel speeds from the encoders' travel over the nominal radius {nominal_radius:.4} m; \
+         the radii are that radius times each wheel's scale"
     ));
     calibration.notes.splice(0..0, notes);
     Ok(calibration)
@@ -251,7 +315,11 @@ impl<'a> Path<'a> {
         }
         let i = o.partition_point(|s| s.t_s <= t).clamp(1, o.len() - 1) - 1;
         let span = o[i + 1].t_s - o[i].t_s;
-        let u = if span > 0.0 { (t - o[i].t_s) / span } else { 0.0 };
+        let u = if span > 0.0 {
+            (t - o[i].t_s) / span
+        } else {
+            0.0
+        };
         Some((i, u.clamp(0.0, 1.0)))
     }
 

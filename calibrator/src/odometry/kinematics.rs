@@ -151,7 +151,10 @@ mod tests {
         let s = g.lidar_motion(g.robot_motion(&[[-speed, speed]]));
         // The lidar ends at (0, 0.1) of the robot's start frame, facing +y: in its own start
         // frame at (-0.1, 0.1).
-        assert!((s[0] + 0.1).abs() < 1e-12 && (s[1] - 0.1).abs() < 1e-12, "{s:?}");
+        assert!(
+            (s[0] + 0.1).abs() < 1e-12 && (s[1] - 0.1).abs() < 1e-12,
+            "{s:?}"
+        );
         assert!((s[2] - quarter).abs() < 1e-12);
     }
 

@@ -8,8 +8,8 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-use super::kinematics::{residual, Geometry, PARAMETERS};
 use super::interval::Interval;
+use super::kinematics::{residual, Geometry, PARAMETERS};
 use crate::checks::{variance_inflation, LJUNG_BOX_LAGS};
 use crate::CalibrationError;
 
@@ -55,7 +55,10 @@ pub struct Fit {
 /// [`CalibrationError::Unidentifiable`] when the information matrix is singular (a parameter the
 /// drive does not inform), [`CalibrationError::Diverged`] when the estimate leaves finite
 /// numbers, [`CalibrationError::TooFewSamples`] when fewer than a dozen intervals remain.
-pub fn maximum_likelihood(intervals: &[Interval], start: Geometry) -> Result<Fit, CalibrationError> {
+pub fn maximum_likelihood(
+    intervals: &[Interval],
+    start: Geometry,
+) -> Result<Fit, CalibrationError> {
     let mut p = SVector::<f64, PARAMETERS>::from(start.to_array());
     let mut inlier = vec![true; intervals.len()];
     let mut sigma = residual_covariance(intervals, &inlier, &p)?;
@@ -94,7 +97,9 @@ pub fn maximum_likelihood(intervals: &[Interval], start: Geometry) -> Result<Fit
     let whitener = sigma
         .cholesky()
         .and_then(|c| c.l().try_inverse())
-        .ok_or_else(|| CalibrationError::Diverged("the residuals' covariance is singular".into()))?;
+        .ok_or_else(|| {
+            CalibrationError::Diverged("the residuals' covariance is singular".into())
+        })?;
     let whitened: Vec<[f64; 3]> = intervals
         .iter()
         .map(|t| {
@@ -230,8 +235,7 @@ fn gauss_newton(
         }
         let Some(step) = h.cholesky().map(|c| c.solve(&g)) else {
             return Err(CalibrationError::Unidentifiable(
-                "the drive does not inform every parameter (a singular information matrix)"
-                    .into(),
+                "the drive does not inform every parameter (a singular information matrix)".into(),
             ));
         };
         // Linearised, e(p + δ) ≈ e + J δ, least at δ = −H⁻¹ g.

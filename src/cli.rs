@@ -178,6 +178,13 @@ pub struct CalibrateArgs {
         allow_hyphen_values = true
     )]
     pub priors: Vec<String>,
+    /// Odometry: the wheels' nominal radius the encoders' travel was reported with (default:
+    /// `meta.toml`'s `[robot] wheel_radius_m`).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub wheel_radius_m: Option<f64>,
+    /// Odometry: the length of an interval between matched scans, seconds (default 1).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub interval_s: Option<f64>,
 }
 
 /// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.

@@ -32,7 +32,25 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     {
         bail!("--min-revolutions: expected a number of revolutions from 1 to 1000000");
     }
+    if args
+        .wheel_radius_m
+        .is_some_and(|r| !(r.is_finite() && r > 0.0 && r <= 10.0))
+    {
+        bail!("--wheel-radius-m: expected a radius in metres, more than 0 and at most 10");
+    }
+    let max_interval = hilsim_calibrator::odometry::MAX_INTERVAL_S;
+    if args
+        .interval_s
+        .is_some_and(|s| !(s.is_finite() && s > 0.0 && s <= max_interval))
+    {
+        bail!("--interval-s: expected seconds, more than 0 and at most {max_interval}");
+    }
     // Each method's own options: given to another, they would be silently ignored.
+    if (args.wheel_radius_m.is_some() || args.interval_s.is_some())
+        && (args.method != Method::Odometry || args.tuples.is_some())
+    {
+        bail!("--wheel-radius-m and --interval-s are for --method odometry on a recording");
+    }
     if !args.priors.is_empty() && args.method != Method::Em {
         bail!("--prior: priors are for --method em");
     }
@@ -56,7 +74,12 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
             ..StopOptions::default()
         },
         priors: em::Priors::new(&priors)?,
-        odometry: odometry::RecordingOptions::default(),
+        odometry: odometry::RecordingOptions {
+            nominal_wheel_radius_m: args.wheel_radius_m,
+            interval_s: args
+                .interval_s
+                .unwrap_or(odometry::RecordingOptions::default().interval_s),
+        },
     };
     let method = args.method;
     let (calibration, input) = match (&args.recording, &args.tuples) {

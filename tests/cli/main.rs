@@ -4,6 +4,7 @@
 mod bad_input;
 mod bounded_input;
 mod calibrate;
+mod calibrate_odometry;
 mod common;
 mod dataset;
 mod diagnose;

@@ -21,6 +21,9 @@ pub const RIGHT: &str = "#d9534f";
 /// A region the diagnosis located.
 pub const HIGHLIGHT: &str = "#fff1b8";
 
+/// The path dead-reckoned with an odometry calibration's wheels (the odometry method's colour).
+pub const CALIBRATED_ODOMETRY: &str = "#2e8b57";
+
 /// Each calibration method's fitted curves.
 #[must_use]
 pub fn method(method: hilsim_calibrator::Method) -> &'static str {
@@ -28,6 +31,6 @@ pub fn method(method: hilsim_calibrator::Method) -> &'static str {
         hilsim_calibrator::Method::Em => CALIBRATED,
         hilsim_calibrator::Method::Groundtruth => "#12a4b6",
         hilsim_calibrator::Method::Landmarks => "#9b59b6",
-        hilsim_calibrator::Method::Odometry => "#2e8b57",
+        hilsim_calibrator::Method::Odometry => CALIBRATED_ODOMETRY,
     }
 }

@@ -32,6 +32,7 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
         .truth
         .iter()
         .chain(&view.odometry)
+        .chain(&view.calibrated_odometry)
         .map(|(_, p)| (p.x, p.y))
         .collect();
     let revs = chosen_revolutions(view);
@@ -84,6 +85,14 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
         let stroke = Stroke::dashed(colours::ODOMETRY, 2.0);
         chart.line(&line(&view.odometry), stroke);
         keys.push(Key::Line(stroke, "path from the odometry".into()));
+    }
+    if !view.calibrated_odometry.is_empty() {
+        let stroke = Stroke::dashed(colours::CALIBRATED_ODOMETRY, 2.0);
+        chart.line(&line(&view.calibrated_odometry), stroke);
+        keys.push(Key::Line(
+            stroke,
+            "path from the odometry, wheels calibrated".into(),
+        ));
     }
     if !view.truth.is_empty() {
         let stroke = Stroke::solid(colours::TRUTH, 1.8);

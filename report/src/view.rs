@@ -65,6 +65,9 @@ pub struct View<'a> {
     /// The path dead-reckoned from the odometry, from the true start (else the scenario's
     /// start, else the origin); empty without odometry.
     pub odometry: Path,
+    /// The same dead-reckoned with an odometry calibration's wheels (the first calibration
+    /// that has them); empty without one.
+    pub calibrated_odometry: Path,
     /// What a reading's world position is computed from: "truth", "odometry" or "none".
     pub reference: &'static str,
     /// Each valid lidar reading with its true distance.
@@ -95,7 +98,14 @@ impl<'a> View<'a> {
                 Pose::new(p.x, p.y, p.yaw_deg.to_radians())
             })
         });
-        let odometry = dead_reckoning(rec, start.unwrap_or(Pose::new(0.0, 0.0, 0.0)));
+        let origin = start.unwrap_or(Pose::new(0.0, 0.0, 0.0));
+        let odometry = dead_reckoning(rec, origin, Wheels::declared(rec));
+        let calibrated_odometry = inputs
+            .calibrations
+            .iter()
+            .find_map(|c| c.odometry.as_ref())
+            .and_then(|o| Wheels::calibrated(rec, o))
+            .map_or_else(Vec::new, |wheels| dead_reckoning(rec, origin, wheels));
         let reference = if !truth.is_empty() {
             "truth"
         } else if !odometry.is_empty() {
@@ -178,6 +188,7 @@ impl<'a> View<'a> {
             inputs,
             truth,
             odometry,
+            calibrated_odometry,
             reference,
             lidar,
             sonar,
@@ -265,18 +276,56 @@ fn cast(
         .map_or(f64::NAN, |hit| hit.distance)
 }
 
+/// How the encoders' travel becomes the wheels': each wheel's travel times its scale, the
+/// wheels `base_m` apart.
+#[derive(Debug, Clone, Copy)]
+struct Wheels {
+    scale: [f64; 2],
+    base_m: f64,
+}
+
+impl Wheels {
+    /// As the recording declares them.
+    fn declared(rec: &Recording) -> Self {
+        Self {
+            scale: [1.0, 1.0],
+            base_m: rec.meta.robot.wheel_base_m,
+        }
+    }
+
+    /// As an odometry calibration found them; `None` when it does not say how its radii
+    /// compare with the recording's travel (a calibration of tuples, and the recording gives
+    /// no nominal radius).
+    fn calibrated(rec: &Recording, o: &hilsim_calibrator::OdometryModel) -> Option<Self> {
+        let scale = o.wheel_scale.or_else(|| {
+            let nominal = rec.meta.robot.wheel_radius_m?;
+            Some([
+                o.left_wheel_radius_m / nominal,
+                o.right_wheel_radius_m / nominal,
+            ])
+        })?;
+        Some(Self {
+            scale,
+            base_m: o.wheel_base_m,
+        })
+    }
+}
+
 /// The odometry dead-reckoned from `start` ([`Pose::drive`] between readings).
-fn dead_reckoning(rec: &Recording, start: Pose) -> Path {
+fn dead_reckoning(rec: &Recording, start: Pose, wheels: Wheels) -> Path {
     let Some(odometry) = rec.odometry.as_deref() else {
         return Vec::new();
     };
-    let base = rec.meta.robot.wheel_base_m;
+    let Wheels {
+        scale: [left, right],
+        base_m: base,
+    } = wheels;
     let mut path = Vec::with_capacity(odometry.len());
     let mut pose = start;
     let mut last: Option<(f64, f64)> = None;
     for o in odometry {
         if let Some((l, r)) = last {
-            pose = pose.drive(o.left_m - l, o.right_m - r, base);
+            pose = pose.drive((o.left_m - l) * left, (o.right_m - r) * right, base);
         }
         last = Some((o.left_m, o.right_m));
         path.push((o.t_s, pose));

@@ -183,6 +183,14 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
         check_output_file(csv, SMOOTHED_CSV, &inputs)?;
     }
     let trained = super::read_calibration(&args.calibration)?;
+    if trained.sensors.is_empty() {
+        bail!(
+            "{}: the {} method's calibration holds no sensor model; smooth applies em's (lidar, sonar, \
+             odometer)",
+            args.calibration.display(),
+            trained.method.name()
+        );
+    }
     let rec = Recording::read_dir(&args.recording)?;
     let (estimates, checks) =
         smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))

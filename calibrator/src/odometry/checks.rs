@@ -61,17 +61,17 @@ pub fn odometry_checks(intervals: &[Interval], fit: &Fit, model: &OdometryModel)
             straight_m += travel;
         }
     }
-    for (name, turned) in [
-        ("odometry.turned_left_deg", left),
-        ("odometry.turned_right_deg", right),
+    for (name, way, turned) in [
+        ("odometry.turned_left_deg", "left", left),
+        ("odometry.turned_right_deg", "right", right),
     ] {
         checks.push(Check::at_least(
             name,
             turned.to_degrees(),
             MIN_TURN_EACH_WAY_DEG,
             format!(
-                "the drive turned {:.0}° this way; turning one way only, a wheel's radius \
-                 trades against the lidar's sideways offset",
+                "the drive turned {:.0}° to the {way} in all; turning one way only, a \
+                 wheel's radius trades against the lidar's sideways offset",
                 turned.to_degrees()
             ),
         ));

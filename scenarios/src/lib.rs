@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod calibrated;
 mod discover;
 pub mod metrics;
 mod pipeline;

@@ -1,4 +1,5 @@
-//! `hilsim diagnose --sim SCENARIO --real RECORDING [--json] [--report DIR]` and
+//! `hilsim diagnose --sim SCENARIO --real RECORDING [--calibration FILE] [--json] [--report DIR]`
+//! and
 //! `hilsim diagnose --self-test N [--seed S] [--sim SCENARIO] [--json]`.
 //!
 //! Exit codes: 0 when a verdict is reached (`none`, an effect, or `unexplained`: each is an
@@ -85,6 +86,11 @@ pub struct DiagnoseArgs {
     /// reported (default 0.25).
     #[arg(long, value_name = "X", conflicts_with = "self_test")]
     pub floor_noise_share: Option<f64>,
+    /// An odometry calibration of the robot (`hilsim calibrate --method odometry --json`): the
+    /// simulation takes its wheels and lidar mount instead of the scenario's declared ones, so
+    /// that what is left is what the calibration did not explain.
+    #[arg(long, value_name = "FILE", conflicts_with = "self_test")]
+    pub calibration: Option<PathBuf>,
 }
 
 /// The diagnosis's options from `--floor` and `--floor-noise-share`.
@@ -234,7 +240,20 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(dir) = &args.report {
         super::report_dir::check_report_dir(dir, &[MAP_FILE])?;
     }
-    let scenario = super::load_scenario(Some(sim), None)?;
+    let mut scenario = super::load_scenario(Some(sim), None)?;
+    if let Some(path) = &args.calibration {
+        let calibration = super::read_calibration(path)?;
+        let Some(model) = calibration.odometry else {
+            bail!(
+                "{}: the {} method's calibration has no wheels or lidar mount; --calibration \
+                 takes an odometry calibration",
+                path.display(),
+                calibration.method.name()
+            );
+        };
+        scenario = hilsim_scenarios::calibrated::with_odometry(&scenario, &model)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    }
     let recording = Recording::read_dir(real)?;
     let physics = SimPhysics::new(&scenario).with_context(|| sim.display().to_string())?;
     // The stages on a terminal only: stdout starts with the verdict and stderr holds one line

@@ -82,7 +82,8 @@ pub struct MatchOptions {
     /// ICP), in [0, 1).
     pub trim_fraction: f64,
     /// Fewer correspondences (or usable current points) than this is
-    /// [`MatchFailure::TooFewPoints`]; at least 3, the unknowns.
+    /// [`MatchFailure::TooFewPoints`]; at least 4 (three unknowns and a residual to measure the
+    /// noise).
     pub min_points: usize,
     /// An iteration moving the lidar less than this (metres) and turning it less than
     /// `convergence_rad` ends the match.
@@ -170,9 +171,10 @@ impl MatchOptions {
                 self.trim_fraction
             ));
         }
-        if self.min_points < 3 {
+        if self.min_points < 4 {
             return bad(format!(
-                "min_points must be at least 3 (the motion has three unknowns), got {}",
+                "min_points must be at least 4 (three unknowns and a residual to measure the \
+                 noise), got {}",
                 self.min_points
             ));
         }
@@ -328,18 +330,25 @@ pub fn match_scans(
         current: &current,
         options,
         pairs: Vec::with_capacity(current.len()),
+        kept: 0,
         scratch: Vec::with_capacity(current.len()),
     };
     let tiny = (options.convergence_m / 10.0, options.convergence_rad / 10.0);
     let mut x = [guess[0], guess[1], wrap_angle(guess[2])];
     let mut gate = options.max_correspondence_m;
     let mut last = (f64::NAN, f64::NAN);
+    let mut visited: Vec<[f64; 3]> = Vec::with_capacity(options.max_iterations.min(64));
     for iteration in 1..=options.max_iterations {
         let spread = work.associate(x, gate);
-        if work.pairs.len() < options.min_points {
-            return Err(too_few(work.pairs.len()));
+        if work.kept < options.min_points {
+            return Err(too_few(work.kept));
         }
-        let Some(next) = refine(&mut work.pairs, x, options.min_observability, tiny) else {
+        let Some(next) = refine(
+            &mut work.pairs[..work.kept],
+            x,
+            options.min_observability,
+            tiny,
+        ) else {
             break;
         };
         let step = (
@@ -354,9 +363,18 @@ pub fn match_scans(
             options.max_correspondence_m
         };
         last = step;
-        if step.0 < options.convergence_m && step.1 < options.convergence_rad {
+        let close = |y: &[f64; 3]| {
+            (x[0] - y[0]).hypot(x[1] - y[1]) < options.convergence_m
+                && wrap_angle(x[2] - y[2]).abs() < options.convergence_rad
+        };
+        // A motion met before is a cycle between correspondence sets (the trim and the gate
+        // flip a few points back and forth); any motion on it is as good as the others.
+        if step.0 < options.convergence_m && step.1 < options.convergence_rad
+            || visited.iter().any(close)
+        {
             return work.finish(x, gate, iteration);
         }
+        visited.push(x);
     }
     Err(MatchFailure::NotConverged {
         iterations: options.max_iterations,
@@ -383,6 +401,8 @@ struct Work<'a> {
     current: &'a [[f64; 2]],
     options: &'a MatchOptions,
     pairs: Vec<Pair>,
+    /// How many of `pairs` (the first) survive the trim.
+    kept: usize,
     scratch: Vec<f64>,
 }
 
@@ -423,8 +443,8 @@ impl Work<'_> {
         if keep < n {
             self.pairs
                 .select_nth_unstable_by(keep, |a, b| a.residual.abs().total_cmp(&b.residual.abs()));
-            self.pairs.truncate(keep);
         }
+        self.kept = keep.min(n);
         Spread {
             residual_m,
             point_m,
@@ -440,7 +460,7 @@ impl Work<'_> {
         iterations: usize,
     ) -> Result<ScanMatch, MatchFailure> {
         let spread = self.associate(x, gate);
-        let m = self.pairs.len();
+        let m = self.kept;
         if m < self.options.min_points {
             return Err(MatchFailure::TooFewPoints {
                 reference: self.reference.points(),
@@ -450,7 +470,7 @@ impl Work<'_> {
                 needed: self.options.min_points,
             });
         }
-        let normal = Normal::at(&self.pairs, &x);
+        let normal = Normal::at(&self.pairs[..m], &x);
         let not_finite = MatchFailure::NotConverged {
             iterations,
             step_m: f64::NAN,
@@ -469,8 +489,7 @@ impl Work<'_> {
         // The three fitted unknowns shrink the residuals by (m - 3) / m on average.
         let sigma2 = spread.point_m * spread.point_m * m as f64 / (m - 3) as f64;
         let cov = inverse * (2.0 * sigma2);
-        let rms = (self
-            .pairs
+        let rms = (self.pairs[..m]
             .iter()
             .map(|p| p.residual * p.residual)
             .sum::<f64>()

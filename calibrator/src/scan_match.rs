@@ -8,7 +8,8 @@
 //! search along the bearing, not over all pairs), keeps the correspondences within a gate that
 //! shrinks with the residuals' spread and then the best `1 − trim_fraction` of them (trimmed
 //! ICP), and moves to the motion that minimises their squared distances to the segments' lines
-//! (`solve`). It stops when a step is below the convergence thresholds.
+//! (`solve`). It stops when a step is below the convergence thresholds, or when it comes back
+//! to a motion it has already reached (a cycle between correspondence sets).
 //!
 //! A segment's line is the total-least-squares line of its two points and of their neighbours
 //! on the same surface within [`MatchOptions::line_fit_radius_m`]; with a radius of zero it is
@@ -16,6 +17,13 @@
 //! apart, neighbours 2 cm apart tilt a two-point line by tens of degrees, and such tilted lines
 //! would both blur the motion and make a corridor look as if its walls fixed the motion along
 //! them.
+//!
+//! What it can tell: on scans ray-cast in an irregular room with 1 cm range noise and 360 beams
+//! (`tests/scan_match.rs`), over 200 motions of up to 0.2 m and 11° from a zero guess, the
+//! error was 1.2–1.3 mm RMS in x and y and 0.034° in θ. The covariance is somewhat optimistic:
+//! the mean squared Mahalanobis distance of the errors was 3.7 where 3 would fit, because it
+//! leaves out how the noise moves the correspondences and the trim. With two-point lines the
+//! errors were 15 % larger and that mean 6.0.
 
 mod reference;
 mod solve;

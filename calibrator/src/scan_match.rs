@@ -8,7 +8,8 @@
 //! search along the bearing, not over all pairs), keeps the correspondences within a gate that
 //! shrinks with the residuals' spread and then the best `1 − trim_fraction` of them (trimmed
 //! ICP), and moves to the motion that minimises their squared distances to the segments' lines
-//! (`solve`). It stops when a step is below the convergence thresholds.
+//! (`solve`). It stops when a step is below the convergence thresholds, or when it comes back
+//! to a motion it has already reached (a cycle between correspondence sets).
 //!
 //! A segment's line is the total-least-squares line of its two points and of their neighbours
 //! on the same surface within [`MatchOptions::line_fit_radius_m`]; with a radius of zero it is
@@ -16,13 +17,19 @@
 //! apart, neighbours 2 cm apart tilt a two-point line by tens of degrees, and such tilted lines
 //! would both blur the motion and make a corridor look as if its walls fixed the motion along
 //! them.
+//!
+//! What it can tell: on scans ray-cast in an irregular room with 1 cm range noise and 360 beams
+//! (`tests/scan_match.rs`), over 200 motions of up to 0.2 m and 11° from a zero guess, the
+//! error was 1.2–1.3 mm RMS in x and y and 0.034° in θ. The covariance is somewhat optimistic:
+//! the mean squared Mahalanobis distance of the errors was 3.7 where 3 would fit, because it
+//! leaves out how the noise moves the correspondences and the trim. With two-point lines the
+//! errors were 15 % larger and that mean 6.0.
 
 mod reference;
 mod solve;
 
 use hilsim_recording::{wrap_angle, Pose};
 
-use crate::stats::median;
 use reference::{usable, Reference, Surfaces};
 use solve::{refine, Normal, Pair};
 
@@ -82,7 +89,8 @@ pub struct MatchOptions {
     /// ICP), in [0, 1).
     pub trim_fraction: f64,
     /// Fewer correspondences (or usable current points) than this is
-    /// [`MatchFailure::TooFewPoints`]; at least 3, the unknowns.
+    /// [`MatchFailure::TooFewPoints`]; at least 4 (three unknowns and a residual to measure the
+    /// noise).
     pub min_points: usize,
     /// An iteration moving the lidar less than this (metres) and turning it less than
     /// `convergence_rad` ends the match.
@@ -100,7 +108,10 @@ pub struct MatchOptions {
     /// The smallest share of the information a direction of the motion may have before the
     /// match is [`MatchFailure::Degenerate`]: the smallest eigenvalue of `JᵀJ / m` with θ
     /// multiplied by the current points' RMS range, a number between 0 and about 1 (½ for a
-    /// square room's translations).
+    /// square room's translations). With 1 cm noise, a corridor's walls alone give 0.002–0.008
+    /// (their fitted lines' tilt from the noise), a corridor closed by a wall 4 m ahead
+    /// 0.05–0.08, an irregular room 0.15–0.2. Steps are also taken only along directions above
+    /// it.
     pub min_observability: f64,
 }
 
@@ -170,9 +181,10 @@ impl MatchOptions {
                 self.trim_fraction
             ));
         }
-        if self.min_points < 3 {
+        if self.min_points < 4 {
             return bad(format!(
-                "min_points must be at least 3 (the motion has three unknowns), got {}",
+                "min_points must be at least 4 (three unknowns and a residual to measure the \
+                 noise), got {}",
                 self.min_points
             ));
         }
@@ -248,7 +260,8 @@ pub enum MatchFailure {
         /// [`MatchOptions::min_points`].
         needed: usize,
     },
-    /// The iterations ran out before a step fell below the convergence thresholds.
+    /// The iterations ran out before a step fell below the convergence thresholds (or the
+    /// numbers stopped being finite: then the step is NaN).
     #[error(
         "the match did not settle in {iterations} iterations: its last step moved {step_m} m \
          and turned {step_rad} rad"
@@ -328,18 +341,28 @@ pub fn match_scans(
         current: &current,
         options,
         pairs: Vec::with_capacity(current.len()),
+        kept: 0,
         scratch: Vec::with_capacity(current.len()),
     };
     let tiny = (options.convergence_m / 10.0, options.convergence_rad / 10.0);
     let mut x = [guess[0], guess[1], wrap_angle(guess[2])];
     let mut gate = options.max_correspondence_m;
     let mut last = (f64::NAN, f64::NAN);
+    let mut visited: Vec<[f64; 3]> = Vec::with_capacity(options.max_iterations.min(64));
+    let mut ran = 0;
     for iteration in 1..=options.max_iterations {
+        ran = iteration;
         let spread = work.associate(x, gate);
-        if work.pairs.len() < options.min_points {
-            return Err(too_few(work.pairs.len()));
+        if work.kept < options.min_points {
+            return Err(too_few(work.kept));
         }
-        let Some(next) = refine(&mut work.pairs, x, options.min_observability, tiny) else {
+        let Some(next) = refine(
+            &mut work.pairs[..work.kept],
+            x,
+            options.min_observability,
+            tiny,
+        ) else {
+            last = (f64::NAN, f64::NAN);
             break;
         };
         let step = (
@@ -347,35 +370,56 @@ pub fn match_scans(
             wrap_angle(next[2] - x[2]).abs(),
         );
         x = [next[0], next[1], wrap_angle(next[2])];
-        let g = options.gate_sigmas * spread.residual_m;
+        let g = options.gate_sigmas * spread;
         gate = if g.is_finite() {
             g.clamp(options.min_correspondence_m, options.max_correspondence_m)
         } else {
             options.max_correspondence_m
         };
         last = step;
-        if step.0 < options.convergence_m && step.1 < options.convergence_rad {
+        let close = |y: &[f64; 3]| {
+            (x[0] - y[0]).hypot(x[1] - y[1]) < options.convergence_m
+                && wrap_angle(x[2] - y[2]).abs() < options.convergence_rad
+        };
+        // A motion met before is a cycle between correspondence sets (the trim and the gate
+        // flip a few points back and forth); any motion on it is as good as the others.
+        if step.0 < options.convergence_m && step.1 < options.convergence_rad
+            || visited.iter().any(close)
+        {
             return work.finish(x, gate, iteration);
         }
+        visited.push(x);
     }
     Err(MatchFailure::NotConverged {
-        iterations: options.max_iterations,
+        iterations: ran,
         step_m: last.0,
         step_rad: last.1,
     })
 }
 
-/// Robust spreads of one association's gated residuals (before the trim).
-#[derive(Debug, Clone, Copy)]
-struct Spread {
-    /// 1.4826 × the median absolute residual, metres.
-    residual_m: f64,
-    /// The same of the residuals each divided by `√(1 + v)` (see [`ScanMatch::point_noise_m`]).
-    point_m: f64,
-}
-
 /// Median absolute deviation to a Gaussian's standard deviation: 1 / Φ⁻¹(3/4).
 const MAD_TO_SIGMA: f64 = 1.4826;
+
+/// [`crate::stats::median`]'s value (the mean of the two middle values for an even count) in
+/// linear time, `v` reordered: it runs every iteration, where sorting took a tenth of the time.
+fn median(v: &mut [f64]) -> f64 {
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let (below, upper, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    let upper = *upper;
+    if n % 2 == 1 {
+        upper
+    } else {
+        let lower = below
+            .iter()
+            .copied()
+            .max_by(f64::total_cmp)
+            .unwrap_or(upper);
+        (lower + upper) / 2.0
+    }
+}
 
 /// One match's scans, settings and buffers.
 struct Work<'a> {
@@ -383,12 +427,15 @@ struct Work<'a> {
     current: &'a [[f64; 2]],
     options: &'a MatchOptions,
     pairs: Vec<Pair>,
+    /// How many of `pairs` (the first) survive the trim.
+    kept: usize,
     scratch: Vec<f64>,
 }
 
 impl Work<'_> {
-    /// Matches the current points moved by `x` to the reference within `gate`, then trims.
-    fn associate(&mut self, x: [f64; 3], gate: f64) -> Spread {
+    /// Matches the current points moved by `x` to the reference within `gate`, then trims;
+    /// returns the gated residuals' robust spread (1.4826 × their median absolute value).
+    fn associate(&mut self, x: [f64; 3], gate: f64) -> f64 {
         self.pairs.clear();
         let (sin, cos) = x[2].sin_cos();
         for p in self.current {
@@ -410,25 +457,15 @@ impl Work<'_> {
         self.scratch.clear();
         self.scratch
             .extend(self.pairs.iter().map(|p| p.residual.abs()));
-        let residual_m = MAD_TO_SIGMA * median(&mut self.scratch);
-        self.scratch.clear();
-        self.scratch.extend(
-            self.pairs
-                .iter()
-                .map(|p| p.residual.abs() / (1.0 + p.variance_factor).sqrt()),
-        );
-        let point_m = MAD_TO_SIGMA * median(&mut self.scratch);
+        let spread = MAD_TO_SIGMA * median(&mut self.scratch);
         let n = self.pairs.len();
         let keep = ((1.0 - self.options.trim_fraction) * n as f64).ceil() as usize;
         if keep < n {
             self.pairs
                 .select_nth_unstable_by(keep, |a, b| a.residual.abs().total_cmp(&b.residual.abs()));
-            self.pairs.truncate(keep);
         }
-        Spread {
-            residual_m,
-            point_m,
-        }
+        self.kept = keep.min(n);
+        spread
     }
 
     /// The result at the converged motion `x`: its correspondences, covariance and the check
@@ -439,8 +476,8 @@ impl Work<'_> {
         gate: f64,
         iterations: usize,
     ) -> Result<ScanMatch, MatchFailure> {
-        let spread = self.associate(x, gate);
-        let m = self.pairs.len();
+        self.associate(x, gate);
+        let m = self.kept;
         if m < self.options.min_points {
             return Err(MatchFailure::TooFewPoints {
                 reference: self.reference.points(),
@@ -450,7 +487,7 @@ impl Work<'_> {
                 needed: self.options.min_points,
             });
         }
-        let normal = Normal::at(&self.pairs, &x);
+        let normal = Normal::at(&self.pairs[..m], &x);
         let not_finite = MatchFailure::NotConverged {
             iterations,
             step_m: f64::NAN,
@@ -466,11 +503,18 @@ impl Work<'_> {
             return Err(degenerate);
         }
         let inverse = normal.inverse().ok_or(degenerate)?;
+        // One point's noise, from all the gated residuals (the trim would bias it low).
+        self.scratch.clear();
+        self.scratch.extend(
+            self.pairs
+                .iter()
+                .map(|p| p.residual.abs() / (1.0 + p.variance_factor).sqrt()),
+        );
+        let point_m = MAD_TO_SIGMA * median(&mut self.scratch);
         // The three fitted unknowns shrink the residuals by (m - 3) / m on average.
-        let sigma2 = spread.point_m * spread.point_m * m as f64 / (m - 3) as f64;
+        let sigma2 = point_m * point_m * m as f64 / (m - 3) as f64;
         let cov = inverse * (2.0 * sigma2);
-        let rms = (self
-            .pairs
+        let rms = (self.pairs[..m]
             .iter()
             .map(|p| p.residual * p.residual)
             .sum::<f64>()
@@ -486,7 +530,7 @@ impl Work<'_> {
             correspondences: m,
             rms_residual_m: rms,
             iterations,
-            point_noise_m: spread.point_m,
+            point_noise_m: point_m,
             observability: observability.smallest,
         };
         let finite = result.covariance.iter().flatten().all(|v| v.is_finite())
@@ -496,6 +540,23 @@ impl Work<'_> {
             Ok(result)
         } else {
             Err(not_finite)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_linear_median_equals_the_shared_one() {
+        for n in 0..40 {
+            let v: Vec<f64> = (0..n)
+                .map(|i| f64::from((i * 37 + 11) % 23) - 5.0)
+                .collect();
+            let (mut a, mut b) = (v.clone(), v);
+            let (fast, shared) = (median(&mut a), crate::stats::median(&mut b));
+            assert!(fast == shared || fast.is_nan() && shared.is_nan(), "n {n}");
         }
     }
 }

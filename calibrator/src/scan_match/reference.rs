@@ -7,8 +7,11 @@
 //! wedge between its ends' bearings, so a point `q` is at least `|q|·sin Δ` from it, `Δ` the
 //! angle from `q`'s bearing to the wedge (at least `|q|` once `Δ ≥ 90°`); that bound only grows
 //! along the walk, so the walk stops at the first segment whose bound exceeds the best distance.
+//! `|q|·sin Δ` is the cross product of `q` with the unit bearing, so the walk needs no
+//! trigonometry, and the bearings are ordered by a pseudo-angle rather than `atan2`: this runs
+//! for every point of every iteration.
 
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
+use std::f64::consts::FRAC_1_SQRT_2;
 
 /// Farthest a usable point may lie from the lidar, metres: no 2-D lidar reads beyond a
 /// kilometre, and the cap keeps every square and sum of squares finite.
@@ -16,10 +19,10 @@ const MAX_RANGE_M: f64 = 1_000.0;
 /// Nearest a usable point may lie, metres: a point at the lidar has no bearing (the XV-11's
 /// nearest reading is 0.06 m, its datasheet's minimum range).
 const MIN_RANGE_M: f64 = 1e-6;
-/// Widest angle a segment may span. The search's bound needs each segment inside the wedge
-/// between its ends' bearings, true for spans under a half turn; a gap this wide is missing
-/// readings, not a surface seen by a lidar.
-const MAX_SPAN_RAD: f64 = FRAC_PI_4;
+/// Cosine of the widest angle a segment may span, 45°. The search's bound needs each segment
+/// inside the wedge between its ends' bearings, true for spans under a quarter turn; a gap this
+/// wide is missing readings, not a surface seen by a lidar.
+const COS_MAX_SPAN: f64 = FRAC_1_SQRT_2;
 /// Shortest segment with a direction, metres: closer points are one point read twice.
 const MIN_SEGMENT_M: f64 = 1e-6;
 /// Most neighbours on each side of a segment that its line fit takes (bounds the work on a
@@ -28,8 +31,32 @@ const MAX_FIT_SIDE: usize = 8;
 
 /// Whether a point can be matched: finite, and neither at the lidar nor beyond any lidar's reach.
 pub(super) fn usable(p: &[f64; 2]) -> bool {
-    let r = p[0].hypot(p[1]);
-    p[0].is_finite() && p[1].is_finite() && (MIN_RANGE_M..=MAX_RANGE_M).contains(&r)
+    let r2 = p[0] * p[0] + p[1] * p[1];
+    p[0].is_finite()
+        && p[1].is_finite()
+        && (MIN_RANGE_M.powi(2)..=MAX_RANGE_M.powi(2)).contains(&r2)
+}
+
+/// A number in [0, 4) growing with `p`'s bearing counter-clockwise from +x, like the bearing
+/// in [0, 2π) but without `atan2` (the "diamond angle": the position on the unit L1 circle).
+/// NaN at the origin.
+fn pseudo_angle(p: [f64; 2]) -> f64 {
+    let t = p[1] / (p[0].abs() + p[1].abs());
+    match (p[0] >= 0.0, p[1] >= 0.0) {
+        (true, true) => t,
+        (false, _) => 2.0 - t,
+        (true, false) => 4.0 + t,
+    }
+}
+
+/// `a × b`, the z of the cross product.
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// `a · b`.
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
 }
 
 /// The line a segment's residuals are measured to: the total-least-squares line of the
@@ -116,8 +143,10 @@ struct Segment {
 /// A reference scan ready for nearest-segment searches.
 #[derive(Debug, Clone)]
 pub(super) struct Reference {
-    /// Bearings of the usable points, ascending, radians in [-π, π].
+    /// Pseudo-angles of the usable points' bearings, ascending.
     bearing: Vec<f64>,
+    /// The unit vectors along those bearings.
+    unit: Vec<[f64; 2]>,
     /// `segments[k]` joins points `k` and `(k + 1) % n`.
     segments: Vec<Segment>,
     /// Segments that are surfaces.
@@ -130,15 +159,22 @@ impl Reference {
         let mut sorted: Vec<(f64, [f64; 2])> = points
             .iter()
             .filter(|p| usable(p))
-            .map(|p| (p[1].atan2(p[0]), *p))
+            .map(|p| (pseudo_angle(*p), *p))
             .collect();
-        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        sorted.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         let n = sorted.len();
         let bearing: Vec<f64> = sorted.iter().map(|s| s.0).collect();
         let pts: Vec<[f64; 2]> = sorted.iter().map(|s| s.1).collect();
+        let range: Vec<f64> = pts.iter().map(|p| dot(*p, *p).sqrt()).collect();
+        let unit: Vec<[f64; 2]> = pts
+            .iter()
+            .zip(&range)
+            .map(|(p, r)| [p[0] / r, p[1] / r])
+            .collect();
         if n < 2 {
             return Self {
                 bearing,
+                unit,
                 segments: Vec::new(),
                 surfaces: 0,
             };
@@ -149,12 +185,15 @@ impl Reference {
         let surface: Vec<bool> = (0..n)
             .map(|k| {
                 let (a, b) = (pts[k], pts[next(k)]);
-                let span = (bearing[next(k)] - bearing[k]).rem_euclid(TAU);
-                let length = (b[0] - a[0]).hypot(b[1] - a[1]);
-                let range = a[0].hypot(a[1]).max(b[0].hypot(b[1]));
-                span <= MAX_SPAN_RAD
+                let (ua, ub) = (unit[k], unit[next(k)]);
+                // Counter-clockwise from a to b by at most the widest span.
+                let span_ok = cross(ua, ub) >= 0.0 && dot(ua, ub) >= COS_MAX_SPAN;
+                let d = [b[0] - a[0], b[1] - a[1]];
+                let length = dot(d, d).sqrt();
+                let reach = range[k].max(range[next(k)]);
+                span_ok
                     && length >= MIN_SEGMENT_M
-                    && length <= rules.jump_m + rules.jump_fraction * range
+                    && length <= rules.jump_m + rules.jump_fraction * reach
             })
             .collect();
         let radius = rules.fit_radius_m;
@@ -165,7 +204,10 @@ impl Reference {
                     return Segment { a, b, line: None };
                 }
                 let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-                let near = |i: usize| (pts[i][0] - mid[0]).hypot(pts[i][1] - mid[1]) <= radius;
+                let near = |i: usize| {
+                    let d = [pts[i][0] - mid[0], pts[i][1] - mid[1]];
+                    dot(d, d) <= radius * radius
+                };
                 // Neighbours on the same surface, outwards from each end; at most n points in
                 // all, so that a small closed scan takes no point twice.
                 let mut before = 0;
@@ -193,6 +235,7 @@ impl Reference {
         let surfaces = segments.iter().filter(|s| s.line.is_some()).count();
         Self {
             bearing,
+            unit,
             segments,
             surfaces,
         }
@@ -215,69 +258,75 @@ impl Reference {
         if n == 0 || self.surfaces == 0 {
             return None;
         }
-        let rho = q[0].hypot(q[1]);
-        let phi = q[1].atan2(q[0]);
-        let bound = |delta: f64| {
-            if delta < FRAC_PI_2 {
-                rho * delta.sin()
-            } else {
-                rho
-            }
-        };
-        let mut best: Option<(&Line, f64)> = None;
-        let mut best_d = gate;
-        let mut try_segment = |k: usize, best_d: &mut f64| {
+        let rho = dot(q, q).sqrt();
+        let mut best: Option<&Line> = None;
+        let mut best_d2 = gate * gate;
+        let mut try_segment = |k: usize, best_d2: &mut f64| {
             let s = &self.segments[k];
             if let Some(line) = &s.line {
-                let d = segment_distance(q, s.a, s.b);
-                if d < *best_d {
-                    *best_d = d;
-                    best = Some((line, d));
+                let d2 = segment_distance2(q, s.a, s.b);
+                if d2 < *best_d2 {
+                    *best_d2 = d2;
+                    best = Some(line);
                 }
+            }
+        };
+        // The lower bound on the distance to segments beyond bearing `u`, given `c`, `q`'s
+        // cross product with `u` taken in the walk's direction; `None` past a half turn.
+        let bound = |u: [f64; 2], c: f64| {
+            let d = dot(q, u);
+            if d > 0.0 {
+                // Within a quarter turn; a slightly negative c is rounding at the same bearing.
+                Some(c.abs())
+            } else if c >= 0.0 {
+                Some(rho)
+            } else {
+                None
             }
         };
         // The segment whose wedge holds q's bearing (the closing one when q is before the first
         // bearing or after the last).
+        let phi = pseudo_angle(q);
         let pos = self.bearing.partition_point(|&b| b <= phi);
         let k0 = (pos + n - 1) % n;
-        try_segment(k0, &mut best_d);
+        try_segment(k0, &mut best_d2);
         // Counter-clockwise: segment k starts at bearing k.
         let mut k = k0;
         for _ in 1..n {
             k = (k + 1) % n;
-            let delta = (self.bearing[k] - phi).rem_euclid(TAU);
-            if delta > PI || bound(delta) >= best_d {
-                break;
+            let u = self.unit[k];
+            match bound(u, cross(q, u)) {
+                Some(b) if b * b < best_d2 => try_segment(k, &mut best_d2),
+                _ => break,
             }
-            try_segment(k, &mut best_d);
         }
         // Clockwise: segment k ends at bearing k + 1.
         let mut k = k0;
         for _ in 1..n {
             k = (k + n - 1) % n;
-            let delta = (phi - self.bearing[(k + 1) % n]).rem_euclid(TAU);
-            if delta > PI || bound(delta) >= best_d {
-                break;
+            let u = self.unit[(k + 1) % n];
+            match bound(u, cross(u, q)) {
+                Some(b) if b * b < best_d2 => try_segment(k, &mut best_d2),
+                _ => break,
             }
-            try_segment(k, &mut best_d);
         }
-        best
+        best.map(|line| (line, best_d2.sqrt()))
     }
 }
 
-/// Distance from `q` to the segment from `a` to `b`.
-fn segment_distance(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
-    let (wx, wy) = (q[0] - a[0], q[1] - a[1]);
-    let len2 = ux * ux + uy * uy;
+/// Squared distance from `q` to the segment from `a` to `b`.
+fn segment_distance2(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let u = [b[0] - a[0], b[1] - a[1]];
+    let w = [q[0] - a[0], q[1] - a[1]];
+    let len2 = dot(u, u);
     let t = if len2 > 0.0 {
-        ((wx * ux + wy * uy) / len2).clamp(0.0, 1.0)
+        (dot(w, u) / len2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    (wx - t * ux).hypot(wy - t * uy)
+    let e = [w[0] - t * u[0], w[1] - t * u[1]];
+    dot(e, e)
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -288,11 +337,23 @@ mod tests {
         fit_radius_m: 0.0,
     };
 
+    #[test]
+    fn the_pseudo_angle_grows_with_the_bearing() {
+        let keys: Vec<f64> = (0..3600)
+            .map(|i| {
+                let a = f64::from(i) * std::f64::consts::TAU / 3600.0;
+                pseudo_angle([3.0 * a.cos(), 3.0 * a.sin()])
+            })
+            .collect();
+        assert!(keys.windows(2).all(|w| w[0] < w[1]), "not increasing");
+        assert!(keys[0] == 0.0 && keys[3599] < 4.0);
+    }
+
     /// A closed polyline of points around the lidar with random-looking ranges.
     fn cloud(n: usize) -> Vec<[f64; 2]> {
         (0..n)
             .map(|i| {
-                let a = i as f64 * TAU / n as f64;
+                let a = i as f64 * std::f64::consts::TAU / n as f64;
                 let r = 2.0 + 0.3 * (7.0 * a).sin() + 0.1 * (31.0 * a).cos();
                 [r * a.cos(), r * a.sin()]
             })
@@ -305,7 +366,7 @@ mod tests {
             .segments
             .iter()
             .filter(|s| s.line.is_some())
-            .map(|s| segment_distance(q, s.a, s.b))
+            .map(|s| segment_distance2(q, s.a, s.b).sqrt())
             .filter(|d| *d < gate)
             .min_by(f64::total_cmp)
     }

@@ -335,6 +335,10 @@ impl<'a> Path<'a> {
         let end = self.travel_at(to)?;
         let o = self.odometry;
         let inside = o.partition_point(|s| s.t_s <= from)..o.partition_point(|s| s.t_s < to);
+        // Rows out of time order make no interval (the reader refuses them; a caller's may not).
+        if inside.start > inside.end {
+            return None;
+        }
         let mut turns = Vec::with_capacity(inside.len() + 1);
         for s in &o[inside] {
             let here = (s.left_m, s.right_m);

@@ -23,6 +23,11 @@ const NOISE: [f64; 3] = [0.0008, 0.0005, 0.0018];
 /// A drive of `n` intervals of 0.8 s: straight runs and turns in place both ways, the wheels'
 /// speeds drawn around each kind's; the lidar's motion the truth's plus noise.
 fn drive(n: usize, seed: u64, turns: &[f64]) -> Vec<Tuple> {
+    drive_of(&TRUTH, n, seed, turns)
+}
+
+/// [`drive`] of another robot.
+fn drive_of(truth: &Geometry, n: usize, seed: u64, turns: &[f64]) -> Vec<Tuple> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let noise: Vec<Normal<f64>> = NOISE
         .iter()
@@ -35,8 +40,8 @@ fn drive(n: usize, seed: u64, turns: &[f64]) -> Vec<Tuple> {
             let left = forward - turn + rng.random_range(-0.02..0.02);
             let right = forward + turn + rng.random_range(-0.02..0.02);
             let duration_s = 0.8;
-            let robot = TRUTH.robot_motion(&[[left * duration_s, right * duration_s]]);
-            let s = TRUTH.lidar_motion(robot);
+            let robot = truth.robot_motion(&[[left * duration_s, right * duration_s]]);
+            let s = truth.lidar_motion(robot);
             Tuple {
                 duration_s,
                 left_rad_s: left,
@@ -95,6 +100,37 @@ fn the_stated_covariance_covers_the_error() {
     }
     for (i, n) in within.iter().enumerate() {
         assert!(*n >= 43, "parameter {i}: within 2 sd in {n} of {runs}");
+    }
+}
+
+/// The paper's other configurations: the lidar turned a quarter, and mounted off the robot's
+/// centre; and one turned half-way round, whose yaw wraps.
+#[test]
+fn a_lidar_turned_or_off_centre_is_found_where_it_is() {
+    for (k, lidar) in [
+        [0.0, 0.0, std::f64::consts::FRAC_PI_2],
+        [0.045, -0.03, 0.2],
+        [-0.02, 0.01, 3.1],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let truth = Geometry { lidar, ..TRUTH };
+        let cal = calibrate_tuples(&drive_of(&truth, 1200, 20 + k as u64, &BOTH_WAYS), 0).unwrap();
+        assert!(cal.failed_checks().next().is_none(), "{:?}", cal.checks);
+        let model = cal.odometry.unwrap();
+        let (v, sd) = (model.parameters(), model.standard_deviations());
+        let want = truth.to_array();
+        for i in 0..6 {
+            // 4 sd: three layouts × six parameters, none may fail by chance.
+            assert!(
+                hilsim_recording::wrap_angle(v[i] - want[i]).abs() <= 4.0 * sd[i],
+                "layout {k}, parameter {i}: {} against {} ± {}",
+                v[i],
+                want[i],
+                sd[i]
+            );
+        }
     }
 }
 

@@ -11,8 +11,12 @@
 //! it calibrates on one half of the drive and, on the other half, prints the RMS of the
 //! predicted minus the scan-matched lidar motion of each interval and the drift of the
 //! dead-reckoned lidar path from the scan-matched one, for both geometries; then the halves
-//! swapped. `--first-beam-left` reads the beams the other way round (the first at +120°), to
-//! show that the turns of the scan matcher then disagree with the wheels'.
+//! swapped, and how far the two halves' calibrations differ in their standard deviations.
+//!
+//! Options: `--scan-lag-s S` takes each scan's first beam S seconds before its line's timestamp
+//! (default 0; see below); `--interval-s S` sets the intervals' length (default the
+//! calibration's, 1 s); `--first-beam-left` reads the beams the other way round (the first at
+//! +120°), to show that the scan matcher's turns then disagree with the wheels'.
 //!
 //! The log's conventions, and where each comes from:
 //! - a line is one scan: timestamp (µs), a field, the left and right encoder counts, 20 more
@@ -29,7 +33,12 @@
 //! - readings under 20 mm are the sensor's error codes and 0 is no return (same section): both
 //!   invalid;
 //! - the beams are taken one step (100 ms / 1024, the URG-04LX's 600 rpm) apart in time, the
-//!   first at the line's timestamp, when the encoders were read with it.
+//!   first at the line's timestamp, when the encoders were read with it, unless `--scan-lag-s`
+//!   says the scan is older. The log does not say when its timestamp was taken; on `exp1.dat`
+//!   the wheels' and the scan matcher's motions agree best when the scans are about 0.19 s
+//!   older than the encoder counts on their line, about two scans: the turn's residual spread
+//!   that the calibration prints ("scan matcher's error") is 99 mrad at lag 0, 56 at 0.1 s,
+//!   21 at 0.19 s, 25 at 0.2 s and 68 at 0.3 s (intervals of 1 s).
 
 use std::f64::consts::TAU;
 use std::process::ExitCode;
@@ -38,6 +47,8 @@ use hilsim_calibrator::odometry::{
     calibrate, calibrate_intervals, drive_intervals, kinematics::residual, DriveIntervals,
     Geometry, Interval, RecordingOptions,
 };
+use hilsim_calibrator::scan_match::MatchFailure;
+use hilsim_calibrator::OdometryModel;
 use hilsim_recording::{LidarSample, Meta, Mount, OdometrySample, Pose, Recording, RobotMeta};
 
 /// Fields before the ranges: timestamp, one field, two encoder counts, 20 more.
@@ -51,7 +62,7 @@ const FRONT_STEP: f64 = 384.0;
 const STEPS_PER_TURN: f64 = 1024.0;
 /// A revolution takes 100 ms (same table's PP example: 600 rpm).
 const REVOLUTION_S: f64 = 0.1;
-/// Readings under 20 mm are error codes (section 5: tables 3; PP's DMIN 20).
+/// Readings under 20 mm are error codes (section 5, table 3; the PP example's DMIN 20).
 const MIN_RANGE_MM: i64 = 20;
 
 /// The rover's nominal geometry (its authors', as BreezySLAM's `mines.py` gives it): wheel
@@ -78,17 +89,26 @@ struct Scan {
     ranges_mm: Vec<i64>,
 }
 
+/// What the command line asks.
+struct Args {
+    path: String,
+    scan_lag_s: f64,
+    options: RecordingOptions,
+    first_beam_left: bool,
+}
+
+const USAGE: &str =
+    "usage: odometry_on_coreslam EXP1.DAT [--scan-lag-s S] [--interval-s S] [--first-beam-left]";
+
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let (path, first_beam_left) = match args.as_slice() {
-        [path] => (path, false),
-        [path, flag] if flag == "--first-beam-left" => (path, true),
-        _ => {
-            eprintln!("usage: odometry_on_coreslam EXP1.DAT [--first-beam-left]");
+    let args = match parse_args(std::env::args().skip(1)) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("odometry_on_coreslam: {e}\n{USAGE}");
             return ExitCode::from(2);
         }
     };
-    match run(path, first_beam_left) {
+    match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("odometry_on_coreslam: {e}");
@@ -97,32 +117,69 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(path: &str, first_beam_left: bool) -> Result<(), String> {
+fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
+    let mut path = None;
+    let mut out = Args {
+        path: String::new(),
+        scan_lag_s: 0.0,
+        options: RecordingOptions::default(),
+        first_beam_left: false,
+    };
+    while let Some(arg) = args.next() {
+        let mut seconds = |name: &str| -> Result<f64, String> {
+            let v = args
+                .next()
+                .ok_or(format!("{name} needs a number of seconds"))?;
+            v.parse::<f64>()
+                .ok()
+                .filter(|s| s.is_finite() && *s >= 0.0)
+                .ok_or(format!(
+                    "{name}: `{v}` is not a number of seconds (0 or more)"
+                ))
+        };
+        match arg.as_str() {
+            "--scan-lag-s" => out.scan_lag_s = seconds("--scan-lag-s")?,
+            "--interval-s" => out.options.interval_s = seconds("--interval-s")?,
+            "--first-beam-left" => out.first_beam_left = true,
+            _ if path.is_none() && !arg.starts_with("--") => path = Some(arg),
+            _ => return Err(format!("unexpected argument `{arg}`")),
+        }
+    }
+    out.path = path.ok_or("no log given")?;
+    Ok(out)
+}
+
+fn run(args: &Args) -> Result<(), String> {
+    let path = &args.path;
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
     let scans = parse(&text, path)?;
-    let rec = recording(&scans, first_beam_left);
-    let options = RecordingOptions::default();
-    let calibration = calibrate(&rec, &options).map_err(|e| format!("{path}: {e}"))?;
+    let rec = recording(&scans, args.scan_lag_s, args.first_beam_left);
+    let calibration = calibrate(&rec, &args.options).map_err(|e| format!("{path}: {e}"))?;
     println!(
-        "{path}: {} scans over {:.1} s{}",
+        "{path}: {} scans over {:.1} s; scans {} s older than their line's encoder counts; \
+         intervals of {} s{}",
         scans.len(),
-        rec.duration_s(),
-        if first_beam_left {
-            ", the beams read clockwise (first at +120°)"
+        (scans[scans.len() - 1].t_us - scans[0].t_us) as f64 * 1e-6,
+        args.scan_lag_s,
+        args.options.interval_s,
+        if args.first_beam_left {
+            "; the beams read clockwise (first at +120°)"
         } else {
             ""
         }
     );
     print!("{}", calibration.describe());
 
-    let drive = drive_intervals(&rec, &options).map_err(|e| format!("{path}: {e}"))?;
+    let drive = drive_intervals(&rec, &args.options).map_err(|e| format!("{path}: {e}"))?;
     println!();
     print_conventions(&drive);
     let [first, second] = halves(&drive);
     println!();
-    held_out("first", &first, "second", &second, &drive.nominal)?;
+    let a = held_out("first", &first, "second", &second, &drive.nominal)?;
     println!();
-    held_out("second", &second, "first", &first, &drive.nominal)?;
+    let b = held_out("second", &second, "first", &first, &drive.nominal)?;
+    println!();
+    print_agreement(&a, &b);
     Ok(())
 }
 
@@ -171,12 +228,16 @@ fn parse(text: &str, origin: &str) -> Result<Vec<Scan>, String> {
                 ));
             }
             let dt_s = (t_us - last.t_us) as f64 * 1e-6;
+            // At least a revolution's time: two lines a few milliseconds apart may carry
+            // counts read a revolution apart.
+            let most = MAX_TURNS_PER_S * TICKS_PER_TURN * dt_s.max(REVOLUTION_S);
             for (k, wheel) in ["left", "right"].iter().enumerate() {
                 let step = ticks[k] - last.ticks[k];
-                if step.unsigned_abs() as f64 > MAX_TURNS_PER_S * TICKS_PER_TURN * dt_s.max(0.1) {
+                if step.unsigned_abs() as f64 > most {
                     return Err(format!(
                         "{at}: the {wheel} encoder count jumped by {step} ticks in {dt_s:.3} s, \
-                         more than a wheel turns: a wrapped or corrupt count"
+                         more than {MAX_TURNS_PER_S} wheel turns a second: a wrapped or corrupt \
+                         count"
                     ));
                 }
             }
@@ -195,7 +256,7 @@ fn parse(text: &str, origin: &str) -> Result<Vec<Scan>, String> {
 
 /// The recording of `scans`: the encoders' travel over the nominal radius, one revolution a
 /// scan with its beams a step apart in time.
-fn recording(scans: &[Scan], first_beam_left: bool) -> Recording {
+fn recording(scans: &[Scan], scan_lag_s: f64, first_beam_left: bool) -> Recording {
     let t0 = scans[0].t_us;
     let ticks0 = scans[0].ticks;
     let metres_per_tick = TAU * WHEEL_RADIUS_M / TICKS_PER_TURN;
@@ -231,7 +292,7 @@ fn recording(scans: &[Scan], first_beam_left: bool) -> Recording {
             };
             let invalid = mm < MIN_RANGE_MM;
             lidar.push(LidarSample {
-                t_s: t_s + i as f64 * step_s,
+                t_s: t_s - scan_lag_s + i as f64 * step_s,
                 rev: rev as u64,
                 angle_deg: angle.rem_euclid(360.0),
                 range_m: if invalid { 0.0 } else { mm as f64 * 1e-3 },
@@ -250,11 +311,22 @@ fn recording(scans: &[Scan], first_beam_left: bool) -> Recording {
 /// The drive's intervals, and whether the scan matcher and the wheels agree on the sign of
 /// each clear turn and each clear drive: the check of the conventions.
 fn print_conventions(drive: &DriveIntervals) {
+    let mut kinds = [0usize; 3];
+    for f in &drive.failed {
+        kinds[match f {
+            MatchFailure::NotConverged { .. } => 0,
+            MatchFailure::Degenerate { .. } => 1,
+            _ => 2,
+        }] += 1;
+    }
     println!(
-        "intervals: {} matched, {} failed to match, {} standing still, {} gaps, {} sparse \
-         ({} revolutions)",
+        "intervals: {} matched, {} failed to match ({} did not settle, {} geometry did not fix \
+         the motion, {} other), {} standing still, {} gaps, {} sparse ({} revolutions)",
         drive.intervals.len(),
         drive.failed.len(),
+        kinds[0],
+        kinds[1],
+        kinds[2],
         drive.still,
         drive.gaps,
         drive.sparse,
@@ -297,14 +369,15 @@ fn halves(drive: &DriveIntervals) -> [Vec<Interval>; 2] {
     out
 }
 
-/// Calibrates on `fit` and prints how the nominal and the calibrated geometry predict `test`.
+/// Calibrates on `fit` and prints how the nominal and the calibrated geometry predict `test`;
+/// the calibration of `fit`.
 fn held_out(
     fit_name: &str,
     fit: &[Interval],
     test_name: &str,
     test: &[Interval],
     nominal: &Geometry,
-) -> Result<(), String> {
+) -> Result<OdometryModel, String> {
     let calibration =
         calibrate_intervals(fit).map_err(|e| format!("calibrating on the {fit_name} half: {e}"))?;
     let Some(m) = calibration.odometry else {
@@ -337,22 +410,40 @@ fn held_out(
         },
         test.len()
     );
+    let sd = m.standard_deviations();
+    // The radii's ratio sets the dead-reckoned heading's drift per metre driven straight.
+    let ratio = m.right_wheel_radius_m / m.left_wheel_radius_m;
+    let ratio_sd = ratio
+        * (m.covariance[0][0] / m.left_wheel_radius_m.powi(2)
+            + m.covariance[1][1] / m.right_wheel_radius_m.powi(2)
+            - 2.0 * m.covariance[0][1] / (m.left_wheel_radius_m * m.right_wheel_radius_m))
+            .max(0.0)
+            .sqrt();
     println!(
-        "  calibrated: radii {:.2} / {:.2} mm, wheel base {:.1} mm, lidar ({:.1}, {:.1}) mm \
-         {:.1} mrad",
-        calibrated.left_radius_m * 1e3,
-        calibrated.right_radius_m * 1e3,
-        calibrated.wheel_base_m * 1e3,
-        calibrated.lidar[0] * 1e3,
-        calibrated.lidar[1] * 1e3,
-        calibrated.lidar[2] * 1e3
+        "  calibrated: radii {:.2} ± {:.2} / {:.2} ± {:.2} mm (right over left {ratio:.4} ± \
+         {ratio_sd:.4}), wheel base {:.1} ± {:.1} mm, lidar ({:.1} ± {:.1}, {:.1} ± {:.1}) mm \
+         {:.1} ± {:.1} mrad",
+        m.left_wheel_radius_m * 1e3,
+        sd[0] * 1e3,
+        m.right_wheel_radius_m * 1e3,
+        sd[1] * 1e3,
+        m.wheel_base_m * 1e3,
+        sd[2] * 1e3,
+        m.lidar_x_m * 1e3,
+        sd[3] * 1e3,
+        m.lidar_y_m * 1e3,
+        sd[4] * 1e3,
+        m.lidar_yaw_rad * 1e3,
+        sd[5] * 1e3
     );
     println!(
         "  {:<11} {:>13} {:>14} {:>14} {:>15}",
         "geometry", "RMS transl mm", "RMS rot mrad", "end drift m", "end drift deg"
     );
+    let mut least_rms_rotation = f64::INFINITY;
     for (name, g) in [("nominal", nominal), ("calibrated", &calibrated)] {
         let s = score(g, test);
+        least_rms_rotation = least_rms_rotation.min(s.rms_rotation_rad);
         println!(
             "  {name:<11} {:>13.1} {:>14.1} {:>14.3} {:>15.2}",
             s.rms_translation_m * 1e3,
@@ -361,7 +452,41 @@ fn held_out(
             s.end_drift_rad.to_degrees()
         );
     }
-    Ok(())
+    // Independent errors of the turns add up as a random walk: the heading drift that the
+    // intervals' scatter alone would leave, whatever the geometry.
+    println!(
+        "  (the intervals' scatter alone leaves the end heading about ±{:.1}° off: √{} × the \
+         smaller RMS rotation)",
+        (least_rms_rotation * (test.len() as f64).sqrt()).to_degrees(),
+        test.len()
+    );
+    Ok(m)
+}
+
+/// How far apart the two halves' calibrations are, each parameter in the standard deviations
+/// of the difference (the halves' covariances added: their intervals do not overlap).
+fn print_agreement(a: &OdometryModel, b: &OdometryModel) {
+    let (pa, pb) = (a.parameters(), b.parameters());
+    let parts: Vec<String> = [
+        "left radius",
+        "right radius",
+        "wheel base",
+        "lidar x",
+        "lidar y",
+        "lidar yaw",
+    ]
+    .iter()
+    .enumerate()
+    .map(|(i, name)| {
+        let sd = (a.covariance[i][i] + b.covariance[i][i]).max(0.0).sqrt();
+        format!("{name} {:+.1}", (pb[i] - pa[i]) / sd)
+    })
+    .collect();
+    println!(
+        "the halves' calibrations differ (second minus first, in standard deviations of the \
+         difference): {}",
+        parts.join(", ")
+    );
 }
 
 /// How a geometry predicts the scan-matched motion of intervals.

@@ -375,6 +375,43 @@ fn coefficients(c: &[f64], sd: &[f64]) -> String {
     format!("[{}]", parts.join(", "))
 }
 
+/// The wheels and the mount with their standard deviations, in millimetres and milliradians
+/// (the sizes a robot's owner measures them in).
+fn write_odometry(s: &mut String, o: &OdometryModel) -> std::fmt::Result {
+    let sd = o.standard_deviations();
+    writeln!(
+        s,
+        "  wheel radius   left {:.3} ± {:.3} mm   right {:.3} ± {:.3} mm",
+        o.left_wheel_radius_m * 1e3,
+        sd[0] * 1e3,
+        o.right_wheel_radius_m * 1e3,
+        sd[1] * 1e3
+    )?;
+    if let Some([left, right]) = o.wheel_scale {
+        writeln!(
+            s,
+            "  wheel scale    left {left:.5}   right {right:.5}   (real travel over recorded)"
+        )?;
+    }
+    writeln!(
+        s,
+        "  wheel base     {:.3} ± {:.3} mm",
+        o.wheel_base_m * 1e3,
+        sd[2] * 1e3
+    )?;
+    writeln!(
+        s,
+        "  lidar mount    x {:.2} ± {:.2} mm   y {:.2} ± {:.2} mm   yaw {:.2} ± {:.2} mrad ({:.3}°)",
+        o.lidar_x_m * 1e3,
+        sd[3] * 1e3,
+        o.lidar_y_m * 1e3,
+        sd[4] * 1e3,
+        o.lidar_yaw_rad * 1e3,
+        sd[5] * 1e3,
+        o.lidar_yaw_rad.to_degrees()
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -461,41 +498,4 @@ mod tests {
         let three = one.replace("[0.1]", "[0.1, 0.1, 0.1]");
         assert!(Calibration::from_json(&three, "cal.json").is_ok());
     }
-}
-
-/// The wheels and the mount with their standard deviations, in millimetres and milliradians
-/// (the sizes a robot's owner measures them in).
-fn write_odometry(s: &mut String, o: &OdometryModel) -> std::fmt::Result {
-    let sd = o.standard_deviations();
-    writeln!(
-        s,
-        "  wheel radius   left {:.3} ± {:.3} mm   right {:.3} ± {:.3} mm",
-        o.left_wheel_radius_m * 1e3,
-        sd[0] * 1e3,
-        o.right_wheel_radius_m * 1e3,
-        sd[1] * 1e3
-    )?;
-    if let Some([left, right]) = o.wheel_scale {
-        writeln!(
-            s,
-            "  wheel scale    left {left:.5}   right {right:.5}   (real travel over recorded)"
-        )?;
-    }
-    writeln!(
-        s,
-        "  wheel base     {:.3} ± {:.3} mm",
-        o.wheel_base_m * 1e3,
-        sd[2] * 1e3
-    )?;
-    writeln!(
-        s,
-        "  lidar mount    x {:.2} ± {:.2} mm   y {:.2} ± {:.2} mm   yaw {:.2} ± {:.2} mrad ({:.3}°)",
-        o.lidar_x_m * 1e3,
-        sd[3] * 1e3,
-        o.lidar_y_m * 1e3,
-        sd[4] * 1e3,
-        o.lidar_yaw_rad * 1e3,
-        sd[5] * 1e3,
-        o.lidar_yaw_rad.to_degrees()
-    )
 }

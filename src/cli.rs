@@ -185,6 +185,10 @@ pub struct CalibrateArgs {
     /// Odometry: the length of an interval between matched scans, seconds (default 1).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub interval_s: Option<f64>,
+    /// Odometry: how late the lidar's stamps are against the encoders', seconds (default:
+    /// estimated from the drive).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub lidar_latency_s: Option<f64>,
 }
 
 /// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.

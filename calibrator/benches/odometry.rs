@@ -21,7 +21,10 @@ use hilsim_recording::Recording;
 const GOAL_S: f64 = 10.0;
 
 fn drive() -> Recording {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/odometry-drive.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/odometry-drive.toml"
+    );
     let scenario = hilsim_sim::Scenario::load(path.as_ref()).expect("odometry-drive.toml loads");
     hilsim_lidar_emulator::Emulation::new(&scenario, scenario.seed)
         .expect("sensors build")

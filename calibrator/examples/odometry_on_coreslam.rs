@@ -13,8 +13,9 @@
 //! dead-reckoned lidar path from the scan-matched one, for both geometries; then the halves
 //! swapped, and how far the two halves' calibrations differ in their standard deviations.
 //!
-//! Options: `--scan-lag-s S` takes each scan's first beam S seconds before its line's timestamp
-//! (default 0; see below); `--interval-s S` sets the intervals' length (default the
+//! Options: `--lidar-latency-s S` takes the scans to be S seconds older than their line's
+//! encoder counts (default: the calibration estimates it; see below); `--interval-s S` sets the
+//! intervals' length (default the
 //! calibration's, 1 s); `--first-beam-left` reads the beams the other way round (the first at
 //! +120°), to show that the scan matcher's turns then disagree with the wheels'.
 //!
@@ -33,12 +34,11 @@
 //! - readings under 20 mm are the sensor's error codes and 0 is no return (same section): both
 //!   invalid;
 //! - the beams are taken one step (100 ms / 1024, the URG-04LX's 600 rpm) apart in time, the
-//!   first at the line's timestamp, when the encoders were read with it, unless `--scan-lag-s`
-//!   says the scan is older. The log does not say when its timestamp was taken; on `exp1.dat`
-//!   the wheels' and the scan matcher's motions agree best when the scans are about 0.19 s
-//!   older than the encoder counts on their line, about two scans: the turn's residual spread
-//!   that the calibration prints ("scan matcher's error") is 99 mrad at lag 0, 56 at 0.1 s,
-//!   21 at 0.19 s, 25 at 0.2 s and 68 at 0.3 s (intervals of 1 s).
+//!   first at the line's timestamp. The log does not say when its timestamp was taken relative
+//!   to the encoder counts on the line; the calibration estimates the lidar's latency against
+//!   the encoders from the turns, and on `exp1.dat` finds the scans about 0.19 s older than the
+//!   counts on their line, about two scans (with the latency held at 0 the turn's residual
+//!   spread, the "scan matcher's error" it prints, is 99 mrad instead of 22).
 
 use std::f64::consts::TAU;
 use std::process::ExitCode;
@@ -92,13 +92,12 @@ struct Scan {
 /// What the command line asks.
 struct Args {
     path: String,
-    scan_lag_s: f64,
     options: RecordingOptions,
     first_beam_left: bool,
 }
 
 const USAGE: &str =
-    "usage: odometry_on_coreslam EXP1.DAT [--scan-lag-s S] [--interval-s S] [--first-beam-left]";
+    "usage: odometry_on_coreslam EXP1.DAT [--lidar-latency-s S] [--interval-s S] [--first-beam-left]";
 
 fn main() -> ExitCode {
     let args = match parse_args(std::env::args().skip(1)) {
@@ -121,7 +120,6 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
     let mut path = None;
     let mut out = Args {
         path: String::new(),
-        scan_lag_s: 0.0,
         options: RecordingOptions::default(),
         first_beam_left: false,
     };
@@ -138,7 +136,9 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
                 ))
         };
         match arg.as_str() {
-            "--scan-lag-s" => out.scan_lag_s = seconds("--scan-lag-s")?,
+            "--lidar-latency-s" => {
+                out.options.lidar_latency_s = Some(seconds("--lidar-latency-s")?);
+            }
             "--interval-s" => out.options.interval_s = seconds("--interval-s")?,
             "--first-beam-left" => out.first_beam_left = true,
             _ if path.is_none() && !arg.starts_with("--") => path = Some(arg),
@@ -153,14 +153,12 @@ fn run(args: &Args) -> Result<(), String> {
     let path = &args.path;
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
     let scans = parse(&text, path)?;
-    let rec = recording(&scans, args.scan_lag_s, args.first_beam_left);
+    let rec = recording(&scans, args.first_beam_left);
     let calibration = calibrate(&rec, &args.options).map_err(|e| format!("{path}: {e}"))?;
     println!(
-        "{path}: {} scans over {:.1} s; scans {} s older than their line's encoder counts; \
-         intervals of {} s{}",
+        "{path}: {} scans over {:.1} s; intervals of {} s{}",
         scans.len(),
         (scans[scans.len() - 1].t_us - scans[0].t_us) as f64 * 1e-6,
-        args.scan_lag_s,
         args.options.interval_s,
         if args.first_beam_left {
             "; the beams read clockwise (first at +120°)"
@@ -173,6 +171,33 @@ fn run(args: &Args) -> Result<(), String> {
     let drive = drive_intervals(&rec, &args.options).map_err(|e| format!("{path}: {e}"))?;
     println!();
     print_conventions(&drive);
+    if let Some(m) = &calibration.odometry {
+        let calibrated = Geometry {
+            left_radius_m: m.left_wheel_radius_m,
+            right_radius_m: m.right_wheel_radius_m,
+            wheel_base_m: m.wheel_base_m,
+            lidar: [m.lidar_x_m, m.lidar_y_m, m.lidar_yaw_rad],
+        };
+        println!();
+        println!(
+            "the whole drive ({} intervals), calibrated on itself:",
+            drive.intervals.len()
+        );
+        println!(
+            "  {:<11} {:>13} {:>14} {:>14} {:>15}",
+            "geometry", "RMS transl mm", "RMS rot mrad", "end drift m", "end drift deg"
+        );
+        for (name, g) in [("nominal", &drive.nominal), ("calibrated", &calibrated)] {
+            let s = score(g, &drive.intervals);
+            println!(
+                "  {name:<11} {:>13.1} {:>14.1} {:>14.3} {:>15.2}",
+                s.rms_translation_m * 1e3,
+                s.rms_rotation_rad * 1e3,
+                s.end_drift_m,
+                s.end_drift_rad.to_degrees()
+            );
+        }
+    }
     let [first, second] = halves(&drive);
     println!();
     let a = held_out("first", &first, "second", &second, &drive.nominal)?;
@@ -256,7 +281,7 @@ fn parse(text: &str, origin: &str) -> Result<Vec<Scan>, String> {
 
 /// The recording of `scans`: the encoders' travel over the nominal radius, one revolution a
 /// scan with its beams a step apart in time.
-fn recording(scans: &[Scan], scan_lag_s: f64, first_beam_left: bool) -> Recording {
+fn recording(scans: &[Scan], first_beam_left: bool) -> Recording {
     let t0 = scans[0].t_us;
     let ticks0 = scans[0].ticks;
     let metres_per_tick = TAU * WHEEL_RADIUS_M / TICKS_PER_TURN;
@@ -292,7 +317,7 @@ fn recording(scans: &[Scan], scan_lag_s: f64, first_beam_left: bool) -> Recordin
             };
             let invalid = mm < MIN_RANGE_MM;
             lidar.push(LidarSample {
-                t_s: t_s - scan_lag_s + i as f64 * step_s,
+                t_s: t_s + i as f64 * step_s,
                 rev: rev as u64,
                 angle_deg: angle.rem_euclid(360.0),
                 range_m: if invalid { 0.0 } else { mm as f64 * 1e-3 },

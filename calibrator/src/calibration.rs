@@ -62,6 +62,13 @@ pub struct OdometryModel {
     /// Absent for tuples, whose wheel speeds are angular already.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wheel_scale: Option<[f64; 2]>,
+    /// How late the lidar's stamps are against the encoders', seconds, as the intervals were cut
+    /// with (estimated unless given). Absent for tuples.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lidar_latency_s: Option<f64>,
+    /// The estimated latency's standard deviation, seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lidar_latency_sd_s: Option<f64>,
 }
 
 impl OdometryModel {

@@ -393,6 +393,16 @@ fn write_odometry(s: &mut String, o: &OdometryModel) -> std::fmt::Result {
             "  wheel scale    left {left:.5}   right {right:.5}   (real travel over recorded)"
         )?;
     }
+    if let Some(latency) = o.lidar_latency_s {
+        let sd = o
+            .lidar_latency_sd_s
+            .map_or(String::new(), |sd| format!(" ± {:.1}", sd * 1e3));
+        writeln!(
+            s,
+            "  lidar latency  {:+.1}{sd} ms   (its stamps against the encoders')",
+            latency * 1e3
+        )?;
+    }
     writeln!(
         s,
         "  wheel base     {:.3} ± {:.3} mm",

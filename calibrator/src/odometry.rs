@@ -17,7 +17,8 @@ pub mod tuples;
 
 pub use estimate::{calibrate_intervals, calibrate_tuples};
 pub use from_recording::{
-    calibrate, drive_intervals, DriveIntervals, RecordingOptions, MAX_INTERVAL_S, MIN_SCAN_POINTS,
+    calibrate, drive_intervals, DriveIntervals, LatencyEstimate, RecordingOptions, MAX_INTERVAL_S,
+    MAX_LIDAR_LATENCY_S, MIN_SCAN_POINTS,
 };
 pub use interval::Interval;
 pub use kinematics::Geometry;

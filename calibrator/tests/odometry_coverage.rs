@@ -136,3 +136,50 @@ fn each_parameter_lands_within_two_sigma_of_the_truth_in_most_drives() {
         worst * 100.0
     );
 }
+
+/// A lidar whose stamps are 120 ms late against the encoders (`[effects.sensor_latency]`): the
+/// latency is found, and with it the wheels; held at 0 instead, the wheels come out imprecise.
+#[test]
+fn a_lidar_stamped_late_is_found_late_and_the_wheels_still_right() {
+    let mut scenario = Scenario::load(DRIVE.as_ref()).expect("odometry-drive.toml loads");
+    scenario.effects.sensor_latency = Some(hilsim_sim::scenario::SensorLatency {
+        lidar_s: 0.12,
+        ..Default::default()
+    });
+    scenario.effects.odometer_wheel_radius = Some(OdometerWheelRadius {
+        left_scale: 1.02,
+        right_scale: 0.985,
+    });
+    let rec = hilsim_lidar_emulator::Emulation::new(&scenario, 3)
+        .expect("sensors build")
+        .run()
+        .recording;
+    let cal = calibrate(&rec, &RecordingOptions::default()).expect("calibrates");
+    let model = cal.odometry.expect("an odometry model");
+    let latency = model.lidar_latency_s.expect("a latency");
+    let sd = model.lidar_latency_sd_s.expect("its sd");
+    // 3 sd and 15 ms: the profile's curvature is a local figure, and a tenth of a revolution
+    // of the XV-11 is 20 ms.
+    assert!(
+        (latency - 0.12).abs() <= (3.0 * sd).max(0.015),
+        "latency {latency} ± {sd}"
+    );
+    let scale = model.wheel_scale.expect("scales");
+    let scale_sd = model.standard_deviations()[0] / 0.033;
+    assert!(
+        (scale[0] - 1.02).abs() <= 3.0 * scale_sd,
+        "{scale:?} ± {scale_sd}"
+    );
+    assert!(cal.failed_checks().next().is_none(), "{:?}", cal.checks);
+    // Held at 0, the turns and the wheels disagree: the estimate is far less precise.
+    let held = calibrate(
+        &rec,
+        &RecordingOptions {
+            lidar_latency_s: Some(0.0),
+            ..RecordingOptions::default()
+        },
+    )
+    .expect("calibrates");
+    let held_sd = held.odometry.expect("a model").standard_deviations()[0];
+    assert!(held_sd > 2.0 * model.standard_deviations()[0], "{held_sd}");
+}

@@ -48,10 +48,8 @@ pub fn with_odometry(scenario: &Scenario, model: &OdometryModel) -> Result<Scena
     };
     let declared = lidar.mount;
     s.effects.lidar_mount_offset = Some(LidarMountOffset {
-        yaw_deg: hilsim_recording::wrap_angle(
-            model.lidar_yaw_rad - declared.yaw_deg.to_radians(),
-        )
-        .to_degrees(),
+        yaw_deg: hilsim_recording::wrap_angle(model.lidar_yaw_rad - declared.yaw_deg.to_radians())
+            .to_degrees(),
         x_m: model.lidar_x_m - declared.x_m,
         y_m: model.lidar_y_m - declared.y_m,
     });

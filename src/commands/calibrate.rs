@@ -45,11 +45,23 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     {
         bail!("--interval-s: expected seconds, more than 0 and at most {max_interval}");
     }
+    let max_latency = odometry::MAX_LIDAR_LATENCY_S;
+    if args
+        .lidar_latency_s
+        .is_some_and(|s| !(s.is_finite() && s.abs() <= max_latency))
+    {
+        bail!("--lidar-latency-s: expected seconds from -{max_latency} to {max_latency}");
+    }
     // Each method's own options: given to another, they would be silently ignored.
-    if (args.wheel_radius_m.is_some() || args.interval_s.is_some())
+    if (args.wheel_radius_m.is_some()
+        || args.interval_s.is_some()
+        || args.lidar_latency_s.is_some())
         && (args.method != Method::Odometry || args.tuples.is_some())
     {
-        bail!("--wheel-radius-m and --interval-s are for --method odometry on a recording");
+        bail!(
+            "--wheel-radius-m, --interval-s and --lidar-latency-s are for --method odometry on \
+             a recording"
+        );
     }
     if !args.priors.is_empty() && args.method != Method::Em {
         bail!("--prior: priors are for --method em");
@@ -79,6 +91,7 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
             interval_s: args
                 .interval_s
                 .unwrap_or(odometry::RecordingOptions::default().interval_s),
+            lidar_latency_s: args.lidar_latency_s,
         },
     };
     let method = args.method;

@@ -86,17 +86,14 @@ fn calibrated_ranges(
     // The recording is checked (as a whole read would, its errors first) on the way.
     let mut farthest = Farthest(1.0);
     recording.check(&mut farthest)?;
-    let model = calibration
-        .sensors
-        .get(&Sensor::Lidar)
-        .with_context(|| {
-            format!(
-                "{}: no lidar model (the {} method's calibration; the calibrated scans need em's, \
+    let model = calibration.sensors.get(&Sensor::Lidar).with_context(|| {
+        format!(
+            "{}: no lidar model (the {} method's calibration; the calibrated scans need em's, \
                  landmarks' or groundtruth's)",
-                path.display(),
-                calibration.method.name()
-            )
-        })?;
+            path.display(),
+            calibration.method.name()
+        )
+    })?;
     // Search up to past the farthest reading: a lidar model is fitted below 100 m.
     Inverse::new(&model.alpha, [0.0, 2.0 * farthest.0 + 100.0])
         .with_context(|| format!("{}: the lidar model", path.display()))

@@ -51,6 +51,8 @@ pub fn calibrate_intervals(tuples: &[Interval]) -> Result<Calibration, Calibrati
         lidar_yaw_rad: g.lidar[2],
         covariance: fit.covariance,
         wheel_scale: None,
+        lidar_latency_s: None,
+        lidar_latency_sd_s: None,
     };
     let used = fit.inlier.iter().filter(|&&i| i).count();
     let notes = vec![

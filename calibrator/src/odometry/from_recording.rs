@@ -22,6 +22,9 @@ pub struct RecordingOptions {
     /// The wheels' nominal radius, metres, when `meta.toml` does not give it (or to override
     /// it): the radius the encoders' turns were multiplied by to report travel.
     pub nominal_wheel_radius_m: Option<f64>,
+    /// How late the lidar's stamps are against the encoders', seconds (a scan stamped `t` was
+    /// taken when the encoders' clock read `t − latency`); `None`: estimated from the drive.
+    pub lidar_latency_s: Option<f64>,
 }
 
 impl Default for RecordingOptions {
@@ -29,6 +32,7 @@ impl Default for RecordingOptions {
         Self {
             interval_s: 1.0,
             nominal_wheel_radius_m: None,
+            lidar_latency_s: None,
         }
     }
 }
@@ -44,6 +48,19 @@ pub const MAX_INTERVAL_S: f64 = 2.0;
 /// An interval is standing still when each wheel moved less than this: 0.5 mm (half the
 /// XV-11 robot encoders' millimetre). Its scan match measures only the matcher's noise.
 const STILL_M: f64 = 0.0005;
+
+/// Largest lidar latency searched for, seconds: 1. A driver's buffering or a host's clock puts
+/// a log's stamps hundreds of milliseconds apart (the CoreSLAM rover's scans lag its encoders by
+/// about 0.19 s); beyond a second, intervals of a second no longer overlap their own wheel
+/// motion.
+pub const MAX_LIDAR_LATENCY_S: f64 = 1.0;
+
+/// The latency search's grid step, seconds: 10 ms, a tenth of a fast lidar's revolution.
+const LATENCY_STEP_S: f64 = 0.01;
+
+/// An estimated latency this far from the one the scans were first matched with has them
+/// matched again from guesses at the right instants: 10 ms.
+const REMATCH_LATENCY_S: f64 = 0.01;
 
 /// Largest share of intervals whose scans could not be matched: 20 %. More means the room
 /// does not fix the lidar's motion (a corridor, open space) for much of the drive, and the
@@ -70,8 +87,28 @@ pub struct DriveIntervals {
     pub gaps: usize,
     /// Intervals with a revolution of fewer than [`MIN_SCAN_POINTS`] readings.
     pub sparse: usize,
+    /// How late the lidar's stamps are taken to be against the encoders', seconds: the
+    /// options', else the estimate's, else 0.
+    pub lidar_latency_s: f64,
+    /// The latency estimated from the drive, when it was not given.
+    pub latency_estimate: Option<LatencyEstimate>,
     /// What was assumed, for people.
     pub notes: Vec<String>,
+}
+
+/// The lidar's latency against the encoders, estimated from the drive: the one at which the
+/// scan-matched turns and the wheels' turns over each interval agree best (the paper's first
+/// step, the turn gains by least squares, at each candidate latency), within
+/// ±[`MAX_LIDAR_LATENCY_S`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LatencyEstimate {
+    /// Seconds.
+    pub latency_s: f64,
+    /// Its standard deviation from the curvature of the turns' profile likelihood, seconds
+    /// (`None` when the profile is flat there).
+    pub sd_s: Option<f64>,
+    /// Whether the best latency is at the edge of the search: the true one may lie beyond it.
+    pub at_bound: bool,
 }
 
 /// `rec`'s drive as intervals: each one's lidar motion from scan-to-scan matching
@@ -134,7 +171,14 @@ pub fn drive_intervals(
         lidar: [mount.x_m, mount.y_m, mount.yaw_rad()],
     };
     let path = Path::new(odometry, nominal.wheel_base_m);
-    let scans = revolutions(lidar, &path, &nominal);
+    let given = options.lidar_latency_s;
+    if given.is_some_and(|l| !(l.is_finite() && l.abs() <= MAX_LIDAR_LATENCY_S)) {
+        return Err(CalibrationError::Invalid(format!(
+            "odometry: the lidar's latency must be within ±{MAX_LIDAR_LATENCY_S} s"
+        )));
+    }
+    let mut latency = given.unwrap_or(0.0);
+    let mut scans = revolutions(lidar, &path, &nominal, latency);
     // A chain of intervals: each interval's last revolution is the next one's first, so no
     // two intervals share a stretch of the drive (their errors would be counted twice).
     let mut pairs: Vec<(usize, usize)> = Vec::new();
@@ -148,10 +192,32 @@ pub fn drive_intervals(
         a = b;
     }
     let matching = MatchOptions::default();
-    let outcomes: Vec<Outcome> = pairs
-        .par_iter()
-        .map(|&(a, b)| interval(&scans[a], &scans[b], &path, &nominal, &matching))
-        .collect();
+    let match_all = |scans: &[Revolution], latency: f64| -> Vec<Outcome> {
+        pairs
+            .par_iter()
+            .map(|&(a, b)| interval(&scans[a], &scans[b], &path, &nominal, &matching, latency))
+            .collect()
+    };
+    let mut outcomes = match_all(&scans, latency);
+    let mut latency_estimate = None;
+    if given.is_none() {
+        let turns: Vec<([f64; 2], f64)> = outcomes
+            .iter()
+            .zip(&pairs)
+            .filter_map(|(o, &(a, b))| match o {
+                Outcome::Matched(i) => Some(([scans[a].t_s, scans[b].t_s], i.lidar_motion[2])),
+                _ => None,
+            })
+            .collect();
+        latency_estimate = estimate_latency(&turns, &path, &nominal);
+        if let Some(e) = latency_estimate {
+            if (e.latency_s - latency).abs() > REMATCH_LATENCY_S {
+                latency = e.latency_s;
+                scans = revolutions(lidar, &path, &nominal, latency);
+                outcomes = match_all(&scans, latency);
+            }
+        }
+    }
     let mut drive = DriveIntervals {
         intervals: Vec::new(),
         spans_s: Vec::new(),
@@ -161,6 +227,8 @@ pub fn drive_intervals(
         still: 0,
         gaps: 0,
         sparse: 0,
+        lidar_latency_s: latency,
+        latency_estimate,
         notes,
     };
     for (outcome, (a, b)) in outcomes.into_iter().zip(pairs) {
@@ -198,6 +266,8 @@ pub fn calibrate(
         still,
         gaps,
         sparse,
+        lidar_latency_s,
+        latency_estimate,
         mut notes,
         ..
     } = drive;
@@ -218,6 +288,38 @@ pub fn calibrate(
             model.left_wheel_radius_m / nominal_radius,
             model.right_wheel_radius_m / nominal_radius,
         ]);
+        model.lidar_latency_s = Some(lidar_latency_s);
+        model.lidar_latency_sd_s = latency_estimate.and_then(|e| e.sd_s);
+    }
+    match latency_estimate {
+        Some(e) => {
+            calibration.checks.push(Check::at_most(
+                "odometry.lidar_latency_s",
+                e.latency_s.abs(),
+                MAX_LIDAR_LATENCY_S - LATENCY_STEP_S,
+                format!(
+                    "the lidar's stamps are {:+.3} s{} against the encoders' (estimated from the \
+                     turns); at the edge of the ±{MAX_LIDAR_LATENCY_S} s search the true offset \
+                     may lie beyond it: fix the stamps, or give it (--lidar-latency-s)",
+                    e.latency_s,
+                    e.sd_s.map_or(String::new(), |sd| format!(" ± {sd:.3}"))
+                ),
+            ));
+            notes.push(format!(
+                "the lidar's stamps taken as {:+.3} s late against the encoders' (estimated{}); \
+                 each interval's wheel turns are the encoders' over its scans' instants",
+                lidar_latency_s,
+                e.sd_s.map_or(String::new(), |sd| format!(", sd {sd:.3} s"))
+            ));
+        }
+        None if options.lidar_latency_s.is_some() => notes.push(format!(
+            "the lidar's stamps taken as {lidar_latency_s:+.3} s late against the encoders' (given)"
+        )),
+        None => notes.push(
+            "the lidar's latency against the encoders could not be estimated (too few turning \
+             intervals): taken as 0"
+                .into(),
+        ),
     }
     let share = failed.len() as f64 / attempted.max(1) as f64;
     let mut kinds: Vec<(String, usize)> = Vec::new();
@@ -373,7 +475,12 @@ fn lidar_motion(path: &Path, nominal: &Geometry, from: f64, to: f64) -> Option<[
 
 /// The recording's revolutions, each de-skewed to its middle instant along the dead-reckoned
 /// path: a revolution of the XV-11 takes 0.2 s, over which a robot at 0.3 m/s moves 6 cm.
-fn revolutions(lidar: &[LidarSample], path: &Path, nominal: &Geometry) -> Vec<Revolution> {
+fn revolutions(
+    lidar: &[LidarSample],
+    path: &Path,
+    nominal: &Geometry,
+    latency_s: f64,
+) -> Vec<Revolution> {
     let mut out = Vec::new();
     let mut start = 0;
     while start < lidar.len() {
@@ -398,7 +505,7 @@ fn revolutions(lidar: &[LidarSample], path: &Path, nominal: &Geometry) -> Vec<Re
                 if !skewed {
                     return p;
                 }
-                match lidar_motion(path, nominal, t_s, s.t_s) {
+                match lidar_motion(path, nominal, t_s - latency_s, s.t_s - latency_s) {
                     Some([x, y, yaw]) => Pose::new(x, y, yaw).transform(p),
                     None => p,
                 }
@@ -412,19 +519,21 @@ fn revolutions(lidar: &[LidarSample], path: &Path, nominal: &Geometry) -> Vec<Re
     out
 }
 
-/// The interval from revolution `a` to `b`.
+/// The interval from revolution `a` to `b`, the lidar's stamps `latency_s` late.
 fn interval(
     a: &Revolution,
     b: &Revolution,
     path: &Path,
     nominal: &Geometry,
     matching: &MatchOptions,
+    latency_s: f64,
 ) -> Outcome {
+    let (from, to) = (a.t_s - latency_s, b.t_s - latency_s);
     let duration_s = b.t_s - a.t_s;
     if !(duration_s > 0.0 && duration_s <= MAX_INTERVAL_S) {
         return Outcome::Gap;
     }
-    let Some(wheel_turns_rad) = path.wheel_turns(a.t_s, b.t_s, nominal) else {
+    let Some(wheel_turns_rad) = path.wheel_turns(from, to, nominal) else {
         return Outcome::Gap;
     };
     let [left, right] = wheel_turns_rad
@@ -438,7 +547,7 @@ fn interval(
     if a.scan.points.len() < MIN_SCAN_POINTS || b.scan.points.len() < MIN_SCAN_POINTS {
         return Outcome::Sparse;
     }
-    let Some(guess) = lidar_motion(path, nominal, a.t_s, b.t_s) else {
+    let Some(guess) = lidar_motion(path, nominal, from, to) else {
         return Outcome::Gap;
     };
     match match_scans(&a.scan, &b.scan, guess, matching) {
@@ -448,4 +557,121 @@ fn interval(
         }),
         Err(f) => Outcome::Failed(f),
     }
+}
+
+/// The latency at which the wheels' turns over each interval best explain its scan-matched
+/// turn `θ = J₂₁ Δφ_L + J₂₂ Δφ_R` (the closed form's first step, refitted at each candidate):
+/// the least trimmed mean square on a 10 ms grid over ±[`MAX_LIDAR_LATENCY_S`], refined by a
+/// parabola. `turns` holds each matched interval's stamps and scan-matched turn. `None` with
+/// fewer than 12 intervals or a drive that never turns.
+fn estimate_latency(
+    turns: &[([f64; 2], f64)],
+    path: &Path,
+    nominal: &Geometry,
+) -> Option<LatencyEstimate> {
+    if turns.len() < 12 {
+        return None;
+    }
+    let steps = (MAX_LIDAR_LATENCY_S / LATENCY_STEP_S).round() as i64;
+    // Each candidate's trimmed mean square and the number of intervals it kept.
+    let profile: Vec<(f64, f64, usize)> = (-steps..=steps)
+        .into_par_iter()
+        .filter_map(|k| {
+            let latency = k as f64 * LATENCY_STEP_S;
+            let rows: Vec<([f64; 2], f64)> = turns
+                .iter()
+                .filter_map(|&([a, b], theta)| {
+                    let w = path.wheel_turns(a - latency, b - latency, nominal)?;
+                    let total = w.iter().fold([0.0, 0.0], |[l, r], [x, y]| [l + x, r + y]);
+                    Some((total, theta))
+                })
+                .collect();
+            // The ends of the log fall outside the odometry at large latencies: a candidate
+            // that loses more than a tenth of the intervals is not compared.
+            if rows.len() * 10 < turns.len() * 9 {
+                return None;
+            }
+            trimmed_turn_misfit(&rows).map(|mse| (latency, mse, rows.len()))
+        })
+        .collect();
+    let best = (0..profile.len()).min_by(|&i, &j| profile[i].1.total_cmp(&profile[j].1))?;
+    let (latency, mse, n) = profile[best];
+    let edge = best == 0 || best + 1 == profile.len();
+    if edge {
+        return Some(LatencyEstimate {
+            latency_s: latency,
+            sd_s: None,
+            at_bound: latency.abs() >= MAX_LIDAR_LATENCY_S - LATENCY_STEP_S / 2.0,
+        });
+    }
+    // The profile log-likelihood of the turns, −(n/2) ln(mse), as a parabola fitted by least
+    // squares to the candidates within 40 ms of the best (the trimmed profile is bumpy at the
+    // grid's scale): its vertex is the estimate, its curvature the information.
+    let ell = |m: f64| -(n as f64) / 2.0 * m.ln();
+    let window: Vec<(f64, f64)> = profile[best.saturating_sub(PARABOLA_HALF_WIDTH)
+        ..(best + PARABOLA_HALF_WIDTH + 1).min(profile.len())]
+        .iter()
+        .map(|&(l, m, _)| (l - latency, ell(m)))
+        .collect();
+    let (latency_s, sd_s) = match parabola(&window) {
+        Some([_, b, c]) if c < 0.0 => {
+            let half = PARABOLA_HALF_WIDTH as f64 * LATENCY_STEP_S;
+            let vertex = (-b / (2.0 * c)).clamp(-half, half);
+            (latency + vertex, Some((-1.0 / (2.0 * c)).sqrt()))
+        }
+        _ => (latency, None),
+    };
+    let _ = mse;
+    Some(LatencyEstimate {
+        latency_s,
+        sd_s,
+        at_bound: false,
+    })
+}
+
+/// Candidates each side of the best one the profile's parabola is fitted to: 4 (40 ms).
+const PARABOLA_HALF_WIDTH: usize = 4;
+
+/// The least-squares parabola `a + b x + c x²` through `points` (x, y); `None` with fewer than
+/// three or a singular system.
+fn parabola(points: &[(f64, f64)]) -> Option<[f64; 3]> {
+    if points.len() < 3 {
+        return None;
+    }
+    let mut ata = nalgebra::Matrix3::<f64>::zeros();
+    let mut aty = nalgebra::Vector3::<f64>::zeros();
+    for &(x, y) in points {
+        let row = nalgebra::Vector3::new(1.0, x, x * x);
+        ata += row * row.transpose();
+        aty += row * y;
+    }
+    let c = ata.try_inverse()? * aty;
+    c.iter().all(|v| v.is_finite()).then(|| [c[0], c[1], c[2]])
+}
+
+/// The mean square of the turn residuals of `rows` (each interval's wheel turns and its
+/// scan-matched turn) after the least-squares turn gains, its worst tenth left out (a match
+/// gone wrong must not choose the latency).
+fn trimmed_turn_misfit(rows: &[([f64; 2], f64)]) -> Option<f64> {
+    let (mut ata, mut aty) = ([[0.0f64; 2]; 2], [0.0f64; 2]);
+    for &([l, r], theta) in rows {
+        ata[0][0] += l * l;
+        ata[0][1] += l * r;
+        ata[1][1] += r * r;
+        aty[0] += l * theta;
+        aty[1] += r * theta;
+    }
+    let det = ata[0][0] * ata[1][1] - ata[0][1] * ata[0][1];
+    if !(det.is_finite() && det.abs() > 1e-12 * (ata[0][0] * ata[1][1]).max(1e-300)) {
+        return None;
+    }
+    let j21 = (aty[0] * ata[1][1] - aty[1] * ata[0][1]) / det;
+    let j22 = (aty[1] * ata[0][0] - aty[0] * ata[0][1]) / det;
+    let mut squares: Vec<f64> = rows
+        .iter()
+        .map(|&([l, r], theta)| (theta - j21 * l - j22 * r).powi(2))
+        .collect();
+    squares.sort_by(f64::total_cmp);
+    let kept = squares.len() - squares.len() / 10;
+    (kept > 0).then(|| squares[..kept].iter().sum::<f64>() / kept as f64)
 }

@@ -189,6 +189,11 @@ pub struct CalibrateArgs {
     /// estimated from the drive).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub lidar_latency_s: Option<f64>,
+    /// Odometry: a calibration whose lidar model (`calibrate --json` of em, landmarks or
+    /// groundtruth) turns each range back into a distance before the scans are matched: a
+    /// lidar with a range bias measures its motion biased too.
+    #[arg(long, value_name = "FILE")]
+    pub lidar_model: Option<PathBuf>,
 }
 
 /// `--method`: the calibrator's methods by name (`hilsim_recording::Method`), each with its help.

@@ -7,7 +7,7 @@ use crate::target_samples::SampleOptions;
 use crate::{em, groundtruth, landmarks, Calibration, CalibrationError, Method};
 
 /// What a user sets of the methods (the rest is each method's default).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Settings {
     /// The beam facing the target and its start distance (EM, ground truth).
     pub target: SampleOptions,

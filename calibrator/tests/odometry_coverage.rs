@@ -10,6 +10,7 @@
 //! ```
 
 use hilsim_calibrator::odometry::{calibrate, RecordingOptions};
+use hilsim_recording::Recording;
 use hilsim_sim::scenario::{DriveWheelBase, LidarMountOffset, OdometerWheelRadius};
 use hilsim_sim::Scenario;
 use rand::{Rng, SeedableRng};
@@ -182,4 +183,61 @@ fn a_lidar_stamped_late_is_found_late_and_the_wheels_still_right() {
     .expect("calibrates");
     let held_sd = held.odometry.expect("a model").standard_deviations()[0];
     assert!(held_sd > 2.0 * model.standard_deviations()[0], "{held_sd}");
+}
+
+/// The drive with its wheels and mount off as `drawn` draws them, the lidar changed by `lidar`.
+fn run_with(seed: u64, lidar: impl Fn(&mut hilsim_sim::scenario::Lidar)) -> (Recording, [f64; 6]) {
+    let base = Scenario::load(DRIVE.as_ref()).expect("odometry-drive.toml loads");
+    let (mut scenario, truth) = drawn(&base, seed);
+    lidar(scenario.sensors.lidar.as_mut().expect("a lidar"));
+    let rec = hilsim_lidar_emulator::Emulation::new(&scenario, seed)
+        .expect("sensors build")
+        .run()
+        .recording;
+    (rec, truth)
+}
+
+/// Each parameter's error in its standard deviations.
+fn sigmas(model: &hilsim_calibrator::OdometryModel, truth: &[f64; 6]) -> [f64; 6] {
+    let (v, sd) = (model.parameters(), model.standard_deviations());
+    std::array::from_fn(|i| (v[i] - truth[i]) / sd[i])
+}
+
+#[test]
+fn a_lidar_that_takes_a_revolution_at_once_is_matched_undistorted() {
+    let (rec, truth) = run_with(5, |l| {
+        l.timing = hilsim_sim::scenario::LidarTiming::PerRevolution
+    });
+    let cal = calibrate(&rec, &RecordingOptions::default()).expect("calibrates");
+    assert!(
+        cal.notes.iter().any(|n| n.contains("one instant")),
+        "{:?}",
+        cal.notes
+    );
+    assert!(cal.failed_checks().next().is_none(), "{:?}", cal.checks);
+    let s = sigmas(cal.odometry.as_ref().expect("a model"), &truth);
+    // A fixed seed: within 3 sd each (a 0.3 % chance each of failing by luck).
+    assert!(s.iter().all(|x| x.abs() <= 3.0), "{s:?}");
+}
+
+#[test]
+fn a_lidar_with_a_range_bias_is_matched_through_its_model() {
+    // The seed papers' XV-11 (the landmark paper's Sec. 4.1): ranges 12 % long at 3 m.
+    let alpha = vec![0.0525, 0.8838, 0.0584];
+    let (rec, truth) = run_with(6, |l| l.bias = alpha.clone());
+    let raw = calibrate(&rec, &RecordingOptions::default()).expect("calibrates");
+    let raw_scale = raw.odometry.expect("a model").wheel_scale.expect("scales");
+    // Without the model the lidar measures its motion long, and the wheels come out long.
+    assert!(raw_scale[0] > truth[0] / 0.033 * 1.03, "{raw_scale:?}");
+    let cal = calibrate(
+        &rec,
+        &RecordingOptions {
+            lidar_bias: Some(alpha),
+            ..RecordingOptions::default()
+        },
+    )
+    .expect("calibrates");
+    assert!(cal.failed_checks().next().is_none(), "{:?}", cal.checks);
+    let s = sigmas(cal.odometry.as_ref().expect("a model"), &truth);
+    assert!(s.iter().all(|x| x.abs() <= 3.0), "{s:?}");
 }

@@ -92,6 +92,20 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
                 .interval_s
                 .unwrap_or(odometry::RecordingOptions::default().interval_s),
             lidar_latency_s: args.lidar_latency_s,
+            lidar_bias: match &args.lidar_model {
+                Some(path) => {
+                    let model = super::read_calibration(path)?;
+                    let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
+                        bail!(
+                            "{}: the {} method's calibration has no lidar model",
+                            path.display(),
+                            model.method.name()
+                        );
+                    };
+                    Some(lidar.alpha.clone())
+                }
+                None => None,
+            },
         },
     };
     let method = args.method;

@@ -554,7 +554,7 @@ fn smooth_refuses_a_calibration_that_is_ambiguous_or_not_one() {
         (
             "method.json",
             method.to_string(),
-            r#"`method` must be em, landmarks or groundtruth, found "<script>""#,
+            r#"`method` must be em, landmarks, groundtruth or odometry, found "<script>""#,
         ),
         (
             "results.json",

@@ -161,6 +161,38 @@ fn what_the_odometry_method_cannot_use_is_refused_with_one_line() {
     assert!(err.contains("RECORDING") || err.contains("tuples"), "{err}");
     // A recording without a nominal wheel radius: the flag it needs is named.
     record_off(tmp.path());
+    let o = hilsim(
+        tmp.path(),
+        &["calibrate", "rec", "--method", "odometry", "--json"],
+    );
+    std::fs::write(tmp.path().join("wheels.json"), o.stdout).unwrap();
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &[
+            "calibrate",
+            "rec",
+            "--method",
+            "odometry",
+            "--lidar-model",
+            "wheels.json",
+        ],
+    ));
+    assert!(
+        err.contains("wheels.json") && err.contains("no lidar model"),
+        "{err}"
+    );
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &[
+            "calibrate",
+            "rec",
+            "--method",
+            "odometry",
+            "--lidar-latency-s",
+            "5",
+        ],
+    ));
+    assert!(err.contains("--lidar-latency-s"), "{err}");
     let meta = tmp.path().join("rec/meta.toml");
     let text = std::fs::read_to_string(&meta).unwrap();
     let without: String = text

@@ -220,6 +220,15 @@ pub fn of_calibration(c: &hilsim_calibrator::Calibration) -> Metrics {
     if let Some(order) = c.order {
         put("order", order as f64);
     }
+    put("checks_failed", c.failed_checks().count() as f64);
+    if let Some(o) = &c.odometry {
+        put("left_wheel_radius_m", o.left_wheel_radius_m);
+        put("right_wheel_radius_m", o.right_wheel_radius_m);
+        put("wheel_base_m", o.wheel_base_m);
+        put("lidar_x_m", o.lidar_x_m);
+        put("lidar_y_m", o.lidar_y_m);
+        put("lidar_yaw_deg", o.lidar_yaw_rad.to_degrees());
+    }
     if let Some(metrics) = c.metrics {
         put("lidar.mse_raw", metrics.mse_raw);
         put("lidar.mse_calibrated", metrics.mse_calibrated);

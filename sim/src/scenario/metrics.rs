@@ -37,7 +37,8 @@ pub const METRICS: &[(&str, &str)] = &[
     ),
 ];
 
-/// Calibration metrics, each prefixed by a method: `em.`, `landmarks.` or `groundtruth.`
+/// Calibration metrics, each prefixed by a method: `em.`, `landmarks.`, `groundtruth.` or
+/// `odometry.`
 /// (computed when the scenario's `[calibration] methods` names it; the `lidar.*` ones need
 /// truth).
 pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
@@ -79,6 +80,16 @@ pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
         "lidar_model.mse_ratio",
         "the lidar model alone: raw over inverted MSE (eq. 31 with eq. 30's inversion)",
     ),
+    (
+        "checks_failed",
+        "how many of the method's assumption checks failed",
+    ),
+    ("left_wheel_radius_m", "the left wheel's radius (odometry)"),
+    ("right_wheel_radius_m", "the right wheel's radius (odometry)"),
+    ("wheel_base_m", "the wheel base (odometry)"),
+    ("lidar_x_m", "the lidar's forward offset on the robot (odometry)"),
+    ("lidar_y_m", "the lidar's leftward offset on the robot (odometry)"),
+    ("lidar_yaw_deg", "the lidar's yaw on the robot (odometry)"),
 ];
 
 /// Metrics of a firmware's session under `hilsim hil` (absent from `run` and `scenario test`,
@@ -126,7 +137,7 @@ pub fn is_calibration(name: &str) -> bool {
 }
 
 /// The calibration methods a calibration metric may be prefixed with.
-pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth"];
+pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth", "odometry"];
 
 /// Whether `name` is in the catalogue.
 #[must_use]

@@ -85,10 +85,19 @@ pub const CALIBRATION_METRICS: &[(&str, &str)] = &[
         "how many of the method's assumption checks failed",
     ),
     ("left_wheel_radius_m", "the left wheel's radius (odometry)"),
-    ("right_wheel_radius_m", "the right wheel's radius (odometry)"),
+    (
+        "right_wheel_radius_m",
+        "the right wheel's radius (odometry)",
+    ),
     ("wheel_base_m", "the wheel base (odometry)"),
-    ("lidar_x_m", "the lidar's forward offset on the robot (odometry)"),
-    ("lidar_y_m", "the lidar's leftward offset on the robot (odometry)"),
+    (
+        "lidar_x_m",
+        "the lidar's forward offset on the robot (odometry)",
+    ),
+    (
+        "lidar_y_m",
+        "the lidar's leftward offset on the robot (odometry)",
+    ),
     ("lidar_yaw_deg", "the lidar's yaw on the robot (odometry)"),
 ];
 

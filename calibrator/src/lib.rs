@@ -1,7 +1,9 @@
 //! Calibration of distance sensors from recordings (`hilsim_recording::Recording`): the
 //! ground-truth-less EM calibrator with its Kalman/RTS smoother (Alhashimi, Varagnolo,
 //! Gustafsson, IEEE Sensors J. 2017), the landmark calibrator (Alhashimi, Magnusson, Knorn,
-//! Varagnolo, Sensors 2021) and the ground-truth baseline.
+//! Varagnolo, Sensors 2021) and the ground-truth baseline; and of the robot that carries them:
+//! its wheels' radii, wheel base and lidar mount from an ordinary drive (Censi, Franchi,
+//! Marchionni, Oriolo, IEEE T-RO 2013), on a point-to-line ICP scan matcher.
 //!
 //! It reads recordings only and never depends on the physics (`hilsim-sim`, rapier): a
 //! calibrator that could only read simulations would be useless on a real robot's data.

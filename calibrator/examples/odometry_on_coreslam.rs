@@ -19,28 +19,13 @@
 //! calibration's, 1 s); `--first-beam-left` reads the beams the other way round (the first at
 //! +120°), to show that the scan matcher's turns then disagree with the wheels'.
 //!
-//! The log's conventions, and where each comes from:
-//! - a line is one scan: timestamp (µs), a field, the left and right encoder counts, 20 more
-//!   fields, then the ranges (mm) of the 682 beams (BreezySLAM's `examples/mines.py` reads the
-//!   same fields; any field after them is ignored, as it does);
-//! - the counts are cumulative, positive forward on both wheels, 2000 a wheel turn (the
-//!   authors' nominal value: BreezySLAM converts ticks to degrees by 180/2000 and then uses
-//!   `r·(φl + φr)` and `(r / half axle)·(φr − φl)`, each twice the usual form, which together
-//!   amount to 2000 ticks a turn); they do not wrap in this log, and a jump larger than a wheel
-//!   could turn is an error;
-//! - the beams run counter-clockwise seen from above, the first one on the right (SCIP 2.0,
-//!   Hokuyo C-42-03320B, section 5: the URG-04LX turns anti-clockwise; its steps 44 to 725 of
-//!   1024 a revolution are the 682 beams, step 384 straight ahead);
-//! - readings under 20 mm are the sensor's error codes and 0 is no return (same section): both
-//!   invalid;
-//! - the beams are taken one step (100 ms / 1024, the URG-04LX's 600 rpm) apart in time, the
-//!   first at the line's timestamp. The log does not say when its timestamp was taken relative
-//!   to the encoder counts on the line; the calibration estimates the lidar's latency against
-//!   the encoders from the turns, and on `exp1.dat` finds the scans about 0.19 s older than the
-//!   counts on their line, about two scans (with the latency held at 0 the turn's residual
-//!   spread, the "scan matcher's error" it prints, is 99 mrad instead of 22).
+//! The log is read by `hilsim_logs::read_coreslam`, whose documentation gives the log's
+//! conventions and where each comes from. The log does not say when its timestamp was taken
+//! relative to the encoder counts on the line; the calibration estimates the lidar's latency
+//! against the encoders from the turns, and on `exp1.dat` finds the scans about 0.19 s older
+//! than the counts on their line, about two scans (with the latency held at 0 the turn's
+//! residual spread, the "scan matcher's error" it prints, is 99 mrad instead of 22).
 
-use std::f64::consts::TAU;
 use std::process::ExitCode;
 
 use hilsim_calibrator::odometry::{
@@ -49,45 +34,14 @@ use hilsim_calibrator::odometry::{
 };
 use hilsim_calibrator::scan_match::MatchFailure;
 use hilsim_calibrator::OdometryModel;
-use hilsim_recording::{LidarSample, Meta, Mount, OdometrySample, Pose, Recording, RobotMeta};
-
-/// Fields before the ranges: timestamp, one field, two encoder counts, 20 more.
-const HEADER_FIELDS: usize = 24;
-/// Beams of a scan (the URG-04LX's steps 44 to 725; SCIP 2.0, C-42-03320B, table 2).
-const BEAMS: usize = 682;
-/// The first beam's step and the step straight ahead (same table).
-const FIRST_STEP: f64 = 44.0;
-const FRONT_STEP: f64 = 384.0;
-/// Steps in a revolution (same table: slit division 1024).
-const STEPS_PER_TURN: f64 = 1024.0;
-/// A revolution takes 100 ms (same table's PP example: 600 rpm).
-const REVOLUTION_S: f64 = 0.1;
-/// Readings under 20 mm are error codes (section 5, table 3; the PP example's DMIN 20).
-const MIN_RANGE_MM: i64 = 20;
-
-/// The rover's nominal geometry (its authors', as BreezySLAM's `mines.py` gives it): wheel
-/// radius 77 mm, half axle 165 mm, the lidar 145 mm ahead of the axle, 2000 ticks a turn.
-const WHEEL_RADIUS_M: f64 = 0.077;
-const WHEEL_BASE_M: f64 = 0.33;
-const LIDAR_X_M: f64 = 0.145;
-const TICKS_PER_TURN: f64 = 2000.0;
-/// Fastest a wheel may turn between two scans before a jump of its count is taken for a wrap
-/// or a corrupt field: 10 turns a second, 4.8 m/s on these wheels, four times the fastest
-/// stretch of this log.
-const MAX_TURNS_PER_S: f64 = 10.0;
+use hilsim_logs::{read_coreslam, CoreSlamOptions};
+use hilsim_recording::Pose;
 
 /// An interval turns "clearly" when the wheels say it turned by more than 3° (50 mrad), well
 /// above the scan matcher's milliradians, so that the sign of its turn is not noise.
 const CLEAR_TURN_RAD: f64 = 0.05;
 /// An interval drives "clearly" when the wheels say it moved more than 5 cm.
 const CLEAR_TRAVEL_M: f64 = 0.05;
-
-/// One line of the log.
-struct Scan {
-    t_us: u64,
-    ticks: [i64; 2],
-    ranges_mm: Vec<i64>,
-}
 
 /// What the command line asks.
 struct Args {
@@ -152,13 +106,17 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
 fn run(args: &Args) -> Result<(), String> {
     let path = &args.path;
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
-    let scans = parse(&text, path)?;
-    let rec = recording(&scans, args.first_beam_left);
+    let options = CoreSlamOptions {
+        first_beam_left: args.first_beam_left,
+        ..CoreSlamOptions::default()
+    };
+    let rec = read_coreslam(&text, path, &options).map_err(|e| e.to_string())?;
+    let scans = rec.odometry.as_deref().unwrap_or_default();
     let calibration = calibrate(&rec, &args.options).map_err(|e| format!("{path}: {e}"))?;
     println!(
         "{path}: {} scans over {:.1} s; intervals of {} s{}",
         scans.len(),
-        (scans[scans.len() - 1].t_us - scans[0].t_us) as f64 * 1e-6,
+        scans.last().map_or(0.0, |s| s.t_s),
         args.options.interval_s,
         if args.first_beam_left {
             "; the beams read clockwise (first at +120°)"
@@ -206,131 +164,6 @@ fn run(args: &Args) -> Result<(), String> {
     println!();
     print_agreement(&a, &b);
     Ok(())
-}
-
-/// The log's scans; an error names the file and line.
-fn parse(text: &str, origin: &str) -> Result<Vec<Scan>, String> {
-    let mut scans: Vec<Scan> = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let at = format!("{origin}:{}", n + 1);
-        let fields: Vec<&str> = line.split_whitespace().collect();
-        if fields.is_empty() {
-            continue;
-        }
-        if fields.len() < HEADER_FIELDS + BEAMS {
-            return Err(format!(
-                "{at}: {} fields, expected at least {} (timestamp, a field, two encoder \
-                 counts, 20 more fields, {BEAMS} ranges)",
-                fields.len(),
-                HEADER_FIELDS + BEAMS
-            ));
-        }
-        let t_us: u64 = fields[0]
-            .parse()
-            .map_err(|_| format!("{at}: the timestamp `{}` is not microseconds", fields[0]))?;
-        let count = |i: usize, wheel: &str| -> Result<i64, String> {
-            fields[i].parse().map_err(|_| {
-                format!(
-                    "{at}: the {wheel} encoder count `{}` is not an integer",
-                    fields[i]
-                )
-            })
-        };
-        let ticks = [count(2, "left")?, count(3, "right")?];
-        let ranges_mm = fields[HEADER_FIELDS..HEADER_FIELDS + BEAMS]
-            .iter()
-            .enumerate()
-            .map(|(i, f)| {
-                f.parse::<i64>()
-                    .map_err(|_| format!("{at}: beam {i}'s range `{f}` is not millimetres"))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        if let Some(last) = scans.last() {
-            if t_us <= last.t_us {
-                return Err(format!(
-                    "{at}: the timestamp {t_us} µs does not follow the previous scan's {} µs",
-                    last.t_us
-                ));
-            }
-            let dt_s = (t_us - last.t_us) as f64 * 1e-6;
-            // At least a revolution's time: two lines a few milliseconds apart may carry
-            // counts read a revolution apart.
-            let most = MAX_TURNS_PER_S * TICKS_PER_TURN * dt_s.max(REVOLUTION_S);
-            for (k, wheel) in ["left", "right"].iter().enumerate() {
-                let step = ticks[k] - last.ticks[k];
-                if step.unsigned_abs() as f64 > most {
-                    return Err(format!(
-                        "{at}: the {wheel} encoder count jumped by {step} ticks in {dt_s:.3} s, \
-                         more than {MAX_TURNS_PER_S} wheel turns a second: a wrapped or corrupt \
-                         count"
-                    ));
-                }
-            }
-        }
-        scans.push(Scan {
-            t_us,
-            ticks,
-            ranges_mm,
-        });
-    }
-    if scans.len() < 2 {
-        return Err(format!("{origin}: fewer than two scans"));
-    }
-    Ok(scans)
-}
-
-/// The recording of `scans`: the encoders' travel over the nominal radius, one revolution a
-/// scan with its beams a step apart in time.
-fn recording(scans: &[Scan], first_beam_left: bool) -> Recording {
-    let t0 = scans[0].t_us;
-    let ticks0 = scans[0].ticks;
-    let metres_per_tick = TAU * WHEEL_RADIUS_M / TICKS_PER_TURN;
-    let step_deg = 360.0 / STEPS_PER_TURN;
-    let step_s = REVOLUTION_S / STEPS_PER_TURN;
-    let mut rec = Recording::new(Meta {
-        robot: RobotMeta {
-            wheel_base_m: WHEEL_BASE_M,
-            wheel_radius_m: Some(WHEEL_RADIUS_M),
-        },
-        lidar: Some(Mount {
-            x_m: LIDAR_X_M,
-            y_m: 0.0,
-            yaw_deg: 0.0,
-        }),
-        ..Meta::default()
-    });
-    let mut odometry = Vec::with_capacity(scans.len());
-    let mut lidar = Vec::with_capacity(scans.len() * BEAMS);
-    for (rev, scan) in scans.iter().enumerate() {
-        let t_s = (scan.t_us - t0) as f64 * 1e-6;
-        odometry.push(OdometrySample {
-            t_s,
-            left_m: (scan.ticks[0] - ticks0[0]) as f64 * metres_per_tick,
-            right_m: (scan.ticks[1] - ticks0[1]) as f64 * metres_per_tick,
-        });
-        for (i, &mm) in scan.ranges_mm.iter().enumerate() {
-            let from_front = (FIRST_STEP + i as f64 - FRONT_STEP) * step_deg;
-            let angle = if first_beam_left {
-                -from_front
-            } else {
-                from_front
-            };
-            let invalid = mm < MIN_RANGE_MM;
-            lidar.push(LidarSample {
-                t_s: t_s + i as f64 * step_s,
-                rev: rev as u64,
-                angle_deg: angle.rem_euclid(360.0),
-                range_m: if invalid { 0.0 } else { mm as f64 * 1e-3 },
-                strength: 0,
-                invalid,
-                warning: false,
-                true_range_m: None,
-            });
-        }
-    }
-    rec.odometry = Some(odometry);
-    rec.lidar = Some(lidar);
-    rec
 }
 
 /// The drive's intervals, and whether the scan matcher and the wheels agree on the sign of

@@ -9,10 +9,12 @@
 //! print; a CARMEN log's bad lines are skipped and described in notes, not refused.
 #![warn(missing_docs)]
 
+pub mod carmen;
 pub mod coreslam;
 mod error;
 mod text;
 
+pub use carmen::{read_carmen, CarmenOptions, Clock, Poses};
 pub use coreslam::{read_coreslam, CoreSlamOptions};
 pub use error::LogError;
 pub use text::{read_text, MAX_TEXT_BYTES};

@@ -50,15 +50,17 @@ const MAX_UNKNOWN_NAMES: usize = 16;
 /// What the log's own pose fields are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Poses {
-    /// Good poses (a corrected log's: localised or SLAM-corrected): `truth.csv`, from `FLASER`'s
-    /// x y θ, `ROBOTLASER1`'s robot pose and `ODOM`. A log with `TRUEPOS` lines has its truth
-    /// from them instead.
+    /// The scan lines' poses are good ones (a corrected log's: localised or SLAM-corrected):
+    /// `truth.csv` from `FLASER`'s x y θ and `ROBOTLASER1`'s robot pose; a log with `TRUEPOS`
+    /// lines has its truth from them instead. `ODOM` lines, CARMEN's odometry message, give
+    /// `odometry.csv` (as in [`Poses::Odometry`]).
     #[default]
     Truth,
-    /// Odometry: `odometry.csv` as the wheel travel that dead reckoning
-    /// ([`Pose::drive`] over [`CarmenOptions::wheel_base_m`]) turns back into the poses, from
-    /// `FLASER`'s odom_x odom_y odom_θ, `ROBOTLASER1`'s robot pose and `ODOM`; `TRUEPOS` gives
-    /// `truth.csv`.
+    /// The log's poses are odometry: `odometry.csv` as the wheel travel that dead reckoning
+    /// ([`Pose::drive`] over [`CarmenOptions::wheel_base_m`]) turns back into the poses of the
+    /// `ODOM` lines, or, in a log without them, of the scan lines (`FLASER`'s odom_x odom_y
+    /// odom_θ, `ROBOTLASER1`'s robot pose); `TRUEPOS` gives `truth.csv`. The two kinds are not
+    /// mixed: a corrected log's `ODOM` and scan poses are in different frames.
     Odometry,
 }
 
@@ -247,7 +249,7 @@ enum Read {
         pose: Option<Pose>,
         mount: Option<Mount>,
     },
-    Pose(Stamped),
+    Odom(Stamped),
     True(Stamped),
     Nothing,
 }
@@ -264,9 +266,11 @@ pub fn read_carmen(
 ) -> Result<(Recording, Vec<String>), LogError> {
     options.validate()?;
     let mut lidar: Vec<LidarSample> = Vec::new();
+    // The scan lines' poses, the ODOM lines', the TRUEPOS lines'.
     let mut poses: Vec<Stamped> = Vec::new();
+    let mut odoms: Vec<Stamped> = Vec::new();
     let mut truths: Vec<Stamped> = Vec::new();
-    let (mut scans, mut pose_stream, mut truth_stream) =
+    let (mut scans, mut odom_stream, mut truth_stream) =
         (Stream::default(), Stream::default(), Stream::default());
     let mut malformed = Skipped::default();
     let mut unknown: BTreeMap<String, Skipped> = BTreeMap::new();
@@ -306,7 +310,7 @@ pub fn read_carmen(
                     fields.number(what)?;
                 }
                 let t = fields.tail(options.clock)?;
-                Ok(Read::Pose(Stamped { t, pose }))
+                Ok(Read::Odom(Stamped { t, pose }))
             })(),
             "TRUEPOS" => (|| {
                 let pose = fields.pose("true pose")?;
@@ -346,7 +350,7 @@ pub fn read_carmen(
         };
         let t = match &read {
             Read::Scan { t, .. } => *t,
-            Read::Pose(s) | Read::True(s) => s.t,
+            Read::Odom(s) | Read::True(s) => s.t,
             Read::Nothing => continue,
         };
         let start = *t0.get_or_insert(t);
@@ -363,14 +367,12 @@ pub fn read_carmen(
                 revs += 1;
                 mount = mount.or(m);
                 if let Some(pose) = pose {
-                    if pose_stream.accept(t_s, number) {
-                        poses.push(Stamped { t: t_s, pose });
-                    }
+                    poses.push(Stamped { t: t_s, pose });
                 }
             }
-            Read::Pose(s) => {
-                if pose_stream.accept(t_s, number) {
-                    poses.push(Stamped {
+            Read::Odom(s) => {
+                if odom_stream.accept(t_s, number) {
+                    odoms.push(Stamped {
                         t: t_s,
                         pose: s.pose,
                     });
@@ -387,7 +389,7 @@ pub fn read_carmen(
             Read::Nothing => {}
         }
     }
-    if revs == 0 && poses.is_empty() && truths.is_empty() {
+    if revs == 0 && odoms.is_empty() && truths.is_empty() {
         return Err(LogError::Empty {
             origin: origin.to_string(),
             message: "no scan (FLASER, ROBOTLASER1) and no pose (ODOM, TRUEPOS)".to_string(),
@@ -397,7 +399,7 @@ pub fn read_carmen(
     let mut notes = Vec::new();
     for (stream, what) in [
         (&scans, "scan"),
-        (&pose_stream, "pose"),
+        (&odom_stream, "ODOM"),
         (&truth_stream, "TRUEPOS"),
     ] {
         if stream.back.count > 0 {
@@ -465,37 +467,34 @@ pub fn read_carmen(
             })
             .collect()
     };
-    match options.poses {
-        Poses::Truth => {
-            if truths.is_empty() {
-                rec.truth = (!poses.is_empty()).then(|| table(&poses));
-            } else {
-                if !poses.is_empty() {
-                    notes.push(format!(
-                        "{origin}: the truth is the TRUEPOS lines'; the {} poses of the other \
-                         lines are not used",
-                        poses.len()
-                    ));
-                }
-                rec.truth = Some(table(&truths));
-            }
+    let mut odometry = |v: &[Stamped], what: &str| -> Vec<OdometrySample> {
+        let (odometry, sideways_m) = wheel_travel(v, options.wheel_base_m);
+        // A millimetre: below the poses' printed precision in CARMEN logs.
+        if sideways_m > 1e-3 {
+            notes.push(format!(
+                "{origin}: the {what} poses move sideways, which wheels cannot: up to \
+                 {sideways_m:.3} m between two poses, left out of the wheel travel"
+            ));
         }
-        Poses::Odometry => {
-            if !poses.is_empty() {
-                let (odometry, sideways_m) = wheel_travel(&poses, options.wheel_base_m);
-                // A millimetre: below the poses' printed precision in CARMEN logs.
-                if sideways_m > 1e-3 {
-                    notes.push(format!(
-                        "{origin}: the odometry poses move sideways, which wheels cannot: up to \
-                         {sideways_m:.3} m between two poses, left out of the wheel travel"
-                    ));
-                }
-                rec.odometry = Some(odometry);
-            }
-            if !truths.is_empty() {
-                rec.truth = Some(table(&truths));
-            }
+        odometry
+    };
+    let odometry = match options.poses {
+        Poses::Truth => (!odoms.is_empty()).then(|| odometry(&odoms, "ODOM")),
+        Poses::Odometry if !odoms.is_empty() => Some(odometry(&odoms, "ODOM")),
+        Poses::Odometry => (!poses.is_empty()).then(|| odometry(&poses, "scan lines'")),
+    };
+    rec.odometry = odometry;
+    if !truths.is_empty() {
+        if options.poses == Poses::Truth && !poses.is_empty() {
+            notes.push(format!(
+                "{origin}: the truth is the TRUEPOS lines'; the {} poses of the scan lines are \
+                 not used",
+                poses.len()
+            ));
         }
+        rec.truth = Some(table(&truths));
+    } else if options.poses == Poses::Truth && !poses.is_empty() {
+        rec.truth = Some(table(&poses));
     }
     Ok((rec, notes))
 }

@@ -1,0 +1,166 @@
+//! The CARMEN reader on small logs written here: what it reads, what it skips and what it says.
+
+use hilsim_logs::{read_carmen, CarmenOptions, LogError, Poses};
+use hilsim_recording::Pose;
+
+/// A FLASER line of 180 beams, beam i at `first + i / 100` metres, the robot at `pose`.
+fn flaser(first: f64, pose: [f64; 3], t: f64) -> String {
+    let ranges: Vec<String> = (0..180)
+        .map(|i| format!("{}", first + f64::from(i) / 100.0))
+        .collect();
+    let [x, y, th] = pose;
+    format!(
+        "FLASER 180 {} {x} {y} {th} {x} {y} {th} {t} host {t}",
+        ranges.join(" ")
+    )
+}
+
+fn odom(x: f64, y: f64, th: f64, t: f64) -> String {
+    format!("ODOM {x} {y} {th} 0.1 0 0 {t} host {t}")
+}
+
+/// Scans at 1, 2, 1.5 (back in time), 3 s; a malformed FLASER at line 6; ODOM lines, one back in
+/// time; a comment, a PARAM, an unknown kind.
+fn log() -> String {
+    [
+        "# CARMEN Logfile".to_string(),
+        "PARAM robot_frontlaser_offset 0.1 host 0".to_string(),
+        odom(0.0, 0.0, 0.0, 0.5),
+        flaser(1.0, [1.0, 2.0, 0.5], 1.0),
+        odom(0.1, 0.0, 0.0, 1.5),
+        "FLASER 180 1 2 3".to_string(),
+        flaser(2.0, [1.1, 2.0, 0.5], 2.0),
+        odom(0.2, 0.0, 0.0, 1.2),
+        flaser(9.0, [9.0, 9.0, 0.0], 1.5),
+        "NEFF 15".to_string(),
+        String::new(),
+        flaser(3.0, [1.2, 2.1, 0.6], 3.0),
+        odom(0.3, 0.0, 0.0, 3.5),
+    ]
+    .join("\n")
+}
+
+#[test]
+fn scans_and_poses_are_read_and_bad_lines_skipped() {
+    let (rec, notes) = read_carmen(&log(), "test.log", &CarmenOptions::default()).unwrap();
+    let lidar = rec.lidar.as_ref().unwrap();
+    assert_eq!(lidar.len(), 3 * 180, "three good scans of 180 beams");
+    assert_eq!(lidar.last().unwrap().rev, 2);
+    // Time 0 is the first line read (the ODOM at 0.5 s).
+    assert_eq!(lidar[0].t_s, 0.5);
+    assert_eq!(lidar[0].range_m, 1.0);
+    assert_eq!(lidar[179].t_s, 0.5, "all beams at the line's time");
+    assert!((lidar[179].range_m - 2.79).abs() < 1e-12);
+    assert_eq!(lidar[180].range_m, 2.0, "the second scan is the one at 2 s");
+    assert_eq!(lidar[360].t_s, 2.5);
+    assert_eq!(lidar[360].range_m, 3.0, "the scan back in time is skipped");
+    // First beam at -90°, the last a degree short of +90°.
+    assert_eq!(lidar[0].angle_deg, 270.0);
+    assert_eq!(lidar[179].angle_deg, 89.0);
+    let truth = rec.truth.as_ref().unwrap();
+    assert_eq!(truth.len(), 3);
+    assert_eq!((truth[0].t_s, truth[0].x_m, truth[0].y_m), (0.5, 1.0, 2.0));
+    assert_eq!((truth[2].t_s, truth[2].x_m), (2.5, 1.2));
+    // The heading goes through wrap_angle: a rounding.
+    assert!((truth[2].yaw_rad - 0.6).abs() < 1e-12);
+    let odometry = rec.odometry.as_ref().unwrap();
+    assert_eq!(odometry.len(), 3, "the ODOM line back in time is skipped");
+    assert_eq!(odometry[0].t_s, 0.0);
+    assert_eq!(odometry[2].t_s, 3.0);
+    assert_eq!(
+        rec.meta.lidar.unwrap().x_m,
+        0.1,
+        "PARAM robot_frontlaser_offset"
+    );
+
+    assert_eq!(notes.len(), 4, "{notes:#?}");
+    assert!(
+        notes[0].contains("1 scan line(s) go back in time (by up to 0.500 s; the first at line 9)"),
+        "{}",
+        notes[0]
+    );
+    assert!(
+        notes[1].contains("1 ODOM line(s) go back in time (by up to 0.300 s; the first at line 8)"),
+        "{}",
+        notes[1]
+    );
+    assert!(
+        notes[2].contains("1 line(s) of a known kind could not be read")
+            && notes[2].contains("the first at line 6: FLASER"),
+        "{}",
+        notes[2]
+    );
+    assert!(
+        notes[3].contains("NEFF ×1 (first at line 10)"),
+        "{}",
+        notes[3]
+    );
+}
+
+#[test]
+fn odometry_poses_become_wheel_travel_that_dead_reckons_back() {
+    let options = CarmenOptions {
+        poses: Poses::Odometry,
+        wheel_base_m: 0.4,
+        ..CarmenOptions::default()
+    };
+    // An arc and a turn on the spot, from a pose not at the origin.
+    let poses = [
+        Pose::new(1.0, 1.0, 0.3),
+        Pose::new(1.0, 1.0, 0.3).drive(0.2, 0.3, 0.4),
+        Pose::new(1.0, 1.0, 0.3)
+            .drive(0.2, 0.3, 0.4)
+            .drive(-0.1, 0.1, 0.4),
+    ];
+    let text: Vec<String> = poses
+        .iter()
+        .enumerate()
+        .map(|(i, p)| odom(p.x, p.y, p.yaw, i as f64))
+        .collect();
+    let (rec, notes) = read_carmen(&text.join("\n"), "odom.log", &options).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    assert!(rec.truth.is_none() && rec.lidar.is_none());
+    let odometry = rec.odometry.unwrap();
+    let mut pose = poses[0];
+    let (mut left, mut right) = (0.0, 0.0);
+    for (s, want) in odometry.iter().zip(&poses).skip(1) {
+        pose = pose.drive(s.left_m - left, s.right_m - right, 0.4);
+        (left, right) = (s.left_m, s.right_m);
+        assert!(
+            (pose.x - want.x).abs() < 1e-9
+                && (pose.y - want.y).abs() < 1e-9
+                && (pose.yaw - want.yaw).abs() < 1e-9,
+            "{pose:?} against {want:?}"
+        );
+    }
+    assert!((odometry[1].left_m - 0.2).abs() < 1e-9 && (odometry[1].right_m - 0.3).abs() < 1e-9);
+}
+
+#[test]
+fn robotlaser_gives_angles_and_the_mount() {
+    // 3 beams from -0.5 rad, 0.5 rad apart, max range 5 (the last reads 5: no return); 2
+    // remissions; the laser 0.2 m ahead of the robot at (1, 0, 0); no turn_axis field.
+    let line = "ROBOTLASER1 0 -0.5 1.0 0.5 5 0.01 0 3 1 2 5 2 0.1 0.2 1.2 0 0 1 0 0 0 0 0 0 \
+                10.0 host 10.1";
+    let (rec, notes) = read_carmen(line, "rl.log", &CarmenOptions::default()).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    let lidar = rec.lidar.unwrap();
+    assert_eq!(lidar.len(), 3);
+    assert!((lidar[0].angle_deg - (360.0 - 0.5f64.to_degrees())).abs() < 1e-9);
+    assert!((lidar[2].angle_deg - 0.5f64.to_degrees()).abs() < 1e-9);
+    assert!(lidar[2].invalid && !lidar[1].invalid);
+    let mount = rec.meta.lidar.unwrap();
+    assert!((mount.x_m - 0.2).abs() < 1e-12 && mount.y_m.abs() < 1e-12);
+    assert_eq!(rec.truth.unwrap()[0].x_m, 1.0);
+}
+
+#[test]
+fn a_log_of_nothing_readable_is_refused() {
+    let err = read_carmen(
+        "# nothing\nNEFF 3\n",
+        "empty.log",
+        &CarmenOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, LogError::Empty { .. }), "{err}");
+}

@@ -147,26 +147,56 @@ impl Skipped {
     }
 }
 
-/// A stream whose times must not go back: the scans, or the poses.
+/// A stream whose times must not go back: the scans, the ODOM poses, the TRUEPOS poses.
 #[derive(Debug, Default)]
 struct Stream {
+    /// The times of the last two lines taken, and the last one's number.
     last_s: Option<f64>,
+    before_last_s: Option<f64>,
+    last_line: usize,
     back: Skipped,
     most_back_s: f64,
 }
 
+/// What becomes of a line in its stream.
+#[derive(Debug, PartialEq, Eq)]
+enum Take {
+    /// It follows the last line taken.
+    Yes,
+    /// It comes before the last line taken but after the one before: the last one is dropped
+    /// for it. Either of the two is out of order and a line is lost either way; dropping the
+    /// last one keeps a single stamp far ahead (a corrupt one) from taking the rest of the log
+    /// with it.
+    InsteadOfLast,
+    /// It comes before the last two lines taken.
+    No,
+}
+
 impl Stream {
-    /// Whether a line at `t` may follow; counts it when not.
-    fn accept(&mut self, t: f64, line: usize) -> bool {
+    /// Whether a line at `t` may follow; counts what is dropped.
+    fn take(&mut self, t: f64, line: usize) -> Take {
         // Time 0 is the first line read: no line may come before it either.
         let last = self.last_s.unwrap_or(0.0);
-        if t < last {
-            self.back.add(line, String::new);
-            self.most_back_s = self.most_back_s.max(last - t);
-            false
-        } else {
+        if t >= last {
+            self.before_last_s = self.last_s;
             self.last_s = Some(t);
-            true
+            self.last_line = line;
+            return Take::Yes;
+        }
+        self.most_back_s = self.most_back_s.max(last - t);
+        match self.before_last_s {
+            Some(before) if t >= before => {
+                let dropped = self.last_line;
+                self.back.add(dropped, String::new);
+                self.back.first_line = self.back.first_line.min(dropped);
+                self.last_s = Some(t);
+                self.last_line = line;
+                Take::InsteadOfLast
+            }
+            _ => {
+                self.back.add(line, String::new);
+                Take::No
+            }
         }
     }
 }
@@ -246,7 +276,7 @@ fn short(w: &str) -> String {
 enum Read {
     Scan {
         t: f64,
-        pose: Option<Pose>,
+        pose: Pose,
         mount: Option<Mount>,
     },
     Odom(Stamped),
@@ -277,6 +307,8 @@ pub fn read_carmen(
     let mut unknown_other = Skipped::default();
     let mut t0: Option<f64> = None;
     let mut revs = 0u64;
+    // Where the last scan taken starts in `lidar`.
+    let mut last_scan_start = 0;
     let mut mount: Option<Mount> = None;
     let mut front_offset: Option<f64> = None;
     for (n, line) in text.lines().enumerate() {
@@ -357,34 +389,32 @@ pub fn read_carmen(
         let t_s = t - start;
         match read {
             Read::Scan { pose, mount: m, .. } => {
-                if !scans.accept(t_s, number) {
-                    lidar.truncate(scan_start);
-                    continue;
+                match scans.take(t_s, number) {
+                    Take::No => {
+                        lidar.truncate(scan_start);
+                        continue;
+                    }
+                    Take::InsteadOfLast => {
+                        // The last scan's readings go; this one's move down to its place.
+                        lidar.drain(last_scan_start..scan_start);
+                        poses.pop();
+                        revs -= 1;
+                    }
+                    Take::Yes => last_scan_start = scan_start,
                 }
-                for s in &mut lidar[scan_start..] {
+                for s in &mut lidar[last_scan_start..] {
                     s.t_s = t_s;
+                    s.rev = revs;
                 }
                 revs += 1;
                 mount = mount.or(m);
-                if let Some(pose) = pose {
-                    poses.push(Stamped { t: t_s, pose });
-                }
+                poses.push(Stamped { t: t_s, pose });
             }
             Read::Odom(s) => {
-                if odom_stream.accept(t_s, number) {
-                    odoms.push(Stamped {
-                        t: t_s,
-                        pose: s.pose,
-                    });
-                }
+                put(&mut odom_stream, &mut odoms, t_s, s.pose, number);
             }
             Read::True(s) => {
-                if truth_stream.accept(t_s, number) {
-                    truths.push(Stamped {
-                        t: t_s,
-                        pose: s.pose,
-                    });
-                }
+                put(&mut truth_stream, &mut truths, t_s, s.pose, number);
             }
             Read::Nothing => {}
         }
@@ -404,8 +434,8 @@ pub fn read_carmen(
     ] {
         if stream.back.count > 0 {
             notes.push(format!(
-                "{origin}: {} {what} line(s) go back in time (by up to {:.3} s; the first at line \
-                 {}): skipped",
+                "{origin}: {} {what} line(s) out of time order, skipped (of two lines out of \
+                 order the later-stamped one; stamps up to {:.3} s back; the first at line {})",
                 stream.back.count, stream.most_back_s, stream.back.first_line
             ));
         }
@@ -499,6 +529,18 @@ pub fn read_carmen(
     Ok((rec, notes))
 }
 
+/// Puts a pose at `t` into `stream`'s table, or not.
+fn put(stream: &mut Stream, table: &mut Vec<Stamped>, t: f64, pose: Pose, line: usize) {
+    match stream.take(t, line) {
+        Take::No => return,
+        Take::InsteadOfLast => {
+            table.pop();
+        }
+        Take::Yes => {}
+    }
+    table.push(Stamped { t, pose });
+}
+
 /// The wheel travel that [`Pose::drive`] turns back into `poses` (the inverse of dead
 /// reckoning: each step's turn and its motion along the heading halfway through it), and the
 /// largest sideways step it cannot express.
@@ -573,10 +615,10 @@ fn read_flaser(
     let t = f.tail(options.clock)?;
     Ok(Read::Scan {
         t,
-        pose: Some(match options.poses {
+        pose: match options.poses {
             Poses::Truth => pose,
             Poses::Odometry => odom,
-        }),
+        },
         mount: None,
     })
 }
@@ -638,7 +680,7 @@ fn read_robotlaser(
     let relative = laser.relative_to(&robot);
     Ok(Read::Scan {
         t,
-        pose: Some(robot),
+        pose: robot,
         mount: Some(Mount {
             x_m: relative.x,
             y_m: relative.y,

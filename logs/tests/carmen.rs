@@ -19,8 +19,9 @@ fn odom(x: f64, y: f64, th: f64, t: f64) -> String {
     format!("ODOM {x} {y} {th} 0.1 0 0 {t} host {t}")
 }
 
-/// Scans at 1, 2, 1.5 (back in time), 3 s; a malformed FLASER at line 6; ODOM lines, one back in
-/// time; a comment, a PARAM, an unknown kind.
+/// Scans at 1, 2, 0.7 (back in time, before both), 3 s; a malformed FLASER at line 6; ODOM
+/// lines at 0.5, 1.5, 1.2 (before the last one, after the one before it), 3.5 s; a comment, a
+/// PARAM, an unknown kind.
 fn log() -> String {
     [
         "# CARMEN Logfile".to_string(),
@@ -31,7 +32,7 @@ fn log() -> String {
         "FLASER 180 1 2 3".to_string(),
         flaser(2.0, [1.1, 2.0, 0.5], 2.0),
         odom(0.2, 0.0, 0.0, 1.2),
-        flaser(9.0, [9.0, 9.0, 0.0], 1.5),
+        flaser(9.0, [9.0, 9.0, 0.0], 0.7),
         "NEFF 15".to_string(),
         String::new(),
         flaser(3.0, [1.2, 2.1, 0.6], 3.0),
@@ -64,8 +65,16 @@ fn scans_and_poses_are_read_and_bad_lines_skipped() {
     // The heading goes through wrap_angle: a rounding.
     assert!((truth[2].yaw_rad - 0.6).abs() < 1e-12);
     let odometry = rec.odometry.as_ref().unwrap();
-    assert_eq!(odometry.len(), 3, "the ODOM line back in time is skipped");
+    assert_eq!(
+        odometry.len(),
+        3,
+        "one of the ODOM lines out of order is skipped"
+    );
     assert_eq!(odometry[0].t_s, 0.0);
+    assert!(
+        (odometry[1].t_s - 0.7).abs() < 1e-12,
+        "the later-stamped of the two goes: a stamp far ahead costs one line"
+    );
     assert_eq!(odometry[2].t_s, 3.0);
     assert_eq!(
         rec.meta.lidar.unwrap().x_m,
@@ -75,12 +84,14 @@ fn scans_and_poses_are_read_and_bad_lines_skipped() {
 
     assert_eq!(notes.len(), 4, "{notes:#?}");
     assert!(
-        notes[0].contains("1 scan line(s) go back in time (by up to 0.500 s; the first at line 9)"),
+        notes[0].contains("1 scan line(s) out of time order")
+            && notes[0].contains("1.300 s back; the first at line 9)"),
         "{}",
         notes[0]
     );
     assert!(
-        notes[1].contains("1 ODOM line(s) go back in time (by up to 0.300 s; the first at line 8)"),
+        notes[1].contains("1 ODOM line(s) out of time order")
+            && notes[1].contains("0.300 s back; the first at line 5)"),
         "{}",
         notes[1]
     );
@@ -94,6 +105,39 @@ fn scans_and_poses_are_read_and_bad_lines_skipped() {
         notes[3].contains("NEFF ×1 (first at line 10)"),
         "{}",
         notes[3]
+    );
+}
+
+#[test]
+fn a_scan_stamped_far_ahead_costs_only_itself() {
+    let text = [
+        flaser(1.0, [0.0; 3], 10.0),
+        flaser(2.0, [0.0; 3], 1e9),
+        flaser(3.0, [0.0; 3], 10.1),
+        flaser(4.0, [0.0; 3], 10.2),
+    ]
+    .join("\n");
+    let (rec, notes) = read_carmen(&text, "ahead.log", &CarmenOptions::default()).unwrap();
+    let lidar = rec.lidar.unwrap();
+    assert_eq!(lidar.len(), 3 * 180);
+    let firsts: Vec<(u64, f64)> = lidar
+        .iter()
+        .step_by(180)
+        .map(|s| (s.rev, s.range_m))
+        .collect();
+    assert_eq!(firsts, [(0, 1.0), (1, 3.0), (2, 4.0)]);
+    assert!((lidar[539].t_s - 0.2).abs() < 1e-9);
+    assert_eq!(rec.truth.unwrap().len(), 3);
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(
+        notes[1].contains("does not give the laser's mount"),
+        "{}",
+        notes[1]
+    );
+    assert!(
+        notes[0].contains("1 scan line(s)") && notes[0].contains("the first at line 2)"),
+        "{}",
+        notes[0]
     );
 }
 

@@ -175,8 +175,11 @@ enum Take {
 impl Stream {
     /// Whether a line at `t` may follow; counts what is dropped.
     fn take(&mut self, t: f64, line: usize) -> Take {
-        // Time 0 is the first line read: no line may come before it either.
-        let last = self.last_s.unwrap_or(0.0);
+        let Some(last) = self.last_s else {
+            self.last_s = Some(t);
+            self.last_line = line;
+            return Take::Yes;
+        };
         if t >= last {
             self.before_last_s = self.last_s;
             self.last_s = Some(t);
@@ -285,7 +288,7 @@ enum Read {
 }
 
 /// The recording of a CARMEN log's `text` (`origin` names it in notes and errors), and notes
-/// on what was skipped and why. Time 0 is the first line's time that was read.
+/// on what was skipped and why. Time 0 is the earliest line taken.
 ///
 /// # Errors
 /// More than [`MAX_LINES`] lines, no scan and no pose, or options out of range.
@@ -305,7 +308,6 @@ pub fn read_carmen(
     let mut malformed = Skipped::default();
     let mut unknown: BTreeMap<String, Skipped> = BTreeMap::new();
     let mut unknown_other = Skipped::default();
-    let mut t0: Option<f64> = None;
     let mut revs = 0u64;
     // Where the last scan taken starts in `lidar`.
     let mut last_scan_start = 0;
@@ -385,8 +387,8 @@ pub fn read_carmen(
             Read::Odom(s) | Read::True(s) => s.t,
             Read::Nothing => continue,
         };
-        let start = *t0.get_or_insert(t);
-        let t_s = t - start;
+        // The log's own time until the end, when time 0 becomes the earliest line taken.
+        let t_s = t;
         match read {
             Read::Scan { pose, mount: m, .. } => {
                 match scans.take(t_s, number) {
@@ -424,6 +426,21 @@ pub fn read_carmen(
             origin: origin.to_string(),
             message: "no scan (FLASER, ROBOTLASER1) and no pose (ODOM, TRUEPOS)".to_string(),
         });
+    }
+
+    let t0 = [
+        lidar.first().map(|s| s.t_s),
+        odoms.first().map(|s| s.t),
+        truths.first().map(|s| s.t),
+    ]
+    .into_iter()
+    .flatten()
+    .fold(f64::INFINITY, f64::min);
+    for s in &mut lidar {
+        s.t_s -= t0;
+    }
+    for s in poses.iter_mut().chain(&mut odoms).chain(&mut truths) {
+        s.t -= t0;
     }
 
     let mut notes = Vec::new();

@@ -1,6 +1,7 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
 //! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP or SQLite3)
-//! into a recording.
+//! into a recording; `hilsim import LOG --out DIR [--log-poses truth|odometry]`: a real robot's
+//! log (CARMEN `.log`/`.clf`, gzipped or not; CoreSLAM `.dat`) into a recording.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -12,7 +13,8 @@ use hilsim_ros2::{ImportOptions, Role};
 
 #[derive(Debug, clap::Args)]
 pub struct ImportArgs {
-    /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files).
+    /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files);
+    /// or a robot's log: CARMEN (`.log`, `.clf`, either gzipped: `.gz`) or CoreSLAM (`.dat`).
     pub bag: PathBuf,
     /// The recording directory to write (replaced atomically when complete).
     #[arg(long)]
@@ -45,9 +47,112 @@ pub struct ImportArgs {
     /// `…right…`).
     #[arg(long, value_name = "LEFT,RIGHT")]
     pub wheel_joints: Option<String>,
+    /// What a CARMEN log's poses are: `truth` (a corrected log's: truth.csv) or `odometry`
+    /// (odometry.csv, as wheel travel); default truth.
+    #[arg(long, value_name = "KIND", value_parser = ["truth", "odometry"])]
+    pub log_poses: Option<String>,
+}
+
+/// The kinds of robot log `import` reads besides ROS 2 bags, by the file's name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LogKind {
+    Carmen,
+    CoreSlam,
+}
+
+fn log_kind(path: &std::path::Path) -> Option<LogKind> {
+    let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    if name.ends_with(".log") || name.ends_with(".clf") {
+        Some(LogKind::Carmen)
+    } else if name.ends_with(".dat") {
+        Some(LogKind::CoreSlam)
+    } else if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+    {
+        // A gzipped file of another name: CARMEN's logger is the one that writes them.
+        Some(LogKind::Carmen)
+    } else {
+        None
+    }
+}
+
+/// A robot's log into a recording.
+fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<()> {
+    let bag_only = [
+        ("--meta", args.meta.is_some()),
+        ("--lidar", args.lidar.is_some()),
+        ("--odom", args.odom.is_some()),
+        ("--cmd", args.cmd.is_some()),
+        ("--sonar", args.sonar.is_some()),
+        ("--truth", args.truth.is_some()),
+        ("--wheel-radius-m", args.wheel_radius_m.is_some()),
+        ("--wheel-joints", args.wheel_joints.is_some()),
+    ];
+    if let Some((flag, _)) = bag_only.iter().find(|(_, given)| *given) {
+        bail!(
+            "{flag} is for ROS 2 bags; {} is a robot's log",
+            args.bag.display()
+        );
+    }
+    if kind == LogKind::CoreSlam && args.log_poses.is_some() {
+        bail!("--log-poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses");
+    }
+    hilsim_recording::check_input_outside(&args.bag, &args.out)?;
+    let text = hilsim_logs::read_text(&args.bag)?;
+    let origin = args.bag.display().to_string();
+    let (rec, notes) = match kind {
+        LogKind::CoreSlam => (
+            hilsim_logs::read_coreslam(&text, &origin, &hilsim_logs::CoreSlamOptions::default())?,
+            Vec::new(),
+        ),
+        LogKind::Carmen => {
+            let options = hilsim_logs::CarmenOptions {
+                poses: match args.log_poses.as_deref() {
+                    Some("odometry") => hilsim_logs::Poses::Odometry,
+                    _ => hilsim_logs::Poses::Truth,
+                },
+                ..hilsim_logs::CarmenOptions::default()
+            };
+            hilsim_logs::read_carmen(&text, &origin, &options)?
+        }
+    };
+    drop(text);
+    hilsim_recording::tidy_after_killed_writers(&args.out)?;
+    rec.write_dir(&args.out)?;
+    let lidar = rec.lidar.as_deref().unwrap_or_default();
+    writeln!(
+        out,
+        "lidar     {} scans: {} rows",
+        lidar.last().map_or(0, |s| s.rev + 1),
+        lidar.len()
+    )?;
+    for (name, rows) in [
+        ("odometry", rec.odometry.as_ref().map(Vec::len)),
+        ("truth", rec.truth.as_ref().map(Vec::len)),
+    ] {
+        if let Some(rows) = rows {
+            writeln!(out, "{name:<9} {rows} rows")?;
+        }
+    }
+    for note in &notes {
+        writeln!(out, "note: {note}")?;
+    }
+    writeln!(out, "wrote {}", args.out.display())?;
+    Ok(())
 }
 
 pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
+    if let Some(kind) = log_kind(&args.bag) {
+        return import_log(args, kind, out);
+    }
+    if args.log_poses.is_some() {
+        bail!(
+            "--log-poses is for CARMEN logs; {} is a ROS 2 bag",
+            args.bag.display()
+        );
+    }
     if args
         .wheel_radius_m
         .is_some_and(|r| !(r.is_finite() && r > 0.0 && r <= 10.0))

@@ -9,6 +9,7 @@ mod common;
 mod dataset;
 mod diagnose;
 mod hil;
+mod import_logs;
 mod limits;
 mod outputs;
 mod record;

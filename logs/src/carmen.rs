@@ -187,18 +187,20 @@ impl Stream {
             return Take::Yes;
         }
         self.most_back_s = self.most_back_s.max(last - t);
+        // With one line taken, that one goes: else a first stamp far ahead would take the
+        // whole log with it.
         match self.before_last_s {
-            Some(before) if t >= before => {
+            Some(before) if t < before => {
+                self.back.add(line, String::new);
+                Take::No
+            }
+            _ => {
                 let dropped = self.last_line;
                 self.back.add(dropped, String::new);
                 self.back.first_line = self.back.first_line.min(dropped);
                 self.last_s = Some(t);
                 self.last_line = line;
                 Take::InsteadOfLast
-            }
-            _ => {
-                self.back.add(line, String::new);
-                Take::No
             }
         }
     }

@@ -142,6 +142,23 @@ fn a_scan_stamped_far_ahead_costs_only_itself() {
 }
 
 #[test]
+fn a_first_odom_stamped_far_ahead_costs_only_itself() {
+    let text = [
+        odom(0.0, 0.0, 0.0, 1e9),
+        odom(0.1, 0.0, 0.0, 5.0),
+        odom(0.2, 0.0, 0.0, 6.0),
+    ]
+    .join("\n");
+    let (rec, notes) = read_carmen(&text, "ahead.log", &CarmenOptions::default()).unwrap();
+    let odometry = rec.odometry.unwrap();
+    assert_eq!(odometry.len(), 2);
+    assert_eq!((odometry[0].t_s, odometry[1].t_s), (0.0, 1.0));
+    assert!((odometry[1].left_m - 0.1).abs() < 1e-12);
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].contains("the first at line 1)"), "{}", notes[0]);
+}
+
+#[test]
 fn odometry_poses_become_wheel_travel_that_dead_reckons_back() {
     let options = CarmenOptions {
         poses: Poses::Odometry,

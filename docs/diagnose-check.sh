@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Reproduces the figures of docs/diagnose.md's Limits section (issue 7):
+# Reproduces the figures of docs/diagnose.md's Limits section:
 #   bash docs/diagnose-check.sh effects   # each effect concealed in diagnose-room (seed 77),
 #                                         # diagnosed with truth.csv and without it
 #   bash docs/diagnose-check.sh nominal   # faithful runs of every checked-in scenario (its own
 #                                         # seed, 101 and 102), with truth.csv and without it
-#   bash docs/diagnose-check.sh quiet     # issue 15: every checked-in scenario at its own seed
+#   bash docs/diagnose-check.sh quiet     # every checked-in scenario at its own seed
 #                                         # and five more (101-105), without truth.csv; exit 1
 #                                         # when any names a catalogued effect
 # Prints one line per diagnosis: the run, the verdict, the fitted parameters, where.

@@ -50,6 +50,9 @@ pub enum Command {
     Import(crate::commands::import::ImportArgs),
     /// Write a recording as ROS 2 messages in an MCAP file (Foxglove, RViz, `ros2 bag play`).
     Export(crate::commands::export::ExportArgs),
+    /// Write a scenario that replays a recorded run in its world (the user's map, or one built
+    /// from the run's scans): `hilsim record` on it makes the run's twin.
+    World(crate::commands::world::WorldArgs),
 }
 
 #[derive(Debug, clap::Args)]

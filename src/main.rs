@@ -52,6 +52,7 @@ fn main() -> ExitCode {
         Command::Export(args) => {
             commands::export::export(args, &mut out).map(|()| ExitCode::SUCCESS)
         }
+        Command::World(args) => commands::world::world(args, &mut out).map(|()| ExitCode::SUCCESS),
     };
     let _ = out.flush();
     match result {

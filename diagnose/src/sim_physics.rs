@@ -167,6 +167,7 @@ impl SimPhysics {
             Obstacle::Wall(i) => i,
             Obstacle::Cylinder(i) => w.walls.len() + i,
             Obstacle::Board(i) => w.walls.len() + w.cylinders.len() + i,
+            Obstacle::Map => w.walls.len() + w.cylinders.len() + w.boards.len(),
         }) as u32
     }
 

@@ -89,7 +89,10 @@ impl Emulation {
         let lidar = s
             .lidar
             .as_ref()
-            .map(|c| Lidar::with_effects(c, e, seed))
+            .map(|c| {
+                Lidar::with_effects(c, e, seed)
+                    .map(|l| l.with_schedule(scenario.files.schedule.clone()))
+            })
             .transpose()?
             // Validation has checked the table: its faults resolve.
             .map(|l| l.with_link(&scenario.link.faults().unwrap_or_default()));
@@ -234,8 +237,16 @@ impl Emulation {
             if let Some(sensor) = &self.lidar {
                 for reading in &s.lidar {
                     on_lidar(reading, sensor.rpm_of_revolution(reading.rev));
+                    // A log's scan is whole when the next one starts (its beams vary in number).
+                    if sensor.is_scheduled()
+                        && revolution.first().is_some_and(|r| r.rev != reading.rev)
+                    {
+                        for r in revolution.drain(..) {
+                            sink.lidar(&r)?;
+                        }
+                    }
                     revolution.push(reading.to_sample());
-                    if revolution.len() == READINGS_PER_REVOLUTION {
+                    if !sensor.is_scheduled() && revolution.len() == READINGS_PER_REVOLUTION {
                         for r in revolution.drain(..) {
                             sink.lidar(&r)?;
                         }
@@ -250,6 +261,12 @@ impl Emulation {
             }
             let (commands, truth) = self.sim.drain_logs();
             log_into(sink, commands, truth)?;
+        }
+        // A log's last scan ends before the run does (its duration covers the schedule).
+        if self.lidar.as_ref().is_some_and(Lidar::is_scheduled) {
+            for r in revolution.drain(..) {
+                sink.lidar(&r)?;
+            }
         }
         let (commands, truth, collisions) = self.sim.take_logs();
         log_into(sink, commands, truth)?;

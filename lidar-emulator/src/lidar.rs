@@ -3,6 +3,9 @@
 
 use hilsim_recording::LidarSample;
 use hilsim_sim::pose::wrap_angle;
+use std::sync::Arc;
+
+use hilsim_sim::scan_schedule::ScanSchedule;
 use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
@@ -48,8 +51,11 @@ pub struct LidarReading {
     pub t_s: f64,
     /// Revolution counter.
     pub rev: u64,
-    /// Angle in the lidar's frame, degrees 0..359, counter-clockwise.
-    pub angle_deg: u16,
+    /// The reading's place in its revolution: the XV-11's whole degree 0..359 (its slot in the
+    /// packets); for a lidar replaying a log's scans, the beam's index in its scan.
+    pub index: u16,
+    /// The beam's angle in the lidar's frame, degrees in [0, 360), counter-clockwise.
+    pub angle_deg: f64,
     /// Reported distance in millimetres (0 when invalid).
     pub distance_mm: u16,
     /// The error code when the reading is invalid.
@@ -70,7 +76,7 @@ impl LidarReading {
         LidarSample {
             t_s: hilsim_sim::exact_time_s(self.t_s),
             rev: self.rev,
-            angle_deg: f64::from(self.angle_deg),
+            angle_deg: self.angle_deg,
             range_m: f64::from(self.distance_mm) / 1000.0,
             strength: self.strength,
             invalid: self.error_code.is_some(),
@@ -106,6 +112,9 @@ pub struct Lidar {
     /// The motor's speed of each revolution while it spins up (`[link] spin_up_s`); empty when
     /// it starts at speed.
     spin_up_rpm: Vec<f64>,
+    /// `[sensors.lidar] schedule`: a log's scans to take instead of the XV-11's revolutions, and
+    /// the next scan and beam to take.
+    schedule: Option<(Arc<ScanSchedule>, usize, u32)>,
 }
 
 impl Lidar {
@@ -156,9 +165,26 @@ impl Lidar {
                 && effects.lidar_motion_skew.is_none(),
             rev_pose: None,
             spin_up_rpm: Vec::new(),
+            schedule: None,
         };
         lidar.rev_rpm = lidar.rpm_of_revolution(0);
         Ok(lidar)
+    }
+
+    /// The lidar taking a log's scans (`[sensors.lidar] schedule`, read with the scenario)
+    /// instead of the XV-11's revolutions: a reading at every beam of every scan, at the
+    /// scan's times and angles.
+    #[must_use]
+    pub fn with_schedule(mut self, schedule: Option<Arc<ScanSchedule>>) -> Self {
+        self.schedule = schedule.map(|s| (s, 0, 0));
+        self
+    }
+
+    /// Whether the lidar takes a log's scans rather than the XV-11's revolutions (it then has
+    /// no XV-11 wire format).
+    #[must_use]
+    pub fn is_scheduled(&self) -> bool {
+        self.schedule.is_some()
     }
 
     /// The range model.
@@ -190,7 +216,17 @@ impl Lidar {
     /// range" rather than "nothing".
     #[must_use]
     pub fn cast_limit_m(&self) -> f64 {
-        (self.max_mm / 1000.0 * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0)
+        (self.max_mm / 1000.0 * 2.0).min(self.largest_mm() / 1000.0)
+    }
+
+    /// The largest distance a reading carries, millimetres: the XV-11's 14-bit field, or for a
+    /// log's scans (never on the XV-11's wire) the reading's 16 bits.
+    fn largest_mm(&self) -> f64 {
+        if self.schedule.is_some() {
+            f64::from(u16::MAX)
+        } else {
+            f64::from(MAX_DISTANCE_MM)
+        }
     }
 
     /// The motor speed during revolution `rev`, as the packets report it: quantised to the
@@ -234,6 +270,10 @@ impl Lidar {
     /// Takes every reading whose instant falls in `[step.t0, step.t1)`.
     pub fn observe(&mut self, world: &World, step: &StepState, out: &mut Vec<LidarReading>) {
         let track = SensorTrack::new(step, self.mount);
+        if self.schedule.is_some() {
+            self.observe_schedule(world, step, &track, out);
+            return;
+        }
         loop {
             let t = reading_time_s(self.rev_start_s, self.index, self.rev_rpm);
             if t >= step.t1 {
@@ -249,7 +289,8 @@ impl Lidar {
                 } else {
                     track.at(t)
                 };
-                out.push(self.read(world, origin, yaw, t));
+                let angle_deg = f64::from(self.index);
+                out.push(self.read(world, origin, yaw, t, angle_deg));
             }
             self.index += 1;
             if usize::from(self.index) == READINGS_PER_REVOLUTION {
@@ -261,16 +302,57 @@ impl Lidar {
         }
     }
 
-    /// One reading at the current (rev, index) from the lidar at `origin` with its 0° axis along
-    /// `yaw` (world frame, radians, not necessarily wrapped).
-    fn read(&mut self, world: &World, origin: [f64; 2], yaw: f64, t: f64) -> LidarReading {
+    /// The scheduled scans' beams whose instant falls in `[step.t0, step.t1)`, each from the
+    /// lidar's pose at its own instant.
+    fn observe_schedule(
+        &mut self,
+        world: &World,
+        step: &StepState,
+        track: &SensorTrack,
+        out: &mut Vec<LidarReading>,
+    ) {
+        let Some((schedule, mut scan_index, mut beam)) = self.schedule.take() else {
+            return;
+        };
+        while let Some(scan) = schedule.scans().get(scan_index) {
+            let t = scan.beam_time_s(beam);
+            if t >= step.t1 {
+                break;
+            }
+            if t >= step.t0 {
+                let (origin, yaw) = track.at(t);
+                self.rev = scan.rev;
+                self.index = u16::try_from(beam).unwrap_or(u16::MAX);
+                out.push(self.read(world, origin, yaw, t, scan.beam_deg(beam)));
+            }
+            beam += 1;
+            if beam >= scan.beams {
+                beam = 0;
+                scan_index += 1;
+            }
+        }
+        self.schedule = Some((schedule, scan_index, beam));
+    }
+
+    /// One reading at the current (rev, index) at `angle_deg` in the lidar's frame, from the
+    /// lidar at `origin` with its 0° axis along `yaw` (world frame, radians, not necessarily
+    /// wrapped).
+    fn read(
+        &mut self,
+        world: &World,
+        origin: [f64; 2],
+        yaw: f64,
+        t: f64,
+        angle_deg: f64,
+    ) -> LidarReading {
         let angle_noise: f64 = StandardNormal.sample(&mut self.rng);
-        let beam = yaw + f64::from(self.index).to_radians() + self.angle_noise_rad * angle_noise;
+        let beam = yaw + angle_deg.to_radians() + self.angle_noise_rad * angle_noise;
         let cast_limit = self.cast_limit_m();
         let mut reading = LidarReading {
             t_s: t + self.latency_s,
             rev: self.rev,
-            angle_deg: self.index,
+            index: self.index,
+            angle_deg,
             distance_mm: 0,
             error_code: Some(ERROR_NO_RETURN),
             strength: 0,
@@ -306,7 +388,7 @@ impl Lidar {
         };
         reading.error_code = error;
         if error.is_none() {
-            reading.distance_mm = measured_mm.min(f64::from(MAX_DISTANCE_MM)) as u16;
+            reading.distance_mm = measured_mm.min(self.largest_mm()) as u16;
             reading.strength = strength;
             reading.warning = strength < STRENGTH_WARNING_BELOW;
         }

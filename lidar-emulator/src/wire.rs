@@ -74,10 +74,10 @@ impl RevolutionCollector {
             self.current = Some((reading.rev, reading.t_s));
             self.filled = 0;
         }
-        self.readings[usize::from(reading.angle_deg)] = to_wire(reading);
+        self.readings[usize::from(reading.index)] = to_wire(reading);
         self.filled += 1;
         let (rev, start_s) = self.current?;
-        if usize::from(reading.angle_deg) != READINGS_PER_REVOLUTION - 1
+        if usize::from(reading.index) != READINGS_PER_REVOLUTION - 1
             || self.filled != READINGS_PER_REVOLUTION
         {
             return None;

@@ -165,7 +165,7 @@ fn beams_hit_cylinders_at_the_analytic_distance() {
     let mut hits = 0;
     for r in &readings {
         let (x, y, yaw) = truth_at(&truth, r.t_s);
-        let beam = yaw + f64::from(r.angle_deg).to_radians();
+        let beam = yaw + r.angle_deg.to_radians();
         hits += usize::from(check_reading(r, geometry.cast([x, y], beam, CAST_LIMIT_M)));
     }
     // Angular widths 2·asin(r/D): 9.7° + 5.9° + 18.6° ≈ 34 beams per revolution; ask for most of
@@ -234,7 +234,7 @@ fn during_a_turn_each_reading_follows_the_pose_at_its_own_instant() {
     // The robot's yaw at the start of each revolution: the instant of its 0° reading.
     let rev_start_yaw: Vec<f64> = readings
         .iter()
-        .filter(|r| r.angle_deg == 0)
+        .filter(|r| r.index == 0)
         .map(|r| truth_at(&truth, r.t_s).2)
         .collect();
     assert_eq!(rev_start_yaw.len(), 20, "4 s at 5 rev/s");
@@ -242,7 +242,7 @@ fn during_a_turn_each_reading_follows_the_pose_at_its_own_instant() {
     let mut worst_with_rev_start_pose: f64 = 0.0;
     for r in &readings {
         let (x, y, yaw) = truth_at(&truth, r.t_s);
-        let angle = f64::from(r.angle_deg).to_radians();
+        let angle = r.angle_deg.to_radians();
         check_reading(r, geometry.cast([x, y], yaw + angle, CAST_LIMIT_M));
         // The same reading predicted from the pose at the start of its revolution.
         let stale = geometry
@@ -287,7 +287,7 @@ fn mount_offsets_are_honoured() {
         let (x, y, yaw) = truth_at(&truth, r.t_s);
         let (sin, cos) = yaw.sin_cos();
         let sensor = [x + cos * mx - sin * my, y + sin * mx + cos * my];
-        let angle = f64::from(r.angle_deg).to_radians();
+        let angle = r.angle_deg.to_radians();
         check_reading(r, geometry.cast(sensor, yaw + myaw + angle, CAST_LIMIT_M));
         let unmounted = geometry.cast([x, y], yaw + angle, CAST_LIMIT_M).unwrap();
         if (unmounted - r.true_range_m.unwrap()).abs() > 100.0 * GEOMETRY_TOL_M {

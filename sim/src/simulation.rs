@@ -83,6 +83,9 @@ enum Driver {
     Program(DriveProgram),
     /// Set from outside (firmware in the loop) with [`Simulation::set_command`].
     External(WheelCommand),
+    /// A recorded path (`[robot] path`): the robot is put where the path says at every step,
+    /// and the wheel commands are what would have moved it there.
+    Path(std::sync::Arc<crate::recorded_path::RecordedPath>),
 }
 
 /// A running simulation of one scenario.
@@ -115,7 +118,11 @@ impl Simulation {
     /// end. The actuation error (if the scenario has one) draws from `scenario.seed`.
     #[must_use]
     pub fn new(scenario: &Scenario) -> Self {
-        let mut sim = Self::build(scenario, Driver::Program(DriveProgram::new(scenario)));
+        let driver = match &scenario.files.path {
+            Some(path) => Driver::Path(path.clone()),
+            None => Driver::Program(DriveProgram::new(scenario)),
+        };
+        let mut sim = Self::build(scenario, driver);
         sim.end_step = Some(scenario.run_steps());
         sim
     }
@@ -128,8 +135,15 @@ impl Simulation {
     }
 
     fn build(scenario: &Scenario, driver: Driver) -> Self {
-        let world = World::new(scenario);
-        let pose = world.robot_pose();
+        let mut world = World::new(scenario);
+        if let Driver::Path(path) = &driver {
+            world.place_robot(path.pose_at(0.0));
+        }
+        let pose = match &driver {
+            // The path's own pose, not its f32 copy in the physics.
+            Driver::Path(path) => path.pose_at(0.0),
+            _ => world.robot_pose(),
+        };
         Self {
             world,
             driver,
@@ -203,11 +217,26 @@ impl Simulation {
             return None;
         }
         let index = self.steps_done;
-        let command = match &self.driver {
-            Driver::Program(program) => program.command_at(index),
-            Driver::External(command) => *command,
-        };
         let t0 = self.time_s();
+        let placed = match &self.driver {
+            Driver::Path(path) => {
+                Some(path.pose_at(exact_time_s((index + 1) as f64 * self.step_s)))
+            }
+            _ => None,
+        };
+        let command = match (&self.driver, placed) {
+            (Driver::Program(program), _) => program.command_at(index),
+            (Driver::External(command), _) => *command,
+            (Driver::Path(_), Some(to)) => {
+                let [left, right] =
+                    crate::kinematics::wheel_travel([0.0; 2], &self.pose, &to, self.wheel_base_m);
+                WheelCommand {
+                    left_mps: left / self.step_s,
+                    right_mps: right / self.step_s,
+                }
+            }
+            (Driver::Path(_), None) => WheelCommand::default(),
+        };
         if self
             .last_command
             .is_none_or(|c| c.left_mps != command.left_mps || c.right_mps != command.right_mps)
@@ -219,12 +248,15 @@ impl Simulation {
                 right_mps: command.right_mps,
             });
         }
-        self.apply(command);
+        match placed {
+            Some(to) => self.world.place_robot(to),
+            None => self.apply(command),
+        }
         self.world.physics.step();
         self.steps_done += 1;
         let t1 = self.time_s();
         let pose0 = self.pose;
-        let pose1 = self.world.robot_pose();
+        let pose1 = placed.unwrap_or_else(|| self.world.robot_pose());
         let wheels0 = self.wheels;
         self.wheels = self.wheel_travel(pose0, pose1);
         self.pose = pose1;

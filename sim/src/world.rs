@@ -5,6 +5,7 @@
 
 use rapier2d::prelude::*;
 
+use crate::occupancy::OccupancyMap;
 use crate::scenario::Scenario;
 use hilsim_recording::pose::Pose;
 
@@ -17,6 +18,8 @@ pub enum Obstacle {
     Cylinder(usize),
     /// `world.boards[i]`.
     Board(usize),
+    /// An occupied cell of `world.map`.
+    Map,
 }
 
 /// A ray's first hit.
@@ -41,6 +44,9 @@ pub struct World {
     obstacles: Vec<(Obstacle, f64)>,
     /// The obstacles as rays see them (see [`World::cast_ray`]).
     fixed: Vec<FixedShape>,
+    /// `[world] map` (rays only: the robot's body passes through its cells) and its cells'
+    /// reflectivity.
+    map: Option<(std::sync::Arc<OccupancyMap>, f64)>,
 }
 
 /// An obstacle's collider with a circle around it, to skip it cheaply for a ray that passes
@@ -174,6 +180,11 @@ impl World {
             robot_collider,
             obstacles,
             fixed,
+            map: scenario
+                .files
+                .map
+                .clone()
+                .map(|map| (map, scenario.reflectivity(None))),
         }
     }
 
@@ -187,6 +198,18 @@ impl World {
             f64::from(t.y),
             f64::from(body.rotation().angle()),
         )
+    }
+
+    /// Puts the robot at `pose`, at rest: a recorded path moves it (the physics then finds its
+    /// contacts there, not its motion).
+    pub(crate) fn place_robot(&mut self, pose: Pose) {
+        let body = &mut self.physics.bodies[self.robot];
+        body.set_position(
+            Pose2::new(Vector::new(pose.x as f32, pose.y as f32), pose.yaw as f32),
+            true,
+        );
+        body.set_linvel(Vector::ZERO, true);
+        body.set_angvel(0.0, true);
     }
 
     /// Casts a ray from `origin` along `heading_rad` (world frame) up to `max_m`, ignoring the
@@ -233,14 +256,28 @@ impl World {
                 }
             }
         }
-        let (handle, hit) = best?;
-        let (obstacle, reflectivity) = self.obstacle_of(handle)?;
-        Some(RayHit {
-            distance: f64::from(hit.time_of_impact),
-            obstacle,
-            normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
-            reflectivity,
-        })
+        let shape_hit = best.and_then(|(handle, hit)| {
+            let (obstacle, reflectivity) = self.obstacle_of(handle)?;
+            Some(RayHit {
+                distance: f64::from(hit.time_of_impact),
+                obstacle,
+                normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
+                reflectivity,
+            })
+        });
+        let Some((map, reflectivity)) = &self.map else {
+            return shape_hit;
+        };
+        let within = shape_hit.map_or(max_m, |h| h.distance);
+        match map.cast_ray(origin, direction, within) {
+            Some(cell) if cell.distance_m < within => Some(RayHit {
+                distance: cell.distance_m,
+                obstacle: Obstacle::Map,
+                normal: cell.normal,
+                reflectivity: *reflectivity,
+            }),
+            _ => shape_hit,
+        }
     }
 
     fn obstacle_of(&self, handle: ColliderHandle) -> Option<(Obstacle, f64)> {

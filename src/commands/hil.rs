@@ -73,6 +73,13 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
     }
+    if scenario.files.schedule.is_some() || scenario.files.path.is_some() {
+        bail!(
+            "{origin}: the scenario replays a log's run (`[robot] path`, `[sensors.lidar] \
+             schedule`): under `hil` the firmware drives and the lidar is an XV-11; `hilsim \
+             record` makes the run's twin"
+        );
+    }
     let duration_s = scenario.duration_s.ok_or_else(|| {
         anyhow!("{origin}: under `hil` the firmware drives: set `duration_s` or pass --duration")
     })?;

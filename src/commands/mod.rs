@@ -18,3 +18,4 @@ pub mod serve;
 
 pub use calibration_file::{read_calibration, read_calibrations};
 pub use scenario_file::load_scenario;
+pub mod world;

@@ -21,6 +21,13 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
             args.scenario.display()
         );
     }
+    if scenario.files.schedule.is_some() {
+        anyhow::bail!(
+            "{}: the lidar replays a log's scans (`schedule`), which have no Neato XV-11 packets \
+             to serve; `hilsim record` makes its twin",
+            args.scenario.display()
+        );
+    }
     let pacing = if args.fast {
         Pacing::Fast
     } else {

@@ -14,7 +14,7 @@ pub(super) struct PacketBuilder {
 
 impl PacketBuilder {
     pub(super) fn push(&mut self, reading: &LidarReading, rpm: f64) -> Option<Packet> {
-        let slot = usize::from(reading.angle_deg) % READINGS_PER_PACKET;
+        let slot = usize::from(reading.index) % READINGS_PER_PACKET;
         if slot == 0 || reading.rev != self.rev {
             self.rev = reading.rev;
             self.filled = 0;
@@ -22,7 +22,7 @@ impl PacketBuilder {
         self.readings[slot] = to_wire(reading);
         self.filled += 1;
         (slot == READINGS_PER_PACKET - 1 && self.filled == READINGS_PER_PACKET).then(|| Packet {
-            index: u8::try_from(usize::from(reading.angle_deg) / READINGS_PER_PACKET).unwrap_or(0),
+            index: u8::try_from(usize::from(reading.index) / READINGS_PER_PACKET).unwrap_or(0),
             rpm_fixed: rpm_to_fixed(rpm),
             readings: self.readings,
         })

@@ -60,6 +60,11 @@ impl Scenario {
         if duration_s.is_some() {
             scenario.duration_s = duration_s;
         }
+        scenario.files = super::files::read(&scenario, origin)?;
+        if let (None, Some(path)) = (scenario.duration_s, &scenario.files.path) {
+            // A replayed log's run lasts as long as its path.
+            scenario.duration_s = Some(path.end_s());
+        }
         validate::validate(&scenario).map_err(|invalid| ScenarioError {
             file: origin.to_path_buf(),
             line: locate::line_of(text, &invalid.path),

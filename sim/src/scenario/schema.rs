@@ -49,6 +49,23 @@ pub struct Scenario {
     /// How the serial link and the unit's motor fail (`serve`, `hil`); default: they do not.
     #[serde(default)]
     pub link: super::link::Link,
+    /// The files the scenario names beside it (a map, a recorded path, a scan schedule), read
+    /// when the scenario is loaded.
+    #[serde(skip)]
+    pub files: ScenarioFiles,
+}
+
+/// What a scenario's files hold, read when it is loaded: a log's run replayed needs its map, its
+/// path and its lidar's scan schedule. Shared, so that copies of a scenario (one a run of a
+/// dataset) cost nothing.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ScenarioFiles {
+    /// `[world] map`, read.
+    pub map: Option<std::sync::Arc<crate::occupancy::OccupancyMap>>,
+    /// `[robot] path`, read.
+    pub path: Option<std::sync::Arc<crate::recorded_path::RecordedPath>>,
+    /// `[sensors.lidar] schedule`, read.
+    pub schedule: Option<std::sync::Arc<crate::scan_schedule::ScanSchedule>>,
 }
 
 impl Scenario {
@@ -106,6 +123,11 @@ pub struct World {
     /// Named materials that obstacles refer to by `material = "name"`.
     #[serde(default)]
     pub materials: BTreeMap<String, Material>,
+    /// An occupancy-grid map beside the walls and shapes: map_server's YAML (its image beside
+    /// it), relative to the scenario file. Rays stop at its occupied cells; the robot's body
+    /// does not collide with them.
+    #[serde(default)]
+    pub map: Option<std::path::PathBuf>,
 }
 
 /// A wall: a segment from `from` to `to`, metres.
@@ -208,6 +230,11 @@ pub struct Robot {
     /// How far the wheels' actual speed departs from the command; default: not at all.
     #[serde(default)]
     pub actuation: Actuation,
+    /// A recorded path the robot follows instead of a drive program: a CSV
+    /// `t_s,x_m,y_m,yaw_deg` relative to the scenario file (`hilsim_sim::recorded_path`). The
+    /// run lasts to its last row unless `duration_s` says otherwise.
+    #[serde(default)]
+    pub path: Option<std::path::PathBuf>,
 }
 
 /// `[robot.actuation]`: the wheels do not do exactly what they are told. The actual speed of both
@@ -366,6 +393,11 @@ pub struct Lidar {
     /// When each reading's geometry is taken; default: each at its own instant.
     #[serde(default)]
     pub timing: LidarTiming,
+    /// The scans of a recorded lidar to take instead of the XV-11's revolutions: a CSV
+    /// `t_s,rev,beams,first_deg,step_deg,beam_period_s` relative to the scenario file
+    /// (`hilsim_sim::scan_schedule`); `rpm` and `rpm_wobble` then do not apply.
+    #[serde(default)]
+    pub schedule: Option<std::path::PathBuf>,
 }
 
 /// When the lidar's readings are taken.

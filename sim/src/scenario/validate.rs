@@ -300,6 +300,12 @@ fn drive(s: &Scenario) -> Check {
             ),
         );
     }
+    if s.robot.path.is_some() && !s.drive.is_empty() {
+        return fail(
+            key_path!["drive"],
+            "the robot follows `[robot] path`: a drive program would have nothing to drive",
+        );
+    }
     if s.drive.is_empty() && s.duration_s.is_none() {
         return fail(
             key_path!["drive"],
@@ -437,6 +443,7 @@ fn start_is_free(s: &Scenario) -> Check {
         Obstacle::Wall(i) => format!("inside wall {i} ({:.3} m from it)", overlap.clearance_m),
         Obstacle::Cylinder(i) => format!("inside or touching cylinder {i}"),
         Obstacle::Board(i) => format!("inside or touching board {i}"),
+        Obstacle::Map => "inside an occupied cell of the map".to_string(),
     };
     fail(
         key_path!["robot", "start"],

@@ -40,6 +40,7 @@ pub mod world;
 pub use drive::{DriveProgram, WheelCommand};
 pub use hilsim_recording::pose::{self, Pose};
 pub use motor_lag::MotorLag;
+pub use occupancy::{MapBuilder, MapError, MapHit, OccupancyMap};
 pub use scenario::{Scenario, ScenarioError};
 pub use simulation::{exact_time_s, Collision, Simulation, StepState};
 pub use world::{Obstacle, RayHit, World};

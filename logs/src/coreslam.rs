@@ -196,6 +196,12 @@ pub fn read_coreslam(
         };
         let rev = odometry.len() as u64;
         let t_s = (t_us - t0) as f64 * 1e-6;
+        // The stamps jitter by more than a scan's 67 ms span takes (one scan stamped 61 ms after
+        // the one before): a scan's readings start no earlier than the previous scan's end, so
+        // that time runs forward through the lidar's table.
+        let readings_from_s = lidar
+            .last()
+            .map_or(t_s, |previous: &LidarSample| t_s.max(previous.t_s + step_s));
         let scan_start = lidar.len();
         for (i, f) in fields[HEADER_FIELDS..].iter().enumerate() {
             let mm: i64 = f
@@ -209,7 +215,8 @@ pub fn read_coreslam(
             };
             let invalid = mm < MIN_RANGE_MM;
             lidar.push(LidarSample {
-                t_s: t_s + i as f64 * step_s,
+                // To the microsecond, as a recording's times are.
+                t_s: ((readings_from_s + i as f64 * step_s) * 1e6).round() / 1e6,
                 rev,
                 angle_deg: angle.rem_euclid(360.0),
                 range_m: if invalid { 0.0 } else { mm as f64 * 1e-3 },

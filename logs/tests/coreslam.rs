@@ -41,10 +41,28 @@ fn scans_and_wheel_travel_are_read() {
     let step = 360.0 / 1024.0;
     assert!((lidar[0].angle_deg - (360.0 - 340.0 * step)).abs() < 1e-9);
     assert!((lidar[681].angle_deg - 341.0 * step).abs() < 1e-9);
-    assert!((lidar[681].t_s - 681.0 * 0.1 / 1024.0).abs() < 1e-12);
+    // Times to the microsecond, as a recording writes them.
+    assert!((lidar[681].t_s - 681.0 * 0.1 / 1024.0).abs() <= 0.5e-6);
     assert_eq!(lidar[682].rev, 1);
     assert_eq!(rec.meta.lidar.unwrap().x_m, 0.145);
     assert_eq!(rec.meta.robot.wheel_base_m, 0.33);
+}
+
+#[test]
+fn a_scan_stamped_before_the_last_one_ended_starts_after_it() {
+    // The second scan is stamped 30 ms after the first, whose 682 readings take 66.5 ms.
+    let text = [line(5_000_000, 0, 0), line(5_030_000, 0, 0)].join("\n");
+    let rec = read_coreslam(&text, "exp.dat", &CoreSlamOptions::default()).unwrap();
+    let lidar = rec.lidar.unwrap();
+    assert!(
+        lidar.windows(2).all(|w| w[1].t_s > w[0].t_s),
+        "time runs forward"
+    );
+    assert!((lidar[682].t_s - 682.0 * 0.1 / 1024.0).abs() <= 0.5e-6);
+    assert!(
+        (rec.odometry.unwrap()[1].t_s - 0.03).abs() < 1e-12,
+        "the wheels keep the stamp"
+    );
 }
 
 #[test]

@@ -270,8 +270,8 @@ impl World {
         };
         let within = shape_hit.map_or(max_m, |h| h.distance);
         match map.cast_ray(origin, direction, within) {
-            Some(cell) if cell.distance_m < within => Some(RayHit {
-                distance: cell.distance_m,
+            Some(cell) if cell.surface_m < within => Some(RayHit {
+                distance: cell.surface_m,
                 obstacle: Obstacle::Map,
                 normal: cell.normal,
                 reflectivity: *reflectivity,

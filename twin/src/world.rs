@@ -319,7 +319,12 @@ impl TwinWorld {
         let _ = writeln!(s, "schedule = {}", relative(&files.schedule));
         let _ = writeln!(s, "noise = [{}]", round_to(noise_m, 1e-4));
         let _ = writeln!(s, "min_range_m = {}", round_to(min_m.max(0.001), 1e-3));
-        let _ = writeln!(s, "max_range_m = {}", round_to(max_m.max(0.01), 1e-3));
+        // A reading carries 16 bits of millimetres.
+        let _ = writeln!(
+            s,
+            "max_range_m = {}",
+            round_to(max_m.clamp(0.01, 65.535), 1e-3)
+        );
         let _ = writeln!(
             s,
             "mount = {{ x_m = {}, y_m = {}, yaw_deg = {} }}",

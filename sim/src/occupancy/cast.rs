@@ -8,6 +8,13 @@ use super::OccupancyMap;
 pub struct MapHit {
     /// Distance from the ray's origin to where it enters the cell, metres.
     pub distance_m: f64,
+    /// Distance from the ray's origin to the surface inside the cell, metres: where the ray
+    /// meets the line through the centres of the occupied cells near the hit (the surface the
+    /// normal is fitted to); without a clear surface, the nearest the ray comes to the cell's
+    /// centre. Within the cell: from `distance_m` to where the ray leaves it. A map built from
+    /// scans puts a wall's cells where its hits fell, so its surface runs through their centres
+    /// on average; the entry is half a cell short of it.
+    pub surface_m: f64,
     /// The surface's normal at the hit: unit, world frame, facing the ray's origin.
     pub normal: [f64; 2],
 }
@@ -83,7 +90,8 @@ impl OccupancyMap {
             }
             if self.is_occupied(cx, cy) {
                 if !skipping {
-                    return Some(self.hit(t, tr.cell, face, d));
+                    let (exit, _, _) = tr.exit();
+                    return Some(self.hit(origin, [t, t0 + exit], tr.cell, face, d));
                 }
             } else {
                 skipping = false;
@@ -99,7 +107,8 @@ impl OccupancyMap {
                         let mut beside = tr.cell;
                         beside[a] += step[a];
                         if self.is_occupied(beside[0], beside[1]) {
-                            return Some(self.hit(exit, beside, Some(a), d));
+                            // A corner's cell is touched at a point: its surface is there.
+                            return Some(self.hit(origin, [exit, exit], beside, Some(a), d));
                         }
                     }
                 }
@@ -114,22 +123,52 @@ impl OccupancyMap {
         }
     }
 
-    /// The hit at `t` on `cell`, entered across the boundary of axis `face`.
-    fn hit(&self, t: f64, cell: [i64; 2], face: Option<usize>, d: [f64; 2]) -> MapHit {
+    /// The hit on `cell`, entered at `span[0]` across the boundary of axis `face` and left at
+    /// `span[1]`, of a ray from `origin` (world) along `d`.
+    fn hit(
+        &self,
+        origin: [f64; 2],
+        span: [f64; 2],
+        cell: [i64; 2],
+        face: Option<usize>,
+        d: [f64; 2],
+    ) -> MapHit {
         let face_normal = match face {
             Some(0) => [-d[0].signum(), 0.0],
             Some(_) => [0.0, -d[1].signum()],
             None => [-d[0], -d[1]],
         };
+        let r = self.resolution_m;
+        let centre_of = |offset: [f64; 2]| {
+            [0, 1].map(|a| self.origin[a] + (cell[a] as f64 + 0.5 + offset[a]) * r - origin[a])
+        };
+        let (normal, surface) = match self.fitted_normal(cell, d) {
+            Some((normal, offset)) => {
+                let c = centre_of(offset);
+                let along = normal[0] * d[0] + normal[1] * d[1];
+                let t = (normal[0] * c[0] + normal[1] * c[1]) / along;
+                (normal, if along < 0.0 { t } else { span[0] })
+            }
+            None => {
+                let c = centre_of([0.0, 0.0]);
+                (face_normal, c[0] * d[0] + c[1] * d[1])
+            }
+        };
+        let entry = span[0].max(0.0);
         MapHit {
-            distance_m: t.max(0.0),
-            normal: self.fitted_normal(cell, d).unwrap_or(face_normal),
+            distance_m: entry,
+            normal,
+            surface_m: if surface.is_finite() {
+                surface.clamp(entry, span[1].max(entry))
+            } else {
+                entry
+            },
         }
     }
 
     /// The normal of the line through the occupied cells near `cell` that face a ray along `d`,
-    /// when they have a clear principal axis.
-    fn fitted_normal(&self, cell: [i64; 2], d: [f64; 2]) -> Option<[f64; 2]> {
+    /// when they have a clear principal axis, and their centroid's offset from `cell`, cells.
+    fn fitted_normal(&self, cell: [i64; 2], d: [f64; 2]) -> Option<([f64; 2], [f64; 2])> {
         let back = d.map(|v| {
             if v > 0.0 {
                 -1
@@ -174,11 +213,12 @@ impl OccupancyMap {
         let along = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
         let (sin, cos) = along.sin_cos();
         let normal = [-sin, cos];
-        Some(if normal[0] * d[0] + normal[1] * d[1] > 0.0 {
+        let facing = if normal[0] * d[0] + normal[1] * d[1] > 0.0 {
             [sin, -cos]
         } else {
             normal
-        })
+        };
+        Some((facing, [mx, my]))
     }
 }
 

@@ -384,11 +384,16 @@ fn sensors(s: &Scenario) -> Check {
         }
         non_negative(p("min_range_m"), l.min_range_m)?;
         positive(p("max_range_m"), l.max_range_m)?;
-        // 14 bits of millimetres.
-        if l.max_range_m > 16.383 || l.min_range_m >= l.max_range_m {
+        // The XV-11's 14 bits of millimetres; a log's scans (never on its wire) 16 bits.
+        let largest = if l.schedule.is_some() { 65.535 } else { 16.383 };
+        if l.max_range_m > largest || l.min_range_m >= l.max_range_m {
             return fail(
                 p("max_range_m"),
-                "expected min_range_m < max_range_m ≤ 16.383 (14 bits of mm)",
+                if l.schedule.is_some() {
+                    "expected min_range_m < max_range_m ≤ 65.535 (16 bits of mm)"
+                } else {
+                    "expected min_range_m < max_range_m ≤ 16.383 (14 bits of mm)"
+                },
             );
         }
         mount(key_path!["sensors", "lidar", "mount"], l.mount)?;

@@ -2,7 +2,8 @@
 //! mount put into the simulation as the effects that model them, so that a diagnosis compares
 //! the recording with the robot it came from, not with the one the scenario declares.
 
-use hilsim_calibrator::OdometryModel;
+use hilsim_calibrator::{Calibration, OdometryModel};
+use hilsim_recording::Sensor;
 use hilsim_sim::scenario::{DriveWheelBase, LidarMountOffset, OdometerWheelRadius};
 use hilsim_sim::Scenario;
 
@@ -54,4 +55,48 @@ pub fn with_odometry(scenario: &Scenario, model: &OdometryModel) -> Result<Scena
         y_m: model.lidar_y_m - declared.y_m,
     });
     Ok(s)
+}
+
+/// `scenario` with what `calibration` found declared: an odometry calibration's wheels and lidar
+/// mount (as [`with_odometry`]), and each calibrated range sensor's bias and noise polynomials
+/// (the papers' eq. 2) as that sensor's declared `bias` and `noise`, replacing the scenario's.
+///
+/// # Errors
+/// A sentence when the calibration has nothing the scenario can take (no wheels, no mount, no
+/// model of a sensor the scenario has), or as [`with_odometry`].
+pub fn with_calibration(scenario: &Scenario, calibration: &Calibration) -> Result<Scenario, String> {
+    let mut s = match &calibration.odometry {
+        Some(model) => with_odometry(scenario, model)?,
+        None => scenario.clone(),
+    };
+    let mut declared = calibration.odometry.is_some();
+    for (sensor, model) in &calibration.sensors {
+        let (bias, noise) = match sensor {
+            Sensor::Lidar => match s.sensors.lidar.as_mut() {
+                Some(l) => (&mut l.bias, &mut l.noise),
+                None => continue,
+            },
+            Sensor::Sonar => match s.sensors.sonar.as_mut() {
+                Some(u) => (&mut u.bias, &mut u.noise),
+                None => continue,
+            },
+            // The odometer's calibration is the wheels' (`odometry` above).
+            Sensor::Odometer => continue,
+        };
+        if model.alpha.is_empty() || model.beta.is_empty() {
+            continue;
+        }
+        bias.clone_from(&model.alpha);
+        noise.clone_from(&model.beta);
+        declared = true;
+    }
+    if declared {
+        Ok(s)
+    } else {
+        Err(format!(
+            "the {} method's calibration has no wheels, no lidar mount and no model of a sensor \
+             the scenario has",
+            calibration.method.name()
+        ))
+    }
 }

@@ -86,9 +86,10 @@ pub struct DiagnoseArgs {
     /// reported (default 0.25).
     #[arg(long, value_name = "X", conflicts_with = "self_test")]
     pub floor_noise_share: Option<f64>,
-    /// An odometry calibration of the robot (`hilsim calibrate --method odometry --json`): the
-    /// simulation takes its wheels and lidar mount instead of the scenario's declared ones, so
-    /// that what is left is what the calibration did not explain.
+    /// A calibration of the robot (`hilsim calibrate --json`): the simulation takes what it
+    /// found instead of the scenario's declared models (an odometry calibration's wheels and
+    /// lidar mount; an em, landmarks or groundtruth calibration's range bias and noise), so that
+    /// what is left is what the calibration did not explain.
     #[arg(long, value_name = "FILE", conflicts_with = "self_test")]
     pub calibration: Option<PathBuf>,
 }
@@ -243,15 +244,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let mut scenario = super::load_scenario(Some(sim), None)?;
     if let Some(path) = &args.calibration {
         let calibration = super::read_calibration(path)?;
-        let Some(model) = calibration.odometry else {
-            bail!(
-                "{}: the {} method's calibration has no wheels or lidar mount; --calibration \
-                 takes an odometry calibration",
-                path.display(),
-                calibration.method.name()
-            );
-        };
-        scenario = hilsim_scenarios::calibrated::with_odometry(&scenario, &model)
+        scenario = hilsim_scenarios::calibrated::with_calibration(&scenario, &calibration)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     }
     let recording = Recording::read_dir(real)?;

@@ -3,11 +3,14 @@
 //! its twin's readings come to the log's.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
+use hilsim_recording::{Mount, Sensor};
 use hilsim_sim::Scenario;
-use hilsim_twin::{build_world, compare, PoseSource, TwinFiles, WorldOptions, COMPARED_WITHIN_M};
+use hilsim_twin::{
+    build_world, compare, Declared, PoseSource, TwinFiles, WorldOptions, COMPARED_WITHIN_M,
+};
 
 #[derive(Debug, clap::Args)]
 pub struct WorldArgs {
@@ -27,6 +30,12 @@ pub struct WorldArgs {
     /// by matching scans), or `auto` (truth when the recording has it).
     #[arg(long, value_name = "SOURCE", default_value = "auto", value_parser = ["auto", "truth", "odometry"])]
     pub poses: String,
+    /// A calibration of the robot (`hilsim calibrate --json`) whose models the scenario
+    /// declares: an em, landmarks or groundtruth calibration's lidar bias and noise; an odometry
+    /// calibration's wheel base and lidar mount. Without one the lidar is declared unbiased,
+    /// with the noise the log shows against its twin.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
 }
 
 pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
@@ -47,28 +56,60 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         poses,
         ..WorldOptions::default()
     };
+    let calibration = args
+        .calibration
+        .as_deref()
+        .map(super::read_calibration)
+        .transpose()?;
     let world = build_world(&args.recording, &options)?;
     for note in &world.notes {
         writeln!(out, "note: {note}")?;
     }
     let files = TwinFiles::beside(&args.out, args.map.as_deref());
+    let mut declared = world.declared();
+    let mut noise_calibrated = false;
+    if let Some(c) = &calibration {
+        if let Some(model) = c.sensors.get(&Sensor::Lidar) {
+            declared.lidar_bias.clone_from(&model.alpha);
+            declared.lidar_noise.clone_from(&model.beta);
+            noise_calibrated = true;
+        }
+        if let Some(o) = &c.odometry {
+            declared.wheel_base_m = o.wheel_base_m;
+            declared.lidar_mount = Mount {
+                x_m: o.lidar_x_m,
+                y_m: o.lidar_y_m,
+                yaw_deg: o.lidar_yaw_rad.to_degrees(),
+            };
+        }
+        if !noise_calibrated && c.odometry.is_none() {
+            bail!(
+                "{}: the {} method's calibration has no lidar model, no wheels and no lidar \
+                 mount for the scenario to declare",
+                args.calibration.as_deref().unwrap_or(Path::new("")).display(),
+                c.method.name()
+            );
+        }
+    }
     // First noiseless, to measure how far the log's readings are from the map's.
-    world.write(&files, 0.0)?;
-    let scenario = Scenario::from_toml(&world.scenario_toml(&files, 0.0), &files.scenario)?;
-    let fit = compare(&scenario, &args.recording)?;
-    // The lidar's noise declared as the spread of the log against its twin: the log's noise and
-    // the map's error together, an upper bound of the lidar's own.
-    let noise_m = if fit.spread_m.is_finite() {
-        fit.spread_m
-    } else {
-        0.0
+    let noiseless = Declared {
+        lidar_noise: vec![0.0],
+        ..declared.clone()
     };
-    world.write(&files, noise_m)?;
+    world.write(&files, &noiseless)?;
+    let scenario = Scenario::from_toml(&world.scenario_toml(&files, &noiseless), &files.scenario)?;
+    let fit = compare(&scenario, &args.recording)?;
+    if !noise_calibrated && fit.spread_m.is_finite() {
+        // The spread of the log against its twin: the log's noise and the map's error
+        // together, an upper bound of the lidar's own.
+        declared.lidar_noise = vec![(fit.spread_m * 1e4).round() / 1e4];
+    }
+    world.write(&files, &declared)?;
     writeln!(
         out,
         "twin: {} of {} readings within {COMPARED_WITHIN_M} m paired ({:.1} %); |twin − log| \
          median {:.1} mm, 90th percentile {:.1} mm; log − twin median {:+.1} mm, spread {:.1} mm \
-         (declared as the lidar's noise)",
+         {}",
         fit.paired,
         fit.compared,
         100.0 * fit.paired_share(),
@@ -76,6 +117,11 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         1000.0 * fit.p90_abs_m,
         1000.0 * fit.median_m,
         1000.0 * fit.spread_m,
+        if noise_calibrated {
+            ""
+        } else {
+            " (declared as the lidar's noise)"
+        }
     )?;
     writeln!(out, "wrote {}", files.scenario.display())?;
     Ok(())

@@ -116,6 +116,20 @@ impl TwinFiles {
     }
 }
 
+/// The robot and lidar a twin's scenario declares: the recording's meta, unless a calibration
+/// says otherwise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Declared {
+    /// The lidar's range bias polynomial (the papers' eq. 2, metres).
+    pub lidar_bias: Vec<f64>,
+    /// The lidar's noise polynomial (standard deviation, metres).
+    pub lidar_noise: Vec<f64>,
+    /// The lidar's mount.
+    pub lidar_mount: Mount,
+    /// The wheel base, metres.
+    pub wheel_base_m: f64,
+}
+
 /// The first line of every scenario `hilsim world` writes: how a later run knows the file is
 /// its own to replace.
 pub const SCENARIO_FIRST_LINE: &str = "# The twin of a recorded run, written by `hilsim world`";
@@ -257,10 +271,22 @@ fn odometer_rate_hz(dir: &hilsim_recording::RecordingDir) -> Result<Option<f64>,
 }
 
 impl TwinWorld {
-    /// The scenario's text, naming `files` relative to the scenario's directory, with the
-    /// lidar's noise declared as `noise_m` (one standard deviation).
+    /// What the recording's meta declares: an unbiased, noiseless lidar at its mount, its
+    /// wheel base.
     #[must_use]
-    pub fn scenario_toml(&self, files: &TwinFiles, noise_m: f64) -> String {
+    pub fn declared(&self) -> Declared {
+        Declared {
+            lidar_bias: vec![0.0, 1.0],
+            lidar_noise: vec![0.0],
+            lidar_mount: self.meta.lidar.unwrap_or_default(),
+            wheel_base_m: self.meta.robot.wheel_base_m,
+        }
+    }
+
+    /// The scenario's text, naming `files` relative to the scenario's directory, declaring
+    /// `declared`.
+    #[must_use]
+    pub fn scenario_toml(&self, files: &TwinFiles, declared: &Declared) -> String {
         let relative = |file: &Path| -> String {
             let dir = files.scenario.parent().unwrap_or(Path::new(""));
             let shown = file.strip_prefix(dir).unwrap_or(file);
@@ -271,7 +297,7 @@ impl TwinWorld {
             .file_name()
             .map_or_else(|| "log".into(), |n| n.to_string_lossy().into_owned());
         let start = self.path.path.first();
-        let mount: Mount = self.meta.lidar.unwrap_or_default();
+        let mount = declared.lidar_mount;
         let mut s = String::new();
         let _ = writeln!(s, "{SCENARIO_FIRST_LINE} from {}.", toml_comment(&name));
         let _ = writeln!(
@@ -309,7 +335,7 @@ impl TwinWorld {
             start.y,
             start.yaw.to_degrees()
         );
-        let _ = writeln!(s, "wheel_base_m = {}", self.meta.robot.wheel_base_m);
+        let _ = writeln!(s, "wheel_base_m = {}", declared.wheel_base_m);
         if let Some(r) = self.meta.robot.wheel_radius_m {
             let _ = writeln!(s, "wheel_radius_m = {r}");
         }
@@ -317,7 +343,14 @@ impl TwinWorld {
         let [min_m, max_m] = self.range_limits_m;
         let _ = writeln!(s, "\n[sensors.lidar]");
         let _ = writeln!(s, "schedule = {}", relative(&files.schedule));
-        let _ = writeln!(s, "noise = [{}]", round_to(noise_m, 1e-4));
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let _ = writeln!(s, "bias = [{}]", list(&declared.lidar_bias));
+        let _ = writeln!(s, "noise = [{}]", list(&declared.lidar_noise));
         let _ = writeln!(s, "min_range_m = {}", round_to(min_m.max(0.001), 1e-3));
         // A reading carries 16 bits of millimetres.
         let _ = writeln!(
@@ -336,12 +369,12 @@ impl TwinWorld {
         s
     }
 
-    /// Writes the twin: the scenario (with the lidar's noise `noise_m`), its path, its scan
-    /// schedule and, when built, its map. Each file replaces only a file of its own kind.
+    /// Writes the twin: the scenario (declaring `declared`), its path, its scan schedule and,
+    /// when built, its map. Each file replaces only a file of its own kind.
     ///
     /// # Errors
     /// A file in the way that is not a twin's, or any I/O error, naming the file.
-    pub fn write(&self, files: &TwinFiles, noise_m: f64) -> Result<(), TwinError> {
+    pub fn write(&self, files: &TwinFiles, declared: &Declared) -> Result<(), TwinError> {
         let inputs = [self.recording.as_path()];
         check_output_file(&files.scenario, SCENARIO_KIND, &inputs)?;
         check_output_file(&files.path, PATH_KIND, &inputs)?;
@@ -353,7 +386,7 @@ impl TwinWorld {
         write_file_atomically(&files.schedule, self.schedule.to_csv().as_bytes())?;
         write_file_atomically(
             &files.scenario,
-            self.scenario_toml(files, noise_m).as_bytes(),
+            self.scenario_toml(files, declared).as_bytes(),
         )?;
         Ok(())
     }

@@ -53,7 +53,7 @@ fn the_twin_of_a_run_replays_its_readings_within_a_cell() {
     let rec = record(tmp.path());
     let world = build_world(&rec, &WorldOptions::default()).unwrap();
     let files = TwinFiles::beside(&tmp.path().join("twin.toml"), None);
-    world.write(&files, 0.0).unwrap();
+    world.write(&files, &world.declared()).unwrap();
     let twin = Scenario::load(&files.scenario).unwrap();
     let fit = compare(&twin, &rec).unwrap();
     // Every valid reading of the log sees a wall the map holds: a few are lost where a beam

@@ -17,7 +17,13 @@ fn map_files(dir: &Path, name: &str, image_bytes: &[u8], extra: &str) -> PathBuf
 }
 
 /// An 8- or 16-bit PNG of `samples` (`channels` a pixel, rows top first).
-fn png_bytes(width: u32, height: u32, color: png::ColorType, wide: bool, samples: &[u16]) -> Vec<u8> {
+fn png_bytes(
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    wide: bool,
+    samples: &[u16],
+) -> Vec<u8> {
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, width, height);
     encoder.set_color(color);
@@ -76,7 +82,12 @@ fn binary_and_plain_pgm_read_the_same_map() {
 #[test]
 fn negate_swaps_black_and_white() {
     let dir = tempfile::tempdir().unwrap();
-    let yaml = map_files(dir.path(), "m.pgm", b"P5 3 1 255\n\x00\xfe\x32", "negate: 1\n");
+    let yaml = map_files(
+        dir.path(),
+        "m.pgm",
+        b"P5 3 1 255\n\x00\xfe\x32",
+        "negate: 1\n",
+    );
     // Negated, p is the shade: 0 free, 254 occupied, 50 (p = 0.196) unknown.
     assert_eq!(picture(&load(&yaml).unwrap()), [".#?"]);
 }
@@ -122,10 +133,30 @@ fn png_gray_alpha_rgb_and_sixteen_bit_read_as_map_server_reads_them() {
         ("g16.png", Grayscale, true, vec![0, 65535, 52685], "#.?"),
         // Black opaque, white opaque, white transparent: trinary averages alpha in, so opaque
         // black is p = 0.5, unknown (map_server's own rule), and transparent white too.
-        ("ga.png", GrayscaleAlpha, false, vec![0, 255, 255, 255, 255, 0], "?.?"),
+        (
+            "ga.png",
+            GrayscaleAlpha,
+            false,
+            vec![0, 255, 255, 255, 255, 0],
+            "?.?",
+        ),
         // Pure red is a mean of 85, p 0.667; grey 200: p 0.216, unknown.
-        ("rgb.png", Rgb, false, vec![255, 0, 0, 255, 255, 255, 200, 200, 200], "#.?"),
-        ("rgba16.png", Rgba, true, vec![0, 0, 0, 65535, 65535, 65535, 65535, 65535, 65535, 65535, 65535, 0], "#.?"),
+        (
+            "rgb.png",
+            Rgb,
+            false,
+            vec![255, 0, 0, 255, 255, 255, 200, 200, 200],
+            "#.?",
+        ),
+        (
+            "rgba16.png",
+            Rgba,
+            true,
+            vec![
+                0, 0, 0, 65535, 65535, 65535, 65535, 65535, 65535, 65535, 65535, 0,
+            ],
+            "#.?",
+        ),
     ];
     for (name, color, wide, samples, expected) in cases {
         let bytes = png_bytes(3, 1, color, wide, &samples);
@@ -145,7 +176,12 @@ fn png_modes_scale_and_raw_and_negate() {
     // Raw: the value is percent occupancy, negate or not.
     let bytes = png_bytes(4, 1, Grayscale, false, &[0, 100, 50, 255]);
     for negate in ["0", "1"] {
-        let yaml = map_files(dir.path(), "r.png", &bytes, &format!("negate: {negate}\nmode: raw\n"));
+        let yaml = map_files(
+            dir.path(),
+            "r.png",
+            &bytes,
+            &format!("negate: {negate}\nmode: raw\n"),
+        );
         assert_eq!(picture(&load(&yaml).unwrap()), [".#??"], "negate {negate}");
     }
     // Negate in trinary mode on a PNG.
@@ -169,12 +205,42 @@ fn malformed_maps_are_errors_naming_the_file() {
     let d = dir.path();
     let name = |p: &str| d.join(p).display().to_string();
     let cases: [(&str, &[u8], &str, String); 6] = [
-        ("missing.pgm", b"", "negate: 0\n", format!("{}: ", name("gone.pgm"))),
-        ("t.pgm", b"P5 2 2 255\n\x00", "negate: 0\n", format!("{}:2: the pixels end", name("t.pgm"))),
-        ("x.bmp", b"BM\x00\x00", "negate: 0\n", format!("{}: neither a PGM", name("x.bmp"))),
-        ("p.png", b"\x89PNG\r\n\x1a\n\x00\x00", "negate: 0\n", format!("{}: not a PNG image", name("p.png"))),
-        ("y.pgm", b"P2 1 1 255 0", "negate: maybe\n", format!("{}:6: `negate`", name("map.yaml"))),
-        ("z.pgm", b"P2 1 1 255 0", "", format!("{}: no `negate`", name("map.yaml"))),
+        (
+            "missing.pgm",
+            b"",
+            "negate: 0\n",
+            format!("{}: ", name("gone.pgm")),
+        ),
+        (
+            "t.pgm",
+            b"P5 2 2 255\n\x00",
+            "negate: 0\n",
+            format!("{}:2: the pixels end", name("t.pgm")),
+        ),
+        (
+            "x.bmp",
+            b"BM\x00\x00",
+            "negate: 0\n",
+            format!("{}: neither a PGM", name("x.bmp")),
+        ),
+        (
+            "p.png",
+            b"\x89PNG\r\n\x1a\n\x00\x00",
+            "negate: 0\n",
+            format!("{}: not a PNG image", name("p.png")),
+        ),
+        (
+            "y.pgm",
+            b"P2 1 1 255 0",
+            "negate: maybe\n",
+            format!("{}:6: `negate`", name("map.yaml")),
+        ),
+        (
+            "z.pgm",
+            b"P2 1 1 255 0",
+            "",
+            format!("{}: no `negate`", name("map.yaml")),
+        ),
     ];
     for (image, bytes, extra, expected) in cases {
         let yaml = map_files(d, image, bytes, extra);
@@ -182,37 +248,59 @@ fn malformed_maps_are_errors_naming_the_file() {
             fs::write(&yaml, format!("image: gone.pgm\n{YAML}negate: 0\n")).unwrap();
         }
         let err = load(&yaml).unwrap_err().to_string();
-        assert!(err.starts_with(&expected), "{err:?} does not start with {expected:?}");
+        assert!(
+            err.starts_with(&expected),
+            "{err:?} does not start with {expected:?}"
+        );
     }
     let err = load(&d.join("nothing.yaml")).unwrap_err().to_string();
     assert!(err.starts_with(&name("nothing.yaml")), "{err}");
     // A truncated PNG: its pixels cut off.
     let mut bytes = png_bytes(64, 64, png::ColorType::Rgb, false, &vec![7; 64 * 64 * 3]);
     bytes.truncate(bytes.len() / 2);
-    let err = load(&map_files(d, "cut.png", &bytes, "negate: 0\n")).unwrap_err().to_string();
+    let err = load(&map_files(d, "cut.png", &bytes, "negate: 0\n"))
+        .unwrap_err()
+        .to_string();
     assert!(err.starts_with(&name("cut.png")), "{err}");
     // A directory named as the image.
     fs::create_dir(d.join("dir.pgm")).unwrap();
-    fs::write(d.join("map.yaml"), format!("image: dir.pgm\n{YAML}negate: 0\n")).unwrap();
+    fs::write(
+        d.join("map.yaml"),
+        format!("image: dir.pgm\n{YAML}negate: 0\n"),
+    )
+    .unwrap();
     let err = load(&d.join("map.yaml")).unwrap_err().to_string();
-    assert!(err.starts_with(&format!("{}: not a regular file", name("dir.pgm"))), "{err}");
+    assert!(
+        err.starts_with(&format!("{}: not a regular file", name("dir.pgm"))),
+        "{err}"
+    );
 }
 
 #[test]
 fn a_rotated_origin_is_refused_saying_why() {
     let dir = tempfile::tempdir().unwrap();
     let yaml = map_files(dir.path(), "m.pgm", b"P2 1 1 255 0", "negate: 0\n");
-    let text = fs::read_to_string(&yaml).unwrap().replace("2.0, 0.0]", "2.0, 0.3]");
+    let text = fs::read_to_string(&yaml)
+        .unwrap()
+        .replace("2.0, 0.0]", "2.0, 0.3]");
     fs::write(&yaml, text).unwrap();
     let err = load(&yaml).unwrap_err().to_string();
-    assert!(err.contains("map.yaml:3: `origin`'s yaw is 0.3") && err.contains("map_server ignores"), "{err}");
+    assert!(
+        err.contains("map.yaml:3: `origin`'s yaw is 0.3") && err.contains("map_server ignores"),
+        "{err}"
+    );
 }
 
 #[test]
 fn a_written_map_loads_back_identical() {
     let dir = tempfile::tempdir().unwrap();
     let mut map = OccupancyMap::new(0.05, [-12.345, 6.789_000_000_000_1], 7, 5).unwrap();
-    for (i, cell) in [Cell::Occupied, Cell::Free].into_iter().cycle().take(20).enumerate() {
+    for (i, cell) in [Cell::Occupied, Cell::Free]
+        .into_iter()
+        .cycle()
+        .take(20)
+        .enumerate()
+    {
         assert!(map.set_cell((i * 3) % 7, i % 5, cell));
     }
     let yaml = dir.path().join("built map.yaml");
@@ -230,22 +318,38 @@ fn writing_never_replaces_a_users_map() {
     let dir = tempfile::tempdir().unwrap();
     let map = OccupancyMap::new(0.05, [0.0, 0.0], 2, 2).unwrap();
     // map_saver's files: a user's map, not hilsim's.
-    let yaml = map_files(dir.path(), "map.pgm", b"P5\n# CREATOR: map_saver.cpp 0.050 m/pix\n1 1\n255\n\x00", "negate: 0\n");
+    let yaml = map_files(
+        dir.path(),
+        "map.pgm",
+        b"P5\n# CREATOR: map_saver.cpp 0.050 m/pix\n1 1\n255\n\x00",
+        "negate: 0\n",
+    );
     let before = fs::read(&yaml).unwrap();
     let err = map.write(&yaml).unwrap_err().to_string();
-    assert!(err.contains("map.pgm") && err.contains("refusing to replace it"), "{err}");
+    assert!(
+        err.contains("map.pgm") && err.contains("refusing to replace it"),
+        "{err}"
+    );
     assert_eq!(fs::read(&yaml).unwrap(), before);
     // The YAML alone is a user's too.
     fs::remove_file(dir.path().join("map.pgm")).unwrap();
     let err = map.write(&yaml).unwrap_err().to_string();
-    assert!(err.contains("map.yaml") && err.contains("refusing to replace it"), "{err}");
-    assert!(!dir.path().join("map.pgm").exists(), "nothing written before the refusal");
+    assert!(
+        err.contains("map.yaml") && err.contains("refusing to replace it"),
+        "{err}"
+    );
+    assert!(
+        !dir.path().join("map.pgm").exists(),
+        "nothing written before the refusal"
+    );
     // An input of the command.
     let other = dir.path().join("other.yaml");
     let err = OccupancyMap::check_output(&other, &[&other]).err();
     assert!(err.is_none(), "absent: not the same file");
     map.write(&other).unwrap();
-    let err = OccupancyMap::check_output(&other, &[&other]).unwrap_err().to_string();
+    let err = OccupancyMap::check_output(&other, &[&other])
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("is an input"), "{err}");
 }
 
@@ -255,6 +359,9 @@ fn an_empty_map_or_a_yaml_named_pgm_is_not_written() {
     let empty = OccupancyMap::new(0.05, [0.0, 0.0], 0, 0).unwrap();
     assert!(empty.write(&dir.path().join("e.yaml")).is_err());
     let map = OccupancyMap::new(0.05, [0.0, 0.0], 1, 1).unwrap();
-    let err = map.write(&dir.path().join("m.pgm")).unwrap_err().to_string();
+    let err = map
+        .write(&dir.path().join("m.pgm"))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("this very file"), "{err}");
 }

@@ -162,7 +162,10 @@ impl MapBuilder {
         let mut hi = [i64::MIN; 2];
         for (tile, cells) in self.tile_cells.iter().zip(self.counts.chunks(TILE_CELLS)) {
             for (i, _) in cells.iter().enumerate().filter(|(_, c)| touched(c)) {
-                let cell = [tile[0] + (i as i64 & (TILE_SIDE - 1)), tile[1] + (i as i64 >> TILE_BITS)];
+                let cell = [
+                    tile[0] + (i as i64 & (TILE_SIDE - 1)),
+                    tile[1] + (i as i64 >> TILE_BITS),
+                ];
                 for a in 0..2 {
                     lo[a] = lo[a].min(cell[a]);
                     hi[a] = hi[a].max(cell[a]);
@@ -264,7 +267,10 @@ impl MapBuilder {
                 };
             }
         }
-        let (ntw, nth) = ((hi_t[0] - lo_t[0] + 1) as usize, (hi_t[1] - lo_t[1] + 1) as usize);
+        let (ntw, nth) = (
+            (hi_t[0] - lo_t[0] + 1) as usize,
+            (hi_t[1] - lo_t[1] + 1) as usize,
+        );
         let mut index = vec![0u32; ntw * nth];
         for y in 0..th {
             for x in 0..tw {
@@ -296,7 +302,8 @@ impl MapBuilder {
             // `cover` made the index hold every cell the beam can reach.
             None => return,
         };
-        let within = ((cell[1] & (TILE_SIDE - 1)) << TILE_BITS | (cell[0] & (TILE_SIDE - 1))) as usize;
+        let within =
+            ((cell[1] & (TILE_SIDE - 1)) << TILE_BITS | (cell[0] & (TILE_SIDE - 1))) as usize;
         if let Some(c) = self.counts.get_mut(tile * TILE_CELLS + within) {
             if hit {
                 c.hits = c.hits.saturating_add(1);

@@ -12,15 +12,16 @@ pub struct MapHit {
     pub normal: [f64; 2],
 }
 
-/// How far from the hit cell the normal's fit looks, in cells: a 5 × 5 window holds five cells
-/// of a rasterised line, enough to give its direction within a few degrees, and little enough of
-/// a corner or a curve to still see one surface.
-const NORMAL_RADIUS_CELLS: i64 = 2;
+/// How far from the hit cell the normal's fit looks, in cells: a 7 × 7 window holds about
+/// fourteen faces of a rasterised line, enough to give its direction within 5° (4.8° the worst
+/// of `tests/occupancy_rays.rs`'s walls; 13° with a 5 × 5 window, 3.5° with 9 × 9), and little
+/// enough of a corner or a curve to still see one surface.
+const NORMAL_RADIUS_CELLS: i64 = 3;
 
-/// The cells' spread across their principal axis, as a fraction of the spread along it, above
-/// which they have no clear axis (a blob, a corner): a rasterised straight line's cells spread
-/// `1/12` of a cell² across it against `2` along it in a 5 × 5 window (ratio ≈ 0.04, at most
-/// ≈ 0.15 for the worst rounding); a square blob's ratio is 1.
+/// The faces' spread across their principal axis, as a fraction of the spread along it, above
+/// which they have no clear axis (a corner, a blob): a rasterised straight line's face
+/// midpoints spread a fraction of a cell² across it against several cells² along it; an L of
+/// two equal arms or a square blob's ratio is 1.
 const AXIS_RATIO: f64 = 0.25;
 
 impl OccupancyMap {
@@ -38,11 +39,12 @@ impl OccupancyMap {
     /// sees out (a robot inside a wall is the map's error, not something to report as a hit at
     /// 0 m).
     ///
-    /// The normal is fitted to the cells near the hit (see [`MapHit::normal`]): the principal
-    /// axis of the centres of the occupied cells within two cells of it that face the ray (have
-    /// a free or unknown neighbour on the ray's side) is the surface's direction, and the normal
-    /// is perpendicular to it. With fewer than three such cells or no clear axis (a lone cell, a
-    /// corner, a blob) it is the normal of the cell face the ray entered through.
+    /// The normal is fitted to the surface near the hit: the principal axis of the midpoints of
+    /// the faces between occupied cells and the open (free or unknown) cells on the ray's side
+    /// (those 4-connected to the cell the ray came from) within three cells of the hit is the
+    /// surface's direction, and the normal is perpendicular to it, facing the ray's origin. With
+    /// fewer than three faces or no clear axis (a lone cell, a corner, a blob) it is the normal
+    /// of the cell face the ray entered through.
     ///
     /// `None` when nothing is hit within `max_m`, or for a direction of zero length or a value
     /// that is not finite.
@@ -121,43 +123,66 @@ impl OccupancyMap {
             Some(_) => [0.0, -d[1].signum()],
             None => [-d[0], -d[1]],
         };
+        // The open cell the ray came from, across the face it entered through.
+        let from = match face {
+            Some(a) => {
+                let mut from = cell;
+                from[a] -= if d[a] > 0.0 { 1 } else { -1 };
+                from
+            }
+            None => cell,
+        };
         MapHit {
             distance_m: t.max(0.0),
-            normal: self.fitted_normal(cell, d).unwrap_or(face_normal),
+            normal: self.fitted_normal(cell, from, d).unwrap_or(face_normal),
         }
     }
 
-    /// The normal of the line through the occupied cells near `cell` that face a ray along `d`,
-    /// when they have a clear principal axis.
-    fn fitted_normal(&self, cell: [i64; 2], d: [f64; 2]) -> Option<[f64; 2]> {
-        let back = d.map(|v| {
-            if v > 0.0 {
-                -1
-            } else if v < 0.0 {
-                1
-            } else {
-                0
-            }
-        });
+    /// The normal of the surface the ray hit at `cell`, entered from the open cell `from`: the
+    /// principal axis of the midpoints of the faces between occupied cells and the open cells
+    /// that `from` reaches (4-connected) within the window around `cell`, which are the ray's
+    /// side of the surface (a thick wall's far side is out of reach, and so is a thin diagonal
+    /// wall's, which 4-connected open cells cannot cross).
+    fn fitted_normal(&self, cell: [i64; 2], from: [i64; 2], d: [f64; 2]) -> Option<[f64; 2]> {
+        const SIDE: usize = 2 * NORMAL_RADIUS_CELLS as usize + 1;
+        let local = |c: [i64; 2]| -> Option<usize> {
+            let (x, y) = (
+                c[0] - cell[0] + NORMAL_RADIUS_CELLS,
+                c[1] - cell[1] + NORMAL_RADIUS_CELLS,
+            );
+            (0..SIDE as i64)
+                .contains(&x)
+                .then_some(())
+                .filter(|()| (0..SIDE as i64).contains(&y))
+                .map(|()| y as usize * SIDE + x as usize)
+        };
+        let mut reached = [false; SIDE * SIDE];
+        let mut stack = Vec::with_capacity(SIDE * SIDE);
+        if let Some(i) = local(from).filter(|_| !self.is_occupied(from[0], from[1])) {
+            reached[i] = true;
+            stack.push(from);
+        }
         let (mut n, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-        for dy in -NORMAL_RADIUS_CELLS..=NORMAL_RADIUS_CELLS {
-            for dx in -NORMAL_RADIUS_CELLS..=NORMAL_RADIUS_CELLS {
-                let (x, y) = (cell[0] + dx, cell[1] + dy);
-                if !self.is_occupied(x, y) {
+        while let Some(c) = stack.pop() {
+            for step in [[1, 0], [-1, 0], [0, 1], [0, -1]] {
+                let next = [c[0] + step[0], c[1] + step[1]];
+                let Some(i) = local(next) else {
                     continue;
+                };
+                if self.is_occupied(next[0], next[1]) {
+                    // The face between them, relative to the hit cell's centre.
+                    let fx = (c[0] - cell[0]) as f64 + 0.5 * step[0] as f64;
+                    let fy = (c[1] - cell[1]) as f64 + 0.5 * step[1] as f64;
+                    n += 1.0;
+                    sx += fx;
+                    sy += fy;
+                    sxx += fx * fx;
+                    syy += fy * fy;
+                    sxy += fx * fy;
+                } else if !reached[i] {
+                    reached[i] = true;
+                    stack.push(next);
                 }
-                let faces_ray = (back[0] != 0 && !self.is_occupied(x + back[0], y))
-                    || (back[1] != 0 && !self.is_occupied(x, y + back[1]));
-                if !faces_ray {
-                    continue;
-                }
-                let (fx, fy) = (dx as f64, dy as f64);
-                n += 1.0;
-                sx += fx;
-                sy += fy;
-                sxx += fx * fx;
-                syy += fy * fy;
-                sxy += fx * fy;
             }
         }
         if n < 3.0 {

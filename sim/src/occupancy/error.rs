@@ -42,7 +42,11 @@ pub enum MapError {
 }
 
 impl MapError {
-    pub(crate) fn format(path: &std::path::Path, line: Option<usize>, message: impl Into<String>) -> Self {
+    pub(crate) fn format(
+        path: &std::path::Path,
+        line: Option<usize>,
+        message: impl Into<String>,
+    ) -> Self {
         Self::Format {
             path: path.to_path_buf(),
             line,

@@ -46,8 +46,8 @@ impl OccupancyMap {
     /// A file that cannot be read, YAML or an image that is not map_server's (naming the file,
     /// and the line where there is one), an image of more than [`super::MAX_CELLS`] pixels.
     pub fn load(yaml: &Path) -> Result<Self, MapError> {
-        let text = read_small_text(yaml, MAX_YAML_BYTES, "a map_server map's YAML")
-            .map_err(from_input)?;
+        let text =
+            read_small_text(yaml, MAX_YAML_BYTES, "a map_server map's YAML").map_err(from_input)?;
         let spec = yaml::parse(&text, yaml)?;
         let image = yaml
             .parent()
@@ -58,9 +58,7 @@ impl OccupancyMap {
         }
         let file = fs::File::open(&image).map_err(|err| MapError::io(&image, err))?;
         let mut input = BufReader::new(file);
-        let head = input
-            .fill_buf()
-            .map_err(|err| MapError::io(&image, err))?;
+        let head = input.fill_buf().map_err(|err| MapError::io(&image, err))?;
         let decoded = if head.starts_with(b"\x89PNG") {
             png_image::decode(input, &image, &spec.rules)?
         } else if head.starts_with(b"P5") || head.starts_with(b"P2") {
@@ -72,8 +70,13 @@ impl OccupancyMap {
                 "neither a PGM (P5, P2) nor a PNG image",
             ));
         };
-        check_geometry(spec.resolution_m, spec.origin, decoded.width, decoded.height)
-            .map_err(|err| MapError::format(yaml, None, err.to_string()))?;
+        check_geometry(
+            spec.resolution_m,
+            spec.origin,
+            decoded.width,
+            decoded.height,
+        )
+        .map_err(|err| MapError::format(yaml, None, err.to_string()))?;
         Ok(Self {
             resolution_m: spec.resolution_m,
             origin: spec.origin,

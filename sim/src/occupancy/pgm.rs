@@ -30,8 +30,7 @@ pub(super) const CREATOR: &str = "P5\n# CREATOR: hilsim ";
 
 /// The `P5` image of `cells` (`width` a row, bottom row first), top row first as PGM has it.
 pub(super) fn encode(width: usize, height: usize, cells: &[Cell], resolution_m: f64) -> Vec<u8> {
-    let mut out =
-        format!("{CREATOR}{resolution_m} m/pix\n{width} {height}\n255\n").into_bytes();
+    let mut out = format!("{CREATOR}{resolution_m} m/pix\n{width} {height}\n255\n").into_bytes();
     out.reserve(width * height);
     if width > 0 {
         for row in cells.chunks_exact(width).rev() {
@@ -57,7 +56,9 @@ pub(super) fn decode(input: impl BufRead, path: &Path, rules: &Rules) -> Result<
     let height = r.header_number("height")?;
     let maxval = r.header_number("maxval")?;
     if width == 0 || height == 0 {
-        return Err(r.fail(format!("an image of {width} × {height} pixels holds no map")));
+        return Err(r.fail(format!(
+            "an image of {width} × {height} pixels holds no map"
+        )));
     }
     if width.saturating_mul(height) > MAX_CELLS as u64 {
         return Err(r.fail(format!(
@@ -78,7 +79,14 @@ pub(super) fn decode(input: impl BufRead, path: &Path, rules: &Rules) -> Result<
     let mut cells = vec![Cell::Unknown; width * height];
     let mut samples = vec![0u16; width];
     let wide = max > 255;
-    let mut bytes = vec![0u8; if plain { 0 } else { width * (1 + usize::from(wide)) }];
+    let mut bytes = vec![
+        0u8;
+        if plain {
+            0
+        } else {
+            width * (1 + usize::from(wide))
+        }
+    ];
     for row in 0..height {
         if plain {
             for sample in &mut samples {
@@ -249,8 +257,14 @@ mod tests {
         let cases: [(&[u8], &str); 7] = [
             (b"P6 1 1 255\n\x00", "map.pgm:1: not a PGM"),
             (b"P2\n1\n", "map.pgm:3: the header ends before its height"),
-            (b"P2 1 1 256\n300", "map.pgm:2: a pixel of 300 is above maxval 256"),
-            (b"P5 2 2 255\n\x00\x00\x00", "map.pgm:2: the pixels end in row 2 of 2"),
+            (
+                b"P2 1 1 256\n300",
+                "map.pgm:2: a pixel of 300 is above maxval 256",
+            ),
+            (
+                b"P5 2 2 255\n\x00\x00\x00",
+                "map.pgm:2: the pixels end in row 2 of 2",
+            ),
             (b"P5 0 2 255\n", "holds no map"),
             (b"P5 100000 100000 255\n", "more than the 100000000 cells"),
             (b"P5 1 1 70000\n", "maxval must be 1 to 65535"),

@@ -107,19 +107,17 @@ pub(super) fn decode(
             })?;
         let mut frame = vec![0u8; size];
         let info = reader.next_frame(&mut frame).map_err(broken)?;
-        for (row, bytes) in frame
-            .chunks_exact(info.line_size)
-            .take(height)
-            .enumerate()
-        {
+        for (row, bytes) in frame.chunks_exact(info.line_size).take(height).enumerate() {
             put_row(row, bytes.get(..row_bytes).unwrap_or(bytes));
         }
     } else {
         for row in 0..height {
-            let bytes = reader
-                .next_row()
-                .map_err(broken)?
-                .ok_or_else(|| fail(&format_args!("the pixels end in row {} of {height}", row + 1)))?;
+            let bytes = reader.next_row().map_err(broken)?.ok_or_else(|| {
+                fail(&format_args!(
+                    "the pixels end in row {} of {height}",
+                    row + 1
+                ))
+            })?;
             put_row(row, bytes.data());
         }
     }

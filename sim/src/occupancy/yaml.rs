@@ -69,7 +69,10 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<MapYaml, MapError> {
             if entries.last().is_some_and(|(k, _)| !is_known(k)) {
                 continue;
             }
-            return Err(fail(line, format!("unexpected indented line {:?}", trimmed)));
+            return Err(fail(
+                line,
+                format!("unexpected indented line {:?}", trimmed),
+            ));
         }
         open_list = None;
         let Some((key, value)) = trimmed.split_once(':') else {
@@ -103,7 +106,9 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<MapYaml, MapError> {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, e)| e)
-            .ok_or_else(|| MapError::format(path, None, format!("no `{key}` (map_server needs it)")))
+            .ok_or_else(|| {
+                MapError::format(path, None, format!("no `{key}` (map_server needs it)"))
+            })
     };
     let scalar = |key: &str| -> Result<(&str, usize), MapError> {
         let entry = get(key)?;
@@ -114,9 +119,12 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<MapYaml, MapError> {
     };
     let number = |key: &str| -> Result<(f64, usize), MapError> {
         let (text, line) = scalar(key)?;
-        parse_number(text)
-            .map(|v| (v, line))
-            .ok_or_else(|| fail(line, format!("`{key}` must be a finite number, not {text:?}")))
+        parse_number(text).map(|v| (v, line)).ok_or_else(|| {
+            fail(
+                line,
+                format!("`{key}` must be a finite number, not {text:?}"),
+            )
+        })
     };
 
     let (image, image_line) = scalar("image")?;
@@ -125,7 +133,10 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<MapYaml, MapError> {
     }
     let (resolution_m, line) = number("resolution")?;
     if resolution_m <= 0.0 {
-        return Err(fail(line, format!("`resolution` must be positive, not {resolution_m}")));
+        return Err(fail(
+            line,
+            format!("`resolution` must be positive, not {resolution_m}"),
+        ));
     }
     let origin_entry = get("origin")?;
     let origin: Vec<f64> = match &origin_entry.value {
@@ -157,7 +168,10 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<MapYaml, MapError> {
         ("free_thresh", free_thresh, free_line),
     ] {
         if !(0.0..=1.0).contains(&v) {
-            return Err(fail(line, format!("`{key}` must be within [0, 1], not {v}")));
+            return Err(fail(
+                line,
+                format!("`{key}` must be within [0, 1], not {v}"),
+            ));
         }
     }
     if free_thresh > occupied_thresh {
@@ -351,14 +365,18 @@ mod tests {
     #[test]
     fn bad_yaml_names_the_file_and_line() {
         assert_eq!(
-            error(&MAP_SAVER.replace("0.000000]", "0.5]")).split(':').take(2).collect::<Vec<_>>(),
+            error(&MAP_SAVER.replace("0.000000]", "0.5]"))
+                .split(':')
+                .take(2)
+                .collect::<Vec<_>>(),
             ["map.yaml", "3"]
         );
         assert!(error(&MAP_SAVER.replace("0.000000]", "0.5]")).contains("yaw"));
-        assert!(error(&MAP_SAVER.replace("resolution: 0.050000", "resolution: -1"))
-            .starts_with("map.yaml:2: `resolution` must be positive"));
-        assert!(error(&MAP_SAVER.replace("negate: 0\n", ""))
-            .starts_with("map.yaml: no `negate`"));
+        assert!(
+            error(&MAP_SAVER.replace("resolution: 0.050000", "resolution: -1"))
+                .starts_with("map.yaml:2: `resolution` must be positive")
+        );
+        assert!(error(&MAP_SAVER.replace("negate: 0\n", "")).starts_with("map.yaml: no `negate`"));
         assert!(error(&format!("{MAP_SAVER}negate: 1\n")).contains("`negate` is given twice"));
         assert!(error(&MAP_SAVER.replace("origin: [", "origin: [1, ")).contains("three"));
         assert!(error(&MAP_SAVER.replace("0.65", "nan")).contains("finite number"));

@@ -103,10 +103,6 @@ fn a_slanted_wall_is_hit_within_a_cell_diagonal_with_its_normal_within_a_few_deg
                 }
             }
         }
-    }
-    eprintln!(
-        "worst distance error {:.4} m, normal {:.2}°",
-        worst.0, worst.1
     );
 }
 

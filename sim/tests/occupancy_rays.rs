@@ -103,7 +103,7 @@ fn a_slanted_wall_is_hit_within_a_cell_diagonal_with_its_normal_within_a_few_deg
                 }
             }
         }
-    );
+    }
 }
 
 #[test]

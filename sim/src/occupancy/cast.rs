@@ -51,9 +51,9 @@ impl OccupancyMap {
     #[must_use]
     pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<MapHit> {
         let norm = dir[0].hypot(dir[1]);
-        if !(norm > 0.0 && norm.is_finite() && origin.iter().all(|v| v.is_finite()))
-            || !(max_m >= 0.0)
-        {
+        let usable =
+            norm > 0.0 && norm.is_finite() && origin.iter().all(|v| v.is_finite()) && max_m >= 0.0;
+        if !usable {
             return None;
         }
         let d = [dir[0] / norm, dir[1] / norm];

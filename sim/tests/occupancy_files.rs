@@ -191,6 +191,16 @@ fn png_modes_scale_and_raw_and_negate() {
 }
 
 #[test]
+fn an_interlaced_png_reads_as_the_plain_one() {
+    // A 3 × 2 gray Adam7 PNG of the rows [0, 254, 205] and [254, 254, 0], made by hand (the
+    // `png` crate writes no interlaced images).
+    const ADAM7: &[u8] = b"\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\x00\x03\x00\x00\x00\x02\x08\x00\x00\x00\x01\xcf\x18\x09\x50\x00\x00\x00\x12\x49\x44\x41\x54\x78\x9c\x63\x60\x60\x38\xcb\xf0\x8f\xe1\xdf\x3f\x06\x00\x0f\x91\x03\xc8\x77\x9c\x40\xd0\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82";
+    let dir = tempfile::tempdir().unwrap();
+    let yaml = map_files(dir.path(), "i.png", ADAM7, "negate: 0\n");
+    assert_eq!(picture(&load(&yaml).unwrap()), ["#.?", "..#"]);
+}
+
+#[test]
 fn the_image_is_found_beside_the_yaml_not_the_working_directory() {
     let dir = tempfile::tempdir().unwrap();
     let sub = dir.path().join("maps");

@@ -64,7 +64,10 @@ pub fn with_odometry(scenario: &Scenario, model: &OdometryModel) -> Result<Scena
 /// # Errors
 /// A sentence when the calibration has nothing the scenario can take (no wheels, no mount, no
 /// model of a sensor the scenario has), or as [`with_odometry`].
-pub fn with_calibration(scenario: &Scenario, calibration: &Calibration) -> Result<Scenario, String> {
+pub fn with_calibration(
+    scenario: &Scenario,
+    calibration: &Calibration,
+) -> Result<Scenario, String> {
     let mut s = match &calibration.odometry {
         Some(model) => with_odometry(scenario, model)?,
         None => scenario.clone(),

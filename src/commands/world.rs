@@ -86,7 +86,10 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
             bail!(
                 "{}: the {} method's calibration has no lidar model, no wheels and no lidar \
                  mount for the scenario to declare",
-                args.calibration.as_deref().unwrap_or(Path::new("")).display(),
+                args.calibration
+                    .as_deref()
+                    .unwrap_or(Path::new(""))
+                    .display(),
                 c.method.name()
             );
         }

@@ -15,8 +15,12 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let run = || -> Result<(), String> {
-        let scenario = hilsim_sim::Scenario::load(&PathBuf::from(scenario)).map_err(|e| e.to_string())?;
-        let number = |s: &str| s.parse::<f64>().map_err(|_| format!("`{s}` is not a number"));
+        let scenario =
+            hilsim_sim::Scenario::load(&PathBuf::from(scenario)).map_err(|e| e.to_string())?;
+        let number = |s: &str| {
+            s.parse::<f64>()
+                .map_err(|_| format!("`{s}` is not a number"))
+        };
         let map = hilsim_twin::map_of_world(&scenario, number(resolution)?, number(offset)?)
             .map_err(|e| e.to_string())?;
         map.write(&PathBuf::from(out)).map_err(|e| e.to_string())

@@ -15,9 +15,10 @@ mod world;
 
 pub use error::TwinError;
 pub use fit::{compare, TwinFit, COMPARED_WITHIN_M};
-pub use raster::map_of_world;
 pub use path::{find_path, scan_points, FoundPath, PoseSource};
+pub use raster::map_of_world;
 pub use scans::{for_each_scan, scan_of, LogScan, ScanCounts};
 pub use world::{
-    build_world, Declared, TwinFiles, TwinMap, TwinWorld, WorldOptions, SCENARIO_FIRST_LINE, SCENARIO_KIND,
+    build_world, Declared, TwinFiles, TwinMap, TwinWorld, WorldOptions, SCENARIO_FIRST_LINE,
+    SCENARIO_KIND,
 };

@@ -9,25 +9,26 @@ pub struct MapHit {
     /// Distance from the ray's origin to where it enters the cell, metres.
     pub distance_m: f64,
     /// Distance from the ray's origin to the surface inside the cell, metres: where the ray
-    /// meets the line through the centres of the occupied cells near the hit (the surface the
-    /// normal is fitted to); without a clear surface, the nearest the ray comes to the cell's
-    /// centre. Within the cell: from `distance_m` to where the ray leaves it. A map built from
-    /// scans puts a wall's cells where its hits fell, so its surface runs through their centres
-    /// on average; the entry is half a cell short of it.
+    /// meets the line through the centres of the surface's first occupied cells (the faces the
+    /// normal is fitted to, moved half a cell's depth into them); without a clear surface, the
+    /// nearest the ray comes to the cell's centre. Within the cell: from `distance_m` to where
+    /// the ray leaves it. A map built from scans puts a wall's cells where its hits fell, so its
+    /// surface runs through their centres on average; the entry is half a cell short of it.
     pub surface_m: f64,
     /// The surface's normal at the hit: unit, world frame, facing the ray's origin.
     pub normal: [f64; 2],
 }
 
-/// How far from the hit cell the normal's fit looks, in cells: a 5 × 5 window holds five cells
-/// of a rasterised line, enough to give its direction within a few degrees, and little enough of
-/// a corner or a curve to still see one surface.
-const NORMAL_RADIUS_CELLS: i64 = 2;
+/// How far from the hit cell the normal's fit looks, in cells: a 7 × 7 window holds about
+/// fourteen faces of a rasterised line, enough to give its direction within 5° (4.8° the worst
+/// of `tests/occupancy_rays.rs`'s walls; 13° with a 5 × 5 window, 3.5° with 9 × 9), and little
+/// enough of a corner or a curve to still see one surface.
+const NORMAL_RADIUS_CELLS: i64 = 3;
 
-/// The cells' spread across their principal axis, as a fraction of the spread along it, above
-/// which they have no clear axis (a blob, a corner): a rasterised straight line's cells spread
-/// `1/12` of a cell² across it against `2` along it in a 5 × 5 window (ratio ≈ 0.04, at most
-/// ≈ 0.15 for the worst rounding); a square blob's ratio is 1.
+/// The faces' spread across their principal axis, as a fraction of the spread along it, above
+/// which they have no clear axis (a corner, a blob): a rasterised straight line's face
+/// midpoints spread a fraction of a cell² across it against several cells² along it; an L of
+/// two equal arms or a square blob's ratio is 1.
 const AXIS_RATIO: f64 = 0.25;
 
 impl OccupancyMap {
@@ -45,20 +46,21 @@ impl OccupancyMap {
     /// sees out (a robot inside a wall is the map's error, not something to report as a hit at
     /// 0 m).
     ///
-    /// The normal is fitted to the cells near the hit (see [`MapHit::normal`]): the principal
-    /// axis of the centres of the occupied cells within two cells of it that face the ray (have
-    /// a free or unknown neighbour on the ray's side) is the surface's direction, and the normal
-    /// is perpendicular to it. With fewer than three such cells or no clear axis (a lone cell, a
-    /// corner, a blob) it is the normal of the cell face the ray entered through.
+    /// The normal is fitted to the surface near the hit: the principal axis of the midpoints of
+    /// the faces between occupied cells and the open (free or unknown) cells on the ray's side
+    /// (those 4-connected to the cell the ray came from) within three cells of the hit is the
+    /// surface's direction, and the normal is perpendicular to it, facing the ray's origin. With
+    /// fewer than three faces or no clear axis (a lone cell, a corner, a blob) it is the normal
+    /// of the cell face the ray entered through.
     ///
     /// `None` when nothing is hit within `max_m`, or for a direction of zero length or a value
     /// that is not finite.
     #[must_use]
     pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<MapHit> {
         let norm = dir[0].hypot(dir[1]);
-        if !(norm > 0.0 && norm.is_finite() && origin.iter().all(|v| v.is_finite()))
-            || !(max_m >= 0.0)
-        {
+        let usable =
+            norm > 0.0 && norm.is_finite() && origin.iter().all(|v| v.is_finite()) && max_m >= 0.0;
+        if !usable {
             return None;
         }
         let d = [dir[0] / norm, dir[1] / norm];
@@ -138,19 +140,32 @@ impl OccupancyMap {
             Some(_) => [0.0, -d[1].signum()],
             None => [-d[0], -d[1]],
         };
+        // The open cell the ray came from, across the face it entered through.
+        let from = match face {
+            Some(a) => {
+                let mut from = cell;
+                from[a] -= if d[a] > 0.0 { 1 } else { -1 };
+                from
+            }
+            None => cell,
+        };
         let r = self.resolution_m;
-        let centre_of = |offset: [f64; 2]| {
+        // A point (cells from the hit cell's centre) relative to the ray's origin, metres.
+        let at = |offset: [f64; 2]| {
             [0, 1].map(|a| self.origin[a] + (cell[a] as f64 + 0.5 + offset[a]) * r - origin[a])
         };
-        let (normal, surface) = match self.fitted_normal(cell, d) {
-            Some((normal, offset)) => {
-                let c = centre_of(offset);
-                let along = normal[0] * d[0] + normal[1] * d[1];
-                let t = (normal[0] * c[0] + normal[1] * c[1]) / along;
-                (normal, if along < 0.0 { t } else { span[0] })
+        let (normal, surface) = match self.fitted_normal(cell, from, d) {
+            Some((n, faces)) => {
+                // The faces' line moved into the cells: by half a cell across an axis-aligned
+                // wall, by a third of the diagonal's half (0.35 cell) across a 45° staircase.
+                let depth = 0.5 * n[0].abs().max(n[1].abs());
+                let p = at([faces[0] - depth * n[0], faces[1] - depth * n[1]]);
+                let along = n[0] * d[0] + n[1] * d[1];
+                let t = (n[0] * p[0] + n[1] * p[1]) / along;
+                (n, if along < 0.0 { t } else { span[0] })
             }
             None => {
-                let c = centre_of([0.0, 0.0]);
+                let c = at([0.0, 0.0]);
                 (face_normal, c[0] * d[0] + c[1] * d[1])
             }
         };
@@ -166,37 +181,57 @@ impl OccupancyMap {
         }
     }
 
-    /// The normal of the line through the occupied cells near `cell` that face a ray along `d`,
-    /// when they have a clear principal axis, and their centroid's offset from `cell`, cells.
-    fn fitted_normal(&self, cell: [i64; 2], d: [f64; 2]) -> Option<([f64; 2], [f64; 2])> {
-        let back = d.map(|v| {
-            if v > 0.0 {
-                -1
-            } else if v < 0.0 {
-                1
-            } else {
-                0
-            }
-        });
+    /// The normal of the surface the ray hit at `cell`, entered from the open cell `from`: the
+    /// principal axis of the midpoints of the faces between occupied cells and the open cells
+    /// that `from` reaches (4-connected) within the window around `cell`, which are the ray's
+    /// side of the surface (a thick wall's far side is out of reach, and so is a thin diagonal
+    /// wall's, which 4-connected open cells cannot cross).
+    /// Also the faces' centroid, cells from the hit cell's centre.
+    fn fitted_normal(
+        &self,
+        cell: [i64; 2],
+        from: [i64; 2],
+        d: [f64; 2],
+    ) -> Option<([f64; 2], [f64; 2])> {
+        const SIDE: usize = 2 * NORMAL_RADIUS_CELLS as usize + 1;
+        let local = |c: [i64; 2]| -> Option<usize> {
+            let (x, y) = (
+                c[0] - cell[0] + NORMAL_RADIUS_CELLS,
+                c[1] - cell[1] + NORMAL_RADIUS_CELLS,
+            );
+            (0..SIDE as i64)
+                .contains(&x)
+                .then_some(())
+                .filter(|()| (0..SIDE as i64).contains(&y))
+                .map(|()| y as usize * SIDE + x as usize)
+        };
+        let mut reached = [false; SIDE * SIDE];
+        let mut stack = Vec::with_capacity(SIDE * SIDE);
+        if let Some(i) = local(from).filter(|_| !self.is_occupied(from[0], from[1])) {
+            reached[i] = true;
+            stack.push(from);
+        }
         let (mut n, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-        for dy in -NORMAL_RADIUS_CELLS..=NORMAL_RADIUS_CELLS {
-            for dx in -NORMAL_RADIUS_CELLS..=NORMAL_RADIUS_CELLS {
-                let (x, y) = (cell[0] + dx, cell[1] + dy);
-                if !self.is_occupied(x, y) {
+        while let Some(c) = stack.pop() {
+            for step in [[1, 0], [-1, 0], [0, 1], [0, -1]] {
+                let next = [c[0] + step[0], c[1] + step[1]];
+                let Some(i) = local(next) else {
                     continue;
+                };
+                if self.is_occupied(next[0], next[1]) {
+                    // The face between them, relative to the hit cell's centre.
+                    let fx = (c[0] - cell[0]) as f64 + 0.5 * step[0] as f64;
+                    let fy = (c[1] - cell[1]) as f64 + 0.5 * step[1] as f64;
+                    n += 1.0;
+                    sx += fx;
+                    sy += fy;
+                    sxx += fx * fx;
+                    syy += fy * fy;
+                    sxy += fx * fy;
+                } else if !reached[i] {
+                    reached[i] = true;
+                    stack.push(next);
                 }
-                let faces_ray = (back[0] != 0 && !self.is_occupied(x + back[0], y))
-                    || (back[1] != 0 && !self.is_occupied(x, y + back[1]));
-                if !faces_ray {
-                    continue;
-                }
-                let (fx, fy) = (dx as f64, dy as f64);
-                n += 1.0;
-                sx += fx;
-                sy += fy;
-                sxx += fx * fx;
-                syy += fy * fy;
-                sxy += fx * fy;
             }
         }
         if n < 3.0 {

@@ -5,7 +5,9 @@
 //! for 16-bit, a PGM's `maxval`):
 //!
 //! * the shade is the mean of the pixel's channels over the maximum; in `trinary` mode the alpha
-//!   channel is averaged in with the colours, in `scale` and `raw` modes it is not;
+//!   channel is averaged in with the colours, in `scale` and `raw` modes it is not (so in
+//!   `trinary` mode an opaque black pixel of a gray-and-alpha image is `p = 0.5`, unknown with
+//!   the usual thresholds: map_server's own rule, kept so a map reads here as it does there);
 //! * the occupancy is `p = 1 - shade` (`p = shade` when `negate`);
 //! * `trinary` and `scale`: `p > occupied_thresh` is occupied, `p < free_thresh` free, anything
 //!   between unknown (map_server's `scale` mode gives the in-between cells a cost; a ray passes

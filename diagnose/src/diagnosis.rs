@@ -80,7 +80,15 @@ pub fn diagnose_with_progress(
 ) -> Result<Diagnosis, MismatchError> {
     progress(Stage::Aligning);
     let aligned = align::align(physics, recording)?;
-    let options = &options.against(&aligned);
+    let mut options = options.against(&aligned);
+    // A world known only to a map's cells: a lidar departure within them is as likely the
+    // map's as the lidar's.
+    let world_m = physics
+        .declared()
+        .lidar
+        .map_or(0.0, |l| l.world_uncertainty_m);
+    options.floors.lidar_m = options.floors.lidar_m.max(world_m);
+    let options = &options;
     // Against an estimate, the drive is judged along a second one that follows the encoders
     // between the lidar's corrections: the first follows the commands, so the drive's residuals
     // along it would be the commands against themselves.

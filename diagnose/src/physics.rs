@@ -111,6 +111,10 @@ pub struct DeclaredLidar {
     pub min_range_m: f64,
     /// Where the lidar sits on the robot, as declared.
     pub mount: Mount,
+    /// How far the world's surfaces may be from where the scenario puts them, metres: 0 for
+    /// drawn shapes, half a cell for an occupancy map. A lidar departure smaller than this is
+    /// as likely the world's as the lidar's, and is not reported.
+    pub world_uncertainty_m: f64,
 }
 
 /// One lidar reading to predict.
@@ -203,7 +207,7 @@ pub struct OdometryPrediction {
 ///     scenario: "corridor".into(), start: Pose::default(), wheel_base_m: 0.23,
 ///     lidar: Some(DeclaredLidar {
 ///         snapshot: false, rpm: 300.0, max_range_m: 6.0, min_range_m: 0.06,
-///         mount: Default::default(),
+///         mount: Default::default(), world_uncertainty_m: 0.0,
 ///     }),
 ///     sonar_half_angle_deg: None, odometer: false,
 ///     actuation: Default::default(),

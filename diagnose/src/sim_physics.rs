@@ -85,8 +85,8 @@ impl SimPhysics {
         for (i, b) in s.world.boards.iter().enumerate() {
             names.push(format!("board {i} ({})", material(&b.material)));
         }
+        let world = World::new(scenario);
         Ok(Self {
-            world: World::new(scenario),
             declared: Declared {
                 scenario: s.name.clone(),
                 start: Pose {
@@ -102,6 +102,7 @@ impl SimPhysics {
                     max_range_m: l.max_range_m,
                     min_range_m: l.min_range_m,
                     mount: l.mount.into(),
+                    world_uncertainty_m: world.surface_uncertainty_m(),
                 }),
                 sonar_half_angle_deg: s.sensors.sonar.as_ref().map(|u| {
                     s.effects
@@ -115,6 +116,7 @@ impl SimPhysics {
                     wander_tau_s: a.wander_tau_s,
                 },
             },
+            world,
             scenario: scenario.clone(),
             names,
             beams: RwLock::default(),

@@ -66,6 +66,7 @@ impl Corridor {
                     max_range_m: 8.0,
                     min_range_m: 0.06,
                     mount: Default::default(),
+                    world_uncertainty_m: 0.0,
                 }),
                 sonar_half_angle_deg: None,
                 odometer: false,

@@ -48,6 +48,17 @@ const GH_WEIGHTS: [f64; 7] = [
     0.000_548_268_855_972,
 ];
 
+/// The obliquest incidence a surface's uncertainty is carried along the beam at: |cos θ| of
+/// 84° (ten times the normal's).
+const MIN_SURFACE_COS: f64 = 0.1;
+
+/// The variance a reading gets from the uncertainty of the surface it hit (a map's cell): the
+/// surface's along its normal, carried along the beam (divided by |cos θ|).
+fn surface_var_m2(ret: &BeamReturn) -> f64 {
+    let sd = ret.hit.surface_sd_m / ret.cos_incidence.max(MIN_SURFACE_COS);
+    sd * sd
+}
+
 /// Directions sampled across an edge: every half σ over ±3.5 σ of the direction noise (the
 /// Gaussian's mass beyond is 5e-4).
 const DENSE_NODES: usize = 15;
@@ -281,7 +292,7 @@ impl LidarPredictor {
             let ranged = self.effects.ranged_m(ret, t_s);
             let mean = self.model.mean(ranged);
             let sd = self.model.std_dev(ranged);
-            let var = sd * sd + ROUNDING_VAR_M2;
+            let var = sd * sd + ROUNDING_VAR_M2 + surface_var_m2(ret);
             // A reading outside [min, max] is reported invalid: a valid one comes from the part
             // of each node's distribution inside (its weight the probability of landing there).
             let valid = self.limited(Gaussian::new(1.0, mean, var.sqrt())).mass();

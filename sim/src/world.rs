@@ -33,6 +33,10 @@ pub struct RayHit {
     pub normal: [f64; 2],
     /// The surface material's reflectivity, (0, 1].
     pub reflectivity: f64,
+    /// How uncertain the surface's position is along its normal, metres (one standard
+    /// deviation): 0 for a scenario's drawn shapes, the quantisation of a map's cell
+    /// (`resolution / √12`, the surface anywhere across the cell) for a map's.
+    pub surface_sd_m: f64,
 }
 
 /// The physics world: obstacles plus the robot's body.
@@ -200,6 +204,15 @@ impl World {
         )
     }
 
+    /// How far the world's surfaces may be from where it puts them, metres: half a cell of its
+    /// map (the surface anywhere across a cell), 0 for drawn shapes alone.
+    #[must_use]
+    pub fn surface_uncertainty_m(&self) -> f64 {
+        self.map
+            .as_ref()
+            .map_or(0.0, |(m, _)| m.resolution_m() / 2.0)
+    }
+
     /// Puts the robot at `pose`, at rest: a recorded path moves it (the physics then finds its
     /// contacts there, not its motion).
     pub(crate) fn place_robot(&mut self, pose: Pose) {
@@ -263,6 +276,7 @@ impl World {
                 obstacle,
                 normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
                 reflectivity,
+                surface_sd_m: 0.0,
             })
         });
         let Some((map, reflectivity)) = &self.map else {
@@ -275,6 +289,7 @@ impl World {
                 obstacle: Obstacle::Map,
                 normal: cell.normal,
                 reflectivity: *reflectivity,
+                surface_sd_m: map.resolution_m() / 12f64.sqrt(),
             }),
             _ => shape_hit,
         }

@@ -28,6 +28,8 @@ mod error;
 mod export;
 mod import;
 pub mod msgs;
+pub mod ros1;
+mod tf;
 pub mod topics;
 
 pub use error::Error;
@@ -42,6 +44,8 @@ pub use export::{
     START_NS,
 };
 pub use import::{
-    angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,
+    angle_deg, decimal_of_f32, import, read_file, Converter, Encoding, Fault, ImportOptions,
+    ImportReport,
 };
+pub use tf::Source as TfSource;
 pub use topics::{Kind, Role};

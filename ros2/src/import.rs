@@ -177,6 +177,36 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     let container = Container::open(bag)?;
     let topic_types = container.topic_types(bag)?;
     let mut chosen = topics::choose(bag, &topic_types, &options.topics)?;
+    // TF: each topic of TFMessage, static when named so (`/tf_static`, `/robot1/tf_static`).
+    let tf_topics: BTreeMap<String, tf::Source> = topic_types
+        .iter()
+        .filter(|(_, ty)| Kind::of(ty) == Some(Kind::Tf))
+        .map(|(topic, _)| {
+            let source = if topic.ends_with("tf_static") {
+                tf::Source::Static
+            } else {
+                tf::Source::Dynamic
+            };
+            (topic.clone(), source)
+        })
+        .collect();
+    if chosen.is_empty() && !tf_topics.values().any(|s| *s == tf::Source::Dynamic) {
+        let all = if topic_types.is_empty() {
+            "none".to_string()
+        } else {
+            topics::listing(
+                topic_types.iter().map(|(t, ty)| format!("{t} ({ty})")),
+                ", ",
+            )
+        };
+        return Err(Error::bag(
+            bag,
+            format!(
+                "no topic of a type hilsim reads (LaserScan, Odometry, JointState, Twist, \
+                 TwistStamped, Range, PoseStamped, TFMessage); topics: {all}"
+            ),
+        ));
+    }
     let mut notes = Vec::new();
     let meta = options.meta.clone().unwrap_or_else(|| {
         let meta = Meta::default();
@@ -222,20 +252,7 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         }
         _ => {}
     }
-    // TF: each topic of TFMessage, static when named so (`/tf_static`, `/robot1/tf_static`).
-    let tf_topics: BTreeMap<String, tf::Source> = topic_types
-        .iter()
-        .filter(|(_, ty)| Kind::of(ty) == Some(Kind::Tf))
-        .map(|(topic, _)| {
-            let source = if topic.ends_with("tf_static") {
-                tf::Source::Static
-            } else {
-                tf::Source::Dynamic
-            };
-            (topic.clone(), source)
-        })
-        .collect();
-    if !chosen.contains_key(&Role::Odometry) {
+    if let std::collections::btree_map::Entry::Vacant(odometry) = chosen.entry(Role::Odometry) {
         let dynamic: Vec<&String> = tf_topics
             .iter()
             .filter(|(_, s)| **s == tf::Source::Dynamic)
@@ -250,7 +267,7 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
                 "no Odometry topic: the odometry from {}'s {ODOM_FRAME} → base transforms",
                 printable(topic)
             ));
-            chosen.insert(Role::Odometry, ((*topic).clone(), Kind::Tf));
+            odometry.insert(((*topic).clone(), Kind::Tf));
         }
     }
     if let Container::Ros2 { channels, .. } = &container {
@@ -268,23 +285,6 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
                 }
             }
         }
-    }
-    if chosen.is_empty() {
-        let all = if topic_types.is_empty() {
-            "none".to_string()
-        } else {
-            topics::listing(
-                topic_types.iter().map(|(t, ty)| format!("{t} ({ty})")),
-                ", ",
-            )
-        };
-        return Err(Error::bag(
-            bag,
-            format!(
-                "no topic of a type hilsim reads (LaserScan, Odometry, JointState, Twist, \
-                 TwistStamped, Range, PoseStamped, TFMessage); topics: {all}"
-            ),
-        ));
     }
     let tables = Tables {
         odometry: chosen.contains_key(&Role::Odometry),
@@ -602,9 +602,9 @@ where
     let damage = ros1::stream_while(file, |item| {
         match item {
             ros1::Item::Connection(c) => {
-                if !routes.contains_key(&c.id) {
+                if let std::collections::hash_map::Entry::Vacant(e) = routes.entry(c.id) {
                     if let Some(r) = route(converter, &c.topic) {
-                        routes.insert(c.id, r);
+                        e.insert(r);
                     }
                 }
             }

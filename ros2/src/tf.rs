@@ -219,36 +219,47 @@ impl Tree {
         })
     }
 
-    /// `name` in its root frame, the root, and whether every edge was static.
-    fn from_root(&self, name: &str) -> (Rigid, String, bool) {
-        let mut at = name.to_string();
-        let mut rigid = Rigid::IDENTITY;
-        let mut all_static = true;
+    /// `name`'s ancestors from itself up to its root: each frame, `name` in that frame, and
+    /// whether every edge up to it was static.
+    fn ancestors(&self, name: &str) -> Vec<(String, Rigid, bool)> {
+        let mut chain = vec![(name.to_string(), Rigid::IDENTITY, true)];
         // A cycle (a bag's TF can say anything) ends after as many steps as there are edges.
-        for _ in 0..=self.edges.len() {
-            let Some((parent, edge, source)) = self.parent(&at) else {
+        for _ in 0..self.edges.len() {
+            let Some((at, rigid, all_static)) = chain.last() else {
                 break;
             };
-            rigid = edge.then(&rigid);
-            all_static &= source == Source::Static;
-            at = parent.to_string();
+            let Some((parent, edge, source)) = self.parent(at) else {
+                break;
+            };
+            let next = (
+                parent.to_string(),
+                edge.then(rigid),
+                *all_static && source == Source::Static,
+            );
+            chain.push(next);
         }
-        (rigid, at, all_static)
+        chain
     }
 
-    /// `sensor`'s frame in `base`'s, composed over the frames between (up to their common
-    /// root); `None` when the two are not in one tree.
+    /// `sensor`'s frame in `base`'s, composed over the frames between them (up to the first
+    /// frame both descend from); `None` when the two are not in one tree.
     #[must_use]
     pub fn mount(&self, base: &str, sensor: &str) -> Option<Found> {
         if !(self.has(base) && self.has(sensor)) {
             return None;
         }
-        let (base_in_root, base_root, base_static) = self.from_root(base);
-        let (sensor_in_root, sensor_root, sensor_static) = self.from_root(sensor);
-        (base_root == sensor_root).then(|| Found {
-            rigid: base_in_root.inverse().then(&sensor_in_root),
-            all_static: base_static && sensor_static,
-        })
+        let sensor_up = self.ancestors(sensor);
+        for (frame, base_in, base_static) in self.ancestors(base) {
+            if let Some((_, sensor_in, sensor_static)) =
+                sensor_up.iter().find(|(f, _, _)| *f == frame)
+            {
+                return Some(Found {
+                    rigid: base_in.inverse().then(sensor_in),
+                    all_static: base_static && *sensor_static,
+                });
+            }
+        }
+        None
     }
 }
 
@@ -317,6 +328,12 @@ mod tests {
         );
         tree.add(Source::Static, &edge("laser", "base_link", 0.0, 0.0, 0.0));
         let _ = tree.mount("base_link", "laser");
+        // Frames below a moving one: the moving edge is not composed.
+        let mut moving = Tree::default();
+        moving.add(Source::Dynamic, &edge("odom", "base_link", 5.0, 1.0, 2.0));
+        moving.add(Source::Static, &edge("base_link", "laser", 0.1, 0.0, 0.0));
+        let found = moving.mount("base_link", "laser").unwrap();
+        assert_eq!((found.rigid.translation.x, found.all_static), (0.1, true));
         let mut flat = edge("a", "b", 0.0, 0.0, 0.0);
         flat.transform.rotation = Quaternion {
             x: 0.0,

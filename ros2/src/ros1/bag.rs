@@ -131,9 +131,12 @@ pub fn is_ros1_bag(path: &Path) -> bool {
     read.is_ok() && head == b"#ROSBAG V"
 }
 
+/// A header field: its name and value.
+type Field<'a> = (&'a [u8], &'a [u8]);
+
 /// The fields of a record header (or of a connection's data): `name=value` each after its
 /// `uint32` length.
-fn fields(mut bytes: &[u8]) -> Result<Vec<(&[u8], &[u8])>, String> {
+fn fields(mut bytes: &[u8]) -> Result<Vec<Field<'_>>, String> {
     let mut out = Vec::new();
     while !bytes.is_empty() {
         let Some((len, rest)) = bytes.split_first_chunk::<4>() else {
@@ -156,21 +159,21 @@ fn fields(mut bytes: &[u8]) -> Result<Vec<(&[u8], &[u8])>, String> {
     Ok(out)
 }
 
-fn field<'a>(fields: &[(&[u8], &'a [u8])], name: &str) -> Option<&'a [u8]> {
+fn field<'a>(fields: &[Field<'a>], name: &str) -> Option<&'a [u8]> {
     fields
         .iter()
         .find(|(n, _)| *n == name.as_bytes())
         .map(|(_, v)| *v)
 }
 
-fn field_u32(fields: &[(&[u8], &[u8])], name: &str) -> Result<u32, String> {
+fn field_u32(fields: &[Field<'_>], name: &str) -> Result<u32, String> {
     field(fields, name)
         .and_then(|v| v.try_into().ok())
         .map(u32::from_le_bytes)
         .ok_or_else(|| format!("no 4-byte `{name}` field"))
 }
 
-fn field_u64(fields: &[(&[u8], &[u8])], name: &str) -> Result<u64, String> {
+fn field_u64(fields: &[Field<'_>], name: &str) -> Result<u64, String> {
     field(fields, name)
         .and_then(|v| v.try_into().ok())
         .map(u64::from_le_bytes)
@@ -189,7 +192,7 @@ fn name(bytes: &[u8], what: &str) -> Result<String, String> {
 }
 
 /// A record's op, from its header fields.
-fn op_of(fields: &[(&[u8], &[u8])]) -> Result<u8, String> {
+fn op_of(fields: &[Field<'_>]) -> Result<u8, String> {
     match field(fields, "op") {
         Some([op]) => Ok(*op),
         _ => Err("a record without its one-byte `op`".into()),
@@ -198,7 +201,7 @@ fn op_of(fields: &[(&[u8], &[u8])]) -> Result<u8, String> {
 
 /// A connection record: the topic from its header, the type from its data (the publisher's
 /// connection header).
-fn connection(header: &[(&[u8], &[u8])], data: &[u8]) -> Result<Connection, String> {
+fn connection(header: &[Field<'_>], data: &[u8]) -> Result<Connection, String> {
     let id = field_u32(header, "conn")?;
     let topic = field(header, "topic").ok_or("a connection without its topic")?;
     let data = fields(data)?;
@@ -211,7 +214,7 @@ fn connection(header: &[(&[u8], &[u8])], data: &[u8]) -> Result<Connection, Stri
 }
 
 /// A message record's connection and time.
-fn message_of(header: &[(&[u8], &[u8])]) -> Result<(u32, i64), String> {
+fn message_of(header: &[Field<'_>]) -> Result<(u32, i64), String> {
     let conn = field_u32(header, "conn")?;
     let time = field_u64(header, "time")?;
     // `time`: uint32 seconds, then uint32 nanoseconds.

@@ -280,6 +280,8 @@ fn split_length<'a>(bytes: &'a [u8], what: &str) -> Result<(&'a [u8], &'a [u8]),
 /// Decompresses a chunk's `data` into `out` (cleared first): exactly `size` bytes.
 fn decompress(compression: &str, data: &[u8], size: u32, out: &mut Vec<u8>) -> Result<(), String> {
     out.clear();
+    // The declared size, within the chunk limit, at once: no doubling past it while reading.
+    out.reserve_exact(size as usize + 1);
     let limit = u64::from(size) + 1;
     let read = match compression {
         "bz2" => bzip2::read::BzDecoder::new(data)
@@ -381,10 +383,14 @@ impl Records {
         Ok(Some(Head { header, data_len }))
     }
 
-    /// `len` bytes into `out` (cleared first): read as they come, so a length that the file
-    /// does not hold allocates no more than the file has.
+    /// `len` bytes into `out` (cleared first); a length beyond the file's end is a record cut
+    /// short, before anything is allocated for it.
     fn bytes(&mut self, len: u32, out: &mut Vec<u8>) -> Result<(), String> {
         out.clear();
+        if self.at + u64::from(len) > self.size {
+            return Err("a record cut short".to_string());
+        }
+        out.reserve_exact(len as usize);
         let n = (&mut self.file)
             .take(u64::from(len))
             .read_to_end(out)

@@ -210,9 +210,14 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     let mut notes = Vec::new();
     let meta = options.meta.clone().unwrap_or_else(|| {
         let meta = Meta::default();
+        let sonar = if chosen.contains_key(&Role::Sonar) {
+            "; the sonar at the robot's centre, facing forward"
+        } else {
+            ""
+        };
         notes.push(format!(
-            "no --meta: a minimal meta.toml (wheel base {} m, a guess; the sensors' mounts as \
-             below); give your robot's with --meta FILE",
+            "no --meta: a minimal meta.toml (wheel base {} m, a guess{sonar}); give your \
+             robot's with --meta FILE",
             meta.robot.wheel_base_m
         ));
         meta

@@ -54,7 +54,8 @@ fn robot_bag() -> Vec<u8> {
         record(&fields, data)
     };
     let mut scan = header(100, "laser");
-    for x in [0.0f32, 1.5708, 1.5708, 0.0, 0.1, 0.1, 8.0] {
+    let quarter = std::f32::consts::FRAC_PI_2;
+    for x in [0.0f32, quarter, quarter, 0.0, 0.1, 0.1, 8.0] {
         scan.extend(x.to_le_bytes());
     }
     scan.extend(2u32.to_le_bytes());

@@ -80,7 +80,8 @@ pub struct Damage {
     pub chunks: u64,
     /// Why the first skipped chunk was.
     pub first_chunk: Option<String>,
-    /// Chunks whose records stopped parsing part-way (the rest of the chunk skipped).
+    /// Chunks whose records stopped parsing part-way (the rest of the chunk skipped), and
+    /// records outside chunks skipped.
     pub records: u64,
     /// Why the first such record did not parse.
     pub first_record: Option<String>,
@@ -111,7 +112,7 @@ impl Damage {
         }
         if self.records > 0 {
             notes.push(format!(
-                "{} chunks read only up to a damaged record (the first: {})",
+                "{} chunks read only up to a damaged record, or records skipped (the first: {})",
                 self.records,
                 self.first_record.as_deref().unwrap_or("")
             ));
@@ -626,6 +627,14 @@ pub(crate) fn stream_while(
             | op::CHUNK_INFO
             | op::CONNECTION
             | op::MESSAGE_DATA => {
+                if matches!(op, op::CONNECTION | op::MESSAGE_DATA) {
+                    damage.records += 1;
+                    damage.first_record.get_or_insert(format!(
+                        "a record of {} bytes, beyond the {} MiB one may have",
+                        head.data_len,
+                        RECORD_LIMIT >> 20
+                    ));
+                }
                 if let Err(why) = records.skip(head.data_len) {
                     stop(&mut damage, why);
                     break;

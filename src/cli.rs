@@ -45,8 +45,8 @@ pub enum Command {
     /// Draw a recording as one self-contained HTML page: the world, the paths, the scans, each
     /// sensor's error against distance and the calibration.
     Report(ReportArgs),
-    /// Turn a ROS 2 bag (MCAP or SQLite3, CDR), or a robot's log (CARMEN `.log`/`.clf`, CoreSLAM
-    /// `.dat`), into a recording.
+    /// Turn a ROS 2 bag (MCAP or SQLite3, CDR), a ROS 1 bag (`.bag`), or a robot's log (CARMEN
+    /// `.log`/`.clf`, CoreSLAM `.dat`), into a recording.
     Import(crate::commands::import::ImportArgs),
     /// Write a recording as ROS 2 messages in an MCAP file (Foxglove, RViz, `ros2 bag play`).
     Export(crate::commands::export::ExportArgs),

@@ -208,7 +208,8 @@ fn starts_like_mcap(path: &Path) -> bool {
 }
 
 /// What a file that is no bag is.
-const NOT_A_BAG: &str = "not an MCAP file (a ROS 2 bag's storage must be MCAP or SQLite3)";
+const NOT_A_BAG: &str =
+    "not an MCAP file (a ROS 2 bag is MCAP or SQLite3; a ROS 1 bag starts `#ROSBAG V2.0`)";
 
 /// One line for an MCAP error.
 fn mcap_error(path: &Path, err: McapError) -> Error {

@@ -1,18 +1,27 @@
-//! A ROS 2 bag into a recording: each chosen topic's messages into its table as they are read
-//! (see `docs/ros2.md` for what becomes of each field).
+//! A bag into a recording: each chosen topic's messages into its table as they are read, and
+//! what the bag's TF says of the robot into `meta.toml` (see `docs/ros2.md` for what becomes of
+//! each field). A ROS 2 bag (MCAP or SQLite3, CDR messages) and a ROS 1 bag (rosbag format
+//! 2.0, ROS 1 messages) differ only in their container and serialisation: both feed the one
+//! [`Converter`].
 
 use std::collections::{BTreeMap, HashMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use hilsim_recording::{
-    printable, wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, OdometrySample,
+    printable, wrap_angle, CommandSample, LidarDecimals, LidarSample, Meta, Mount, OdometrySample,
     RecordingStream, SampleSink, SonarMount, SonarSample, Tables, TruthSample,
 };
+use serde::de::DeserializeOwned;
 
 use crate::bag::{self, Item};
 use crate::cdr::{decode, decode_whole};
-use crate::msgs::{JointState, LaserScan, Odometry, PoseStamped, Range, Time, Twist, TwistStamped};
-use crate::topics::{self, Chosen, Kind, Role};
+use crate::msgs::{
+    Header, JointState, LaserScan, Odometry, Pose, PoseStamped, Range, TfMessage, Time, Twist,
+    TwistStamped,
+};
+use crate::ros1::{self, FromRos1};
+use crate::tf::{self, Rigid};
+use crate::topics::{self, Chosen, Kind, Role, TopicTypes};
 use crate::Error;
 
 /// The metadata record an exported file starts with: its `start_ns` is the recording's t = 0,
@@ -31,6 +40,12 @@ const OTHER_CLOCK_NS: i64 = 60_000_000_000;
 
 /// Unstamped commands held until the first stamped message says which clock they are on.
 const MAX_PENDING_COMMANDS: usize = 1 << 20;
+
+/// The frame odometry is in (REP 105); a namespaced one (`robot1/odom`) counts too.
+const ODOM_FRAME: &str = "odom";
+
+/// The robot's frame when no odometry names it: REP 105's `base_link`, else `base_footprint`.
+const BASE_FRAMES: [&str; 2] = ["base_link", "base_footprint"];
 
 /// What `import` is told besides the bag.
 #[derive(Debug, Clone, Default)]
@@ -53,18 +68,104 @@ pub struct ImportReport {
     pub chosen: Chosen,
     /// Rows written into each table.
     pub rows: BTreeMap<Role, u64>,
-    /// Bytes of MCAP read.
+    /// Bytes of bag read.
     pub bytes: u64,
     /// Sentences for people: what was assumed, skipped or repaired.
     pub notes: Vec<String>,
 }
 
-/// Imports the bag at `bag` (an MCAP file or a bag directory) as a recording at `out`, written
-/// as it is read and put in place when complete ([`RecordingStream`]).
+/// How a message's bytes are laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Encoding {
+    /// ROS 2: CDR after a 4-byte encapsulation header.
+    #[default]
+    Cdr,
+    /// ROS 1: packed little-endian, `std_msgs/Header` with its `seq`.
+    Ros1,
+}
+
+/// A message type read in either serialisation.
+trait Wire: DeserializeOwned + FromRos1 {}
+impl<T: DeserializeOwned + FromRos1> Wire for T {}
+
+/// Decodes a whole message of `encoding` (at most `appended` bytes of fields a newer ROS 2
+/// distribution adds are allowed after it).
+fn decode_as<T: Wire>(encoding: Encoding, data: &[u8], appended: usize) -> Result<T, String> {
+    match encoding {
+        Encoding::Cdr => decode_whole(data, appended),
+        Encoding::Ros1 => ros1::decode_whole(data),
+    }
+}
+
+/// The stamp of a message of `kind`: its header's, or a TF message's first transform's.
+fn first_stamp(kind: Kind, encoding: Encoding, data: &[u8]) -> Option<Time> {
+    match (kind, encoding) {
+        (Kind::Tf, _) => decode_as::<TfMessage>(encoding, data, 0)
+            .ok()?
+            .transforms
+            .first()
+            .map(|t| t.header.stamp),
+        (_, Encoding::Cdr) => decode::<Header>(data).ok().map(|h| h.stamp),
+        (_, Encoding::Ros1) => ros1::decode_prefix::<Header>(data).ok().map(|h| h.stamp),
+    }
+}
+
+/// A bag's container: a ROS 2 bag's files (MCAP or SQLite3) and their channels, or a ROS 1
+/// bag's one file and its connections.
+enum Container {
+    Ros2 {
+        files: Vec<PathBuf>,
+        channels: Vec<bag::Channel>,
+    },
+    Ros1 {
+        connections: Vec<ros1::Connection>,
+    },
+}
+
+impl Container {
+    fn open(path: &Path) -> Result<Self, Error> {
+        if path.is_file() && ros1::is_ros1_bag(path) {
+            return Ok(Self::Ros1 {
+                connections: ros1::connections(path)?,
+            });
+        }
+        let files = bag::bag_files(path)?;
+        let mut channels = Vec::new();
+        for file in &files {
+            channels.extend(bag::channels(file)?);
+        }
+        Ok(Self::Ros2 { files, channels })
+    }
+
+    fn topic_types(&self, path: &Path) -> Result<TopicTypes, Error> {
+        match self {
+            Self::Ros2 { channels, .. } => topics::topic_types(
+                path,
+                channels
+                    .iter()
+                    .map(|c| (c.topic.as_str(), c.type_name.as_str())),
+            ),
+            Self::Ros1 { connections } => topics::topic_types(
+                path,
+                connections
+                    .iter()
+                    .map(|c| (c.topic.as_str(), c.type_name.as_str())),
+            ),
+        }
+    }
+}
+
+/// Imports the bag at `bag` as a recording at `out`, written as it is read and put in place
+/// when complete ([`RecordingStream`]). The bag is a ROS 2 bag (an MCAP or SQLite3 file, or a
+/// bag directory) or a ROS 1 bag (a `.bag` file of rosbag format 2.0). The lidar's mount comes
+/// from the bag's TF when `options.meta` has none; odometry from TF's odom → base transforms
+/// when the bag has no odometry topic.
 ///
 /// # Errors
-/// The bag cannot be read (not MCAP, truncated, an unreadable compression, a message that does
-/// not decode as its type); the topics are ambiguous; the output cannot be written.
+/// The bag cannot be read (neither format, a ROS 2 bag truncated or of an unreadable
+/// compression, a ROS 2 message that does not decode as its type: a ROS 1 bag's damage and
+/// messages that do not decode are counted in the notes instead); the topics are ambiguous; the
+/// output cannot be written.
 pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportReport, Error> {
     if options.wheel_joints.is_some() && options.wheel_radius_m.is_none() {
         return Err(Error::bag(
@@ -73,29 +174,23 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
              --wheel-radius-m R to become wheel travel",
         ));
     }
-    let files = bag::bag_files(bag)?;
-    let mut channels = Vec::new();
-    for file in &files {
-        channels.extend(bag::channels(file)?);
-    }
-    let topic_types = topics::topic_types(bag, &channels)?;
-    let chosen = topics::choose(bag, &topic_types, &options.topics)?;
-    for (topic, _) in chosen.values() {
-        if let Some(c) = channels.iter().find(|c| &c.topic == topic) {
-            if c.message_encoding != "cdr" {
-                return Err(Error::bag(
-                    bag,
-                    format!(
-                        "topic {}: message encoding `{}`, not `cdr` (ROS 2)",
-                        printable(topic),
-                        printable(&c.message_encoding)
-                    ),
-                ));
-            }
-        }
-    }
-    let mut notes = Vec::new();
-    if chosen.is_empty() {
+    let container = Container::open(bag)?;
+    let topic_types = container.topic_types(bag)?;
+    let mut chosen = topics::choose(bag, &topic_types, &options.topics)?;
+    // TF: each topic of TFMessage, static when named so (`/tf_static`, `/robot1/tf_static`).
+    let tf_topics: BTreeMap<String, tf::Source> = topic_types
+        .iter()
+        .filter(|(_, ty)| Kind::of(ty) == Some(Kind::Tf))
+        .map(|(topic, _)| {
+            let source = if topic.ends_with("tf_static") {
+                tf::Source::Static
+            } else {
+                tf::Source::Dynamic
+            };
+            (topic.clone(), source)
+        })
+        .collect();
+    if chosen.is_empty() && !tf_topics.values().any(|s| *s == tf::Source::Dynamic) {
         let all = if topic_types.is_empty() {
             "none".to_string()
         } else {
@@ -108,15 +203,21 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
             bag,
             format!(
                 "no topic of a type hilsim reads (LaserScan, Odometry, JointState, Twist, \
-                 TwistStamped, Range, PoseStamped); topics: {all}"
+                 TwistStamped, Range, PoseStamped, TFMessage); topics: {all}"
             ),
         ));
     }
+    let mut notes = Vec::new();
     let meta = options.meta.clone().unwrap_or_else(|| {
         let meta = Meta::default();
+        let sonar = if chosen.contains_key(&Role::Sonar) {
+            "; the sonar at the robot's centre, facing forward"
+        } else {
+            ""
+        };
         notes.push(format!(
-            "no --meta: a minimal meta.toml (wheel base {} m, sensors at the robot's centre \
-             facing forward); give your robot's with --meta FILE",
+            "no --meta: a minimal meta.toml (wheel base {} m, a guess{sonar}); give your \
+             robot's with --meta FILE",
             meta.robot.wheel_base_m
         ));
         meta
@@ -127,7 +228,6 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     if let Some(radius) = options.wheel_radius_m {
         meta.robot.wheel_radius_m = Some(radius);
     }
-    let mut chosen = chosen;
     match chosen.get(&Role::Odometry) {
         Some((topic, Kind::JointState)) if options.wheel_radius_m.is_none() => {
             // Asked for (the topic or the joints named): an error. Found by type only (it may
@@ -149,13 +249,47 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
             ));
             chosen.remove(&Role::Odometry);
         }
-        Some((topic, Kind::Odometry)) if options.wheel_radius_m.is_some() => {
+        Some((topic, Kind::Odometry | Kind::Tf)) if options.wheel_radius_m.is_some() => {
             notes.push(format!(
-                "--wheel-radius-m unused: the odometry is {}'s Odometry, not wheel angles",
+                "--wheel-radius-m unused: the odometry is {}'s poses, not wheel angles",
                 printable(topic)
             ));
         }
         _ => {}
+    }
+    if let std::collections::btree_map::Entry::Vacant(odometry) = chosen.entry(Role::Odometry) {
+        let dynamic: Vec<&String> = tf_topics
+            .iter()
+            .filter(|(_, s)| **s == tf::Source::Dynamic)
+            .map(|(t, _)| t)
+            .collect();
+        let topic = dynamic
+            .iter()
+            .find(|t| t.as_str() == "/tf")
+            .or(dynamic.first().filter(|_| dynamic.len() == 1));
+        if let Some(topic) = topic {
+            notes.push(format!(
+                "no Odometry topic: the odometry from {}'s {ODOM_FRAME} → base transforms",
+                printable(topic)
+            ));
+            odometry.insert(((*topic).clone(), Kind::Tf));
+        }
+    }
+    if let Container::Ros2 { channels, .. } = &container {
+        for (topic, _) in chosen.values() {
+            if let Some(c) = channels.iter().find(|c| &c.topic == topic) {
+                if c.message_encoding != "cdr" {
+                    return Err(Error::bag(
+                        bag,
+                        format!(
+                            "topic {}: message encoding `{}`, not `cdr` (ROS 2)",
+                            printable(topic),
+                            printable(&c.message_encoding)
+                        ),
+                    ));
+                }
+            }
+        }
     }
     let tables = Tables {
         odometry: chosen.contains_key(&Role::Odometry),
@@ -164,13 +298,29 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
         truth: chosen.contains_key(&Role::Truth),
     };
     let mut stream = RecordingStream::create(out, meta.clone(), tables)?;
+    let encoding = match container {
+        Container::Ros2 { .. } => Encoding::Cdr,
+        Container::Ros1 { .. } => Encoding::Ros1,
+    };
     let mut converter = Converter::new(&chosen, meta.robot.wheel_base_m, options.wheel_radius_m)
-        .with_wheel_joints(options.wheel_joints.clone());
-    (converter.t0_ns, converter.clock_offset_ns) = earliest_time(&files[0], &chosen)?;
+        .with_wheel_joints(options.wheel_joints.clone())
+        .with_encoding(encoding)
+        .with_tf_topics(tf_topics.clone());
     let mut bytes = 0;
-    for file in &files {
-        bytes += std::fs::metadata(file).map_or(0, |m| m.len());
-        read_file(file, &mut converter, &mut stream)?;
+    match &container {
+        Container::Ros2 { files, .. } => {
+            (converter.t0_ns, converter.clock_offset_ns) = earliest_time(&files[0], &chosen)?;
+            for file in files {
+                bytes += std::fs::metadata(file).map_or(0, |m| m.len());
+                read_file(file, &mut converter, &mut stream)?;
+            }
+        }
+        Container::Ros1 { connections } => {
+            (converter.t0_ns, converter.clock_offset_ns) =
+                ros1_earliest_time(bag, connections, &chosen)?;
+            bytes = std::fs::metadata(bag).map_or(0, |m| m.len());
+            notes.extend(read_ros1(bag, connections, &mut converter, &mut stream)?);
+        }
     }
     converter.finish(&mut stream)?;
     if let Some((topic, Kind::JointState)) = chosen.get(&Role::Odometry) {
@@ -194,10 +344,18 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
             ));
         }
     }
+    if let Some((topic, Kind::Tf)) = chosen.get(&Role::Odometry) {
+        if !converter.rows.contains_key(&Role::Odometry) {
+            notes.push(format!(
+                "{} has no {ODOM_FRAME} → base transform: odometry.csv is empty",
+                printable(topic)
+            ));
+        }
+    }
     // What the bag says of the sensors, where meta.toml did not.
     let final_meta = stream.meta_mut();
     if tables.lidar && final_meta.lidar.is_none() {
-        final_meta.lidar = Some(hilsim_recording::Mount::default());
+        final_meta.lidar = Some(lidar_mount(&converter, &tf_topics, &mut notes));
     }
     if tables.sonar && final_meta.sonar.is_none() {
         let sonar_topic = chosen.get(&Role::Sonar).map_or("", |(t, _)| t.as_str());
@@ -235,6 +393,102 @@ pub fn import(bag: &Path, out: &Path, options: &ImportOptions) -> Result<ImportR
     })
 }
 
+/// A value to the nanounit (nanometres, nanodegrees), without a negative zero: what TF's
+/// float64 composition gives, without its last-digit noise (`0.12`, not
+/// `0.12000000000000001`).
+fn to_nano(x: f64) -> f64 {
+    (x * 1e9).round() / 1e9 + 0.0
+}
+
+/// The lidar's mount from the bag's TF: the scans' frame in the robot's, projected onto the
+/// ground (x, y, yaw); the robot's centre facing forward when TF does not say. Each way it was
+/// found, or not, is a note.
+fn lidar_mount(
+    converter: &Converter,
+    tf_topics: &BTreeMap<String, tf::Source>,
+    notes: &mut Vec<String>,
+) -> Mount {
+    let tree = &converter.tree;
+    let assumed = "lidar mount assumed at the robot's centre, facing forward; give it with \
+                   --meta FILE";
+    let Some(sensor) = converter.scan_frame.as_deref() else {
+        return Mount::default();
+    };
+    if tree.is_empty() {
+        let why = if tf_topics.is_empty() {
+            "no /tf_static or /tf"
+        } else {
+            "no usable transform in /tf_static or /tf"
+        };
+        notes.push(format!("{why}: {assumed}"));
+        return Mount::default();
+    }
+    let (base, guessed) = match converter.odometry_frame.as_deref() {
+        Some(base) => (base, false),
+        None => match BASE_FRAMES.iter().find(|b| tree.has(b)) {
+            Some(base) => (*base, true),
+            None => {
+                notes.push(format!(
+                    "no robot frame in TF (base_link, base_footprint, or the odometry's child \
+                     frame): {assumed}"
+                ));
+                return Mount::default();
+            }
+        },
+    };
+    let Some(found) = tree.mount(base, sensor) else {
+        notes.push(format!(
+            "TF has no chain of transforms from {} to the scans' frame {}: {assumed}",
+            printable(base),
+            printable(sensor)
+        ));
+        return Mount::default();
+    };
+    let Rigid {
+        translation,
+        rotation,
+    } = found.rigid;
+    let mount = Mount {
+        x_m: to_nano(translation.x),
+        y_m: to_nano(translation.y),
+        yaw_deg: to_nano(rotation.yaw().to_degrees()),
+    };
+    let source = if found.all_static {
+        "/tf_static"
+    } else if tf_topics.values().any(|s| *s == tf::Source::Static) {
+        "/tf_static and /tf"
+    } else {
+        "/tf (no /tf_static)"
+    };
+    notes.push(format!(
+        "lidar mount from {source} {}→{}: x {} m, y {} m, yaw {}°{}",
+        printable(base),
+        printable(sensor),
+        mount.x_m,
+        mount.y_m,
+        mount.yaw_deg,
+        if guessed {
+            format!(" (the robot's frame taken to be {base}: no odometry names it)")
+        } else {
+            String::new()
+        }
+    ));
+    let tilt = found.rigid.tilt_deg();
+    // A degree of tilt moves a 2-D scan's points by under 0.02 % of their range.
+    if tilt > 1.0 {
+        notes.push(format!(
+            "the lidar's frame is tilted {tilt:.1}° from the robot's: its roll and pitch are \
+             dropped (a 2-D mount has neither){}",
+            if tilt > 90.0 {
+                "; upside down, its scans turn the other way round, which the mount cannot say"
+            } else {
+                ""
+            }
+        ));
+    }
+    mount
+}
+
 /// Streams one MCAP file through the converter.
 ///
 /// The topics were chosen from the file's summary section when it has one: a channel of the
@@ -250,6 +504,7 @@ where
     let summary = bag::summary_channels(file)?;
     // Each chosen channel's role, kind, topic and count of messages so far.
     let mut roles: HashMap<u16, (Role, Kind, String, u64)> = HashMap::new();
+    let mut tf_channels: HashMap<u16, tf::Source> = HashMap::new();
     bag::stream(file, |item| match item {
         Item::Channel(c) => {
             if let Some(listed) = &summary {
@@ -261,6 +516,8 @@ where
                 .find(|(_, (topic, _))| *topic == c.topic)
             {
                 roles.insert(c.id, (*role, *kind, c.topic, 0));
+            } else if let Some(source) = converter.tf_topics.get(&c.topic) {
+                tf_channels.insert(c.id, *source);
             }
             Ok(())
         }
@@ -281,6 +538,10 @@ where
             log_time,
             data,
         } => {
+            if let Some(source) = tf_channels.get(&channel_id) {
+                converter.tf(*source, data);
+                return Ok(());
+            }
             let Some((role, kind, topic, count)) = roles.get_mut(&channel_id) else {
                 return Ok(());
             };
@@ -297,6 +558,97 @@ where
                 })
         }
     })
+}
+
+/// Where a ROS 1 connection's messages go.
+enum Route {
+    /// A table's topic: its role, kind and name.
+    Table(Role, Kind, String),
+    /// A TF topic that feeds no table.
+    Tf(tf::Source),
+}
+
+fn route(converter: &Converter, topic: &str) -> Option<Route> {
+    if let Some((role, (_, kind))) = converter.chosen.iter().find(|(_, (t, _))| t == topic) {
+        return Some(Route::Table(*role, *kind, topic.to_string()));
+    }
+    converter.tf_topics.get(topic).map(|s| Route::Tf(*s))
+}
+
+/// Messages of a topic that did not decode: how many, of how many, and why the first did not.
+#[derive(Default)]
+struct Undecoded {
+    bad: u64,
+    seen: u64,
+    first: String,
+}
+
+/// Streams a ROS 1 bag through the converter. Damage to the bag and messages that do not
+/// decode are counted, and returned as notes.
+///
+/// # Errors
+/// Not a ROS 1 bag, or the recording cannot be written.
+fn read_ros1<S>(
+    file: &Path,
+    connections: &[ros1::Connection],
+    converter: &mut Converter,
+    sink: &mut S,
+) -> Result<Vec<String>, Error>
+where
+    S: SampleSink<Error = hilsim_recording::Error>,
+{
+    let mut routes: HashMap<u32, Route> = HashMap::new();
+    for c in connections {
+        if let Some(r) = route(converter, &c.topic) {
+            routes.insert(c.id, r);
+        }
+    }
+    let mut undecoded: BTreeMap<String, Undecoded> = BTreeMap::new();
+    let damage = ros1::stream_while(file, |item| {
+        match item {
+            ros1::Item::Connection(c) => {
+                if let std::collections::hash_map::Entry::Vacant(e) = routes.entry(c.id) {
+                    if let Some(r) = route(converter, &c.topic) {
+                        e.insert(r);
+                    }
+                }
+            }
+            ros1::Item::Message {
+                conn,
+                time_ns,
+                data,
+            } => match routes.get(&conn) {
+                Some(Route::Tf(source)) => converter.tf(*source, data),
+                Some(Route::Table(role, kind, topic)) => {
+                    let counted = undecoded.entry(topic.clone()).or_default();
+                    counted.seen += 1;
+                    match converter.message(*role, *kind, time_ns, data, sink) {
+                        Ok(()) => {}
+                        Err(Fault::Message(why)) => {
+                            counted.bad += 1;
+                            if counted.first.is_empty() {
+                                counted.first = why;
+                            }
+                        }
+                        Err(Fault::Sink(err)) => return Err(Error::Recording(err)),
+                    }
+                }
+                None => {}
+            },
+        }
+        Ok(true)
+    })?;
+    let mut notes = damage.notes();
+    for (topic, u) in undecoded.iter().filter(|(_, u)| u.bad > 0) {
+        notes.push(format!(
+            "{} of {}'s {} messages skipped: {} (the first)",
+            u.bad,
+            printable(topic),
+            u.seen,
+            u.first
+        ));
+    }
+    Ok(notes)
 }
 
 /// A data-section channel against the summary's list: the same id must be there with the same
@@ -329,7 +681,46 @@ fn check_listed(file: &Path, channel: &bag::Channel, listed: &[bag::Channel]) ->
 
 /// How far into a bag (log time) the earliest message is looked for: a scan's stamp is its first
 /// reading's, logged a revolution or more later, after other topics' messages.
-const EARLIEST_WITHIN_NS: u64 = 10_000_000_000;
+const EARLIEST_WITHIN_NS: i64 = 10_000_000_000;
+
+/// The earliest stamped and unstamped times among the first messages of the chosen topics, and
+/// the stamps' clock against the log clock (see [`earliest_time`]).
+#[derive(Default)]
+struct Earliest {
+    stamped: Option<i64>,
+    unstamped: Option<i64>,
+    first_log: Option<i64>,
+    offset: Option<i64>,
+}
+
+impl Earliest {
+    /// Sees a message of `kind` logged at `log_ns`; `false` once past the window.
+    fn see(&mut self, kind: Kind, encoding: Encoding, log_ns: i64, data: &[u8]) -> bool {
+        let first = *self.first_log.get_or_insert(log_ns);
+        if log_ns.saturating_sub(first) > EARLIEST_WITHIN_NS {
+            return false;
+        }
+        if kind == Kind::Twist {
+            self.unstamped = Some(self.unstamped.map_or(log_ns, |t| t.min(log_ns)));
+        } else if let Some(stamp) = first_stamp(kind, encoding, data).filter(|s| !s.is_zero()) {
+            let ns = stamp.ns();
+            self.stamped = Some(self.stamped.map_or(ns, |t| t.min(ns)));
+            self.offset.get_or_insert(clock_offset(ns, log_ns));
+        }
+        true
+    }
+
+    /// The recording's t = 0 and the clock offset.
+    fn result(&self) -> (Option<i64>, Option<i64>) {
+        let t0 = match (self.stamped, self.unstamped) {
+            // Unstamped messages count when they are on the stamps' clock.
+            (Some(s), Some(u)) if (s - u).abs() <= OTHER_CLOCK_NS => Some(s.min(u)),
+            (Some(s), _) => Some(s),
+            (None, u) => u,
+        };
+        (t0, self.offset)
+    }
+}
 
 /// The recording's t = 0: an export's own start, else the earliest time among the first messages
 /// of the chosen topics (each topic's first within the bag's first 10 s of log time): its header
@@ -345,11 +736,8 @@ const EARLIEST_WITHIN_NS: u64 = 10_000_000_000;
 /// As [`bag::stream`].
 fn earliest_time(file: &Path, chosen: &Chosen) -> Result<(Option<i64>, Option<i64>), Error> {
     let mut roles: HashMap<u16, Kind> = HashMap::new();
-    let mut stamped: Option<i64> = None;
-    let mut unstamped: Option<i64> = None;
+    let mut earliest = Earliest::default();
     let mut start = None;
-    let mut first_log = None;
-    let mut offset = None;
     bag::stream_while(file, |item| {
         match item {
             Item::Channel(c) => {
@@ -370,27 +758,14 @@ fn earliest_time(file: &Path, chosen: &Chosen) -> Result<(Option<i64>, Option<i6
                 log_time,
                 data,
             } => {
-                let first = *first_log.get_or_insert(log_time);
-                if log_time.saturating_sub(first) > EARLIEST_WITHIN_NS {
-                    return Ok(false);
-                }
                 let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
-                match roles.get(&channel_id) {
-                    // Every stamped message starts with its header.
-                    Some(Kind::Twist) => {
-                        unstamped = Some(unstamped.map_or(log_ns, |t| t.min(log_ns)));
+                return Ok(match roles.get(&channel_id) {
+                    Some(kind) => earliest.see(*kind, Encoding::Cdr, log_ns, data),
+                    None => {
+                        log_ns.saturating_sub(*earliest.first_log.get_or_insert(log_ns))
+                            <= EARLIEST_WITHIN_NS
                     }
-                    Some(_) => {
-                        if let Ok(header) = decode::<crate::msgs::Header>(data) {
-                            if !header.stamp.is_zero() {
-                                let ns = header.stamp.ns();
-                                stamped = Some(stamped.map_or(ns, |t| t.min(ns)));
-                                offset.get_or_insert(clock_offset(ns, log_ns));
-                            }
-                        }
-                    }
-                    None => {}
-                }
+                });
             }
         }
         Ok(true)
@@ -398,13 +773,51 @@ fn earliest_time(file: &Path, chosen: &Chosen) -> Result<(Option<i64>, Option<i6
     if start.is_some() {
         return Ok((start, None));
     }
-    let t0 = match (stamped, unstamped) {
-        // Unstamped messages count when they are on the stamps' clock.
-        (Some(s), Some(u)) if (s - u).abs() <= OTHER_CLOCK_NS => Some(s.min(u)),
-        (Some(s), _) => Some(s),
-        (None, u) => u,
+    Ok(earliest.result())
+}
+
+/// [`earliest_time`] of a ROS 1 bag (which has no export's start).
+///
+/// # Errors
+/// Not a ROS 1 bag.
+fn ros1_earliest_time(
+    file: &Path,
+    connections: &[ros1::Connection],
+    chosen: &Chosen,
+) -> Result<(Option<i64>, Option<i64>), Error> {
+    let kind_of = |topic: &str| {
+        chosen
+            .values()
+            .find(|(t, _)| t == topic)
+            .map(|(_, kind)| *kind)
     };
-    Ok((t0, offset))
+    let mut kinds: HashMap<u32, Kind> = connections
+        .iter()
+        .filter_map(|c| Some((c.id, kind_of(&c.topic)?)))
+        .collect();
+    let mut earliest = Earliest::default();
+    ros1::stream_while(file, |item| {
+        Ok(match item {
+            ros1::Item::Connection(c) => {
+                if let Some(kind) = kind_of(&c.topic) {
+                    kinds.insert(c.id, kind);
+                }
+                true
+            }
+            ros1::Item::Message {
+                conn,
+                time_ns,
+                data,
+            } => match kinds.get(&conn) {
+                Some(kind) => earliest.see(*kind, Encoding::Ros1, time_ns, data),
+                None => {
+                    time_ns.saturating_sub(*earliest.first_log.get_or_insert(time_ns))
+                        <= EARLIEST_WITHIN_NS
+                }
+            },
+        })
+    })?;
+    Ok(earliest.result())
 }
 
 /// The stamps' clock minus the log clock from a message's stamp and log time: the difference
@@ -462,6 +875,19 @@ pub struct Converter {
     sonar_fov_unusable: u64,
     /// The last scan's reading angles: a lidar's scans share them.
     scan_angles: ScanAngles,
+    /// How the messages' bytes are laid out.
+    encoding: Encoding,
+    /// The TF topics, and whether each is static.
+    tf_topics: BTreeMap<String, tf::Source>,
+    /// The bag's TF frames.
+    tree: tf::Tree,
+    /// TF messages that did not decode.
+    tf_undecoded: u64,
+    /// The first scan's frame.
+    scan_frame: Option<String>,
+    /// The robot's frame as the odometry names it (an `Odometry`'s child frame, or the child
+    /// of TF's odom → base transforms).
+    odometry_frame: Option<String>,
 }
 
 /// Each reading's angle of a scan's `angle_min` and `angle_increment`, computed once for the
@@ -597,7 +1023,44 @@ impl Converter {
             sonar_fov_rad: None,
             sonar_fov_unusable: 0,
             scan_angles: ScanAngles::default(),
+            encoding: Encoding::Cdr,
+            tf_topics: BTreeMap::new(),
+            tree: tf::Tree::default(),
+            tf_undecoded: 0,
+            scan_frame: None,
+            odometry_frame: None,
         }
+    }
+
+    /// Messages laid out as `encoding` (default: ROS 2's CDR).
+    #[must_use]
+    pub fn with_encoding(mut self, encoding: Encoding) -> Self {
+        self.encoding = encoding;
+        self
+    }
+
+    /// The topics of `tf2_msgs/TFMessage`, each static (`/tf_static`) or not, whose messages
+    /// [`Converter::tf`] takes.
+    #[must_use]
+    pub fn with_tf_topics(mut self, topics: BTreeMap<String, tf::Source>) -> Self {
+        self.tf_topics = topics;
+        self
+    }
+
+    /// Keeps a TF message's transforms (one that does not decode is counted).
+    pub fn tf(&mut self, source: tf::Source, data: &[u8]) {
+        match decode_as::<TfMessage>(self.encoding, data, 0) {
+            Ok(message) => {
+                for t in &message.transforms {
+                    self.tree.add(source, t);
+                }
+            }
+            Err(_) => self.tf_undecoded += 1,
+        }
+    }
+
+    fn decode<T: Wire>(&self, data: &[u8], appended: usize) -> Result<T, String> {
+        decode_as(self.encoding, data, appended)
     }
 
     /// The left and right wheels' joints by name (else the joints named `…left…` and
@@ -686,12 +1149,15 @@ impl Converter {
         let bad = |err: String| Fault::Message(format!("not a {} ({err})", kind.ros_name()));
         match (role, kind) {
             (Role::Lidar, _) => {
-                let scan: LaserScan = decode_whole(data, 0).map_err(bad)?;
+                let scan: LaserScan = self.decode(data, 0).map_err(bad)?;
+                if self.scan_frame.is_none() {
+                    self.scan_frame = Some(tf::frame(&scan.header.frame_id).to_string());
+                }
                 self.scan(&scan, log_ns, sink)
             }
             (Role::Sonar, _) => {
                 // Rolling appends `variance` (a float32) to Range.
-                let range: Range = decode_whole(data, 4).map_err(bad)?;
+                let range: Range = self.decode(data, 4).map_err(bad)?;
                 let ns = self.stamped(range.header.stamp, log_ns);
                 if self.sonar_fov_rad.is_none() {
                     let fov = f64::from(range.field_of_view);
@@ -718,12 +1184,12 @@ impl Converter {
                 })?)
             }
             (Role::Commands, Kind::TwistStamped) => {
-                let twist: TwistStamped = decode_whole(data, 0).map_err(bad)?;
+                let twist: TwistStamped = self.decode(data, 0).map_err(bad)?;
                 let ns = self.stamped(twist.header.stamp, log_ns);
                 self.command(ns, &twist.twist, sink)
             }
             (Role::Commands, _) => {
-                let twist: Twist = decode_whole(data, 0).map_err(bad)?;
+                let twist: Twist = self.decode(data, 0).map_err(bad)?;
                 match self.clock_offset_ns {
                     Some(offset) => self.command(log_ns + offset, &twist, sink),
                     None if self.pending_commands.len() < MAX_PENDING_COMMANDS => {
@@ -737,24 +1203,51 @@ impl Converter {
                 }
             }
             (Role::Truth, Kind::Odometry) => {
-                let odometry: Odometry = decode_whole(data, 0).map_err(bad)?;
+                let odometry: Odometry = self.decode(data, 0).map_err(bad)?;
                 let ns = self.stamped(odometry.header.stamp, log_ns);
                 self.truth(ns, &odometry.pose.pose, sink)
             }
             (Role::Truth, _) => {
-                let pose: PoseStamped = decode_whole(data, 0).map_err(bad)?;
+                let pose: PoseStamped = self.decode(data, 0).map_err(bad)?;
                 let ns = self.stamped(pose.header.stamp, log_ns);
                 self.truth(ns, &pose.pose, sink)
             }
             (Role::Odometry, Kind::JointState) => {
-                let joints: JointState = decode_whole(data, 0).map_err(bad)?;
+                let joints: JointState = self.decode(data, 0).map_err(bad)?;
                 let ns = self.stamped(joints.header.stamp, log_ns);
                 self.joints(ns, &joints, sink)
             }
+            (Role::Odometry, Kind::Tf) => {
+                let message: TfMessage = self.decode(data, 0).map_err(bad)?;
+                for t in &message.transforms {
+                    self.tree.add(tf::Source::Dynamic, t);
+                    let (parent, child) =
+                        (tf::frame(&t.header.frame_id), tf::frame(&t.child_frame_id));
+                    if parent.rsplit('/').next() != Some(ODOM_FRAME) {
+                        continue;
+                    }
+                    // The first child of odom is the robot (odom → base_footprint when a
+                    // robot has both: base_link is then below base_footprint).
+                    let base = self.odometry_frame.get_or_insert_with(|| child.to_string());
+                    if base != child {
+                        continue;
+                    }
+                    let ns = self.stamped(t.header.stamp, log_ns);
+                    let pose = Pose {
+                        position: t.transform.translation,
+                        orientation: t.transform.rotation,
+                    };
+                    self.odometry(ns, &pose, sink)?;
+                }
+                Ok(())
+            }
             (Role::Odometry, _) => {
-                let odometry: Odometry = decode_whole(data, 0).map_err(bad)?;
+                let odometry: Odometry = self.decode(data, 0).map_err(bad)?;
+                if self.odometry_frame.is_none() && !odometry.child_frame_id.is_empty() {
+                    self.odometry_frame = Some(tf::frame(&odometry.child_frame_id).to_string());
+                }
                 let ns = self.stamped(odometry.header.stamp, log_ns);
-                self.odometry(ns, &odometry, sink)
+                self.odometry(ns, &odometry.pose.pose, sink)
             }
         }
     }
@@ -869,11 +1362,10 @@ impl Converter {
     /// Wheel travel rebuilt from the pose increments: over a step the robot turns by dθ and
     /// moves ds along its mean heading (the midpoint rule of differential-drive odometry), so
     /// the wheels, b apart, travel ds ∓ dθ·b/2.
-    fn odometry<S>(&mut self, ns: i64, odometry: &Odometry, sink: &mut S) -> Result<(), Fault>
+    fn odometry<S>(&mut self, ns: i64, pose: &Pose, sink: &mut S) -> Result<(), Fault>
     where
         S: SampleSink<Error = hilsim_recording::Error>,
     {
-        let pose = &odometry.pose.pose;
         let (x, y, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw());
         if ![x, y, yaw].iter().all(|v| v.is_finite()) {
             self.not_finite(Role::Odometry);
@@ -1059,6 +1551,20 @@ impl Converter {
             notes.push(format!(
                 "{} JointState messages without a position for {names} skipped",
                 self.joints_missing
+            ));
+        }
+        if self.tf_undecoded > 0 {
+            notes.push(format!(
+                "{} TF messages skipped: not a tf2_msgs/TFMessage",
+                self.tf_undecoded
+            ));
+        }
+        if self.tree.dropped > 0 {
+            notes.push(format!(
+                "{} TF transforms not kept (not a rotation, a frame its own parent, or beyond \
+                 {} frames)",
+                self.tree.dropped,
+                tf::FRAME_LIMIT
             ));
         }
         if self.sonar_out_of_range > 0 {

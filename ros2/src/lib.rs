@@ -1,6 +1,7 @@
-//! ROS 2 bags in and out: a bag (MCAP storage, CDR messages) read into a hilsim recording
-//! ([`import()`]), and a recording written as an MCAP file of standard ROS 2 messages that
-//! `ros2 bag play`, RViz and Foxglove read ([`export()`]).
+//! ROS bags in and out: a ROS 2 bag (MCAP or SQLite3 storage, CDR messages) or a ROS 1 bag
+//! (rosbag format 2.0, ROS 1 messages: [`ros1`]) read into a hilsim recording ([`import()`]),
+//! the lidar's mount taken from the bag's TF; and a recording written as an MCAP file of
+//! standard ROS 2 messages that `ros2 bag play`, RViz and Foxglove read ([`export()`]).
 //!
 //! Bags stream: an import holds one record (a message, or a chunk being decompressed) at a
 //! time, whatever the bag's size. The crate knows the recording format only through
@@ -28,6 +29,8 @@ mod error;
 mod export;
 mod import;
 pub mod msgs;
+pub mod ros1;
+mod tf;
 pub mod topics;
 
 pub use error::Error;
@@ -42,6 +45,8 @@ pub use export::{
     START_NS,
 };
 pub use import::{
-    angle_deg, decimal_of_f32, import, read_file, Converter, Fault, ImportOptions, ImportReport,
+    angle_deg, decimal_of_f32, import, read_file, Converter, Encoding, Fault, ImportOptions,
+    ImportReport,
 };
+pub use tf::Source as TfSource;
 pub use topics::{Kind, Role};

@@ -7,7 +7,6 @@ use std::path::Path;
 
 use hilsim_recording::printable;
 
-use crate::bag::Channel;
 use crate::Error;
 
 /// A table of the recording, fed by one topic.
@@ -51,7 +50,7 @@ impl Role {
     fn accepts(self) -> &'static [Kind] {
         match self {
             Self::Lidar => &[Kind::LaserScan],
-            Self::Odometry => &[Kind::Odometry, Kind::JointState],
+            Self::Odometry => &[Kind::Odometry, Kind::JointState, Kind::Tf],
             Self::Commands => &[Kind::Twist, Kind::TwistStamped],
             Self::Sonar => &[Kind::Range],
             Self::Truth => &[Kind::PoseStamped, Kind::Odometry],
@@ -59,10 +58,12 @@ impl Role {
     }
 
     /// The types found by type alone, in order of preference (an `Odometry` is the odometer's
-    /// unless named as the truth; wheel joints only when there is no `Odometry`).
+    /// unless named as the truth; wheel joints only when there is no `Odometry`; TF's odom →
+    /// base transforms are the import's last resort, not found here).
     fn found_by_type(self) -> &'static [Kind] {
         match self {
             Self::Truth => &[Kind::PoseStamped],
+            Self::Odometry => &[Kind::Odometry, Kind::JointState],
             other => other.accepts(),
         }
     }
@@ -97,10 +98,13 @@ pub enum Kind {
     Range,
     /// `geometry_msgs/PoseStamped`.
     PoseStamped,
+    /// `tf2_msgs/TFMessage` (ROS 1's older `tf/tfMessage` has the same layout): odometry from
+    /// its odom → base transforms, and the sensors' mounts.
+    Tf,
 }
 
 impl Kind {
-    const NAMES: [(Kind, &'static str); 7] = [
+    const NAMES: [(Kind, &'static str); 8] = [
         (Kind::LaserScan, "sensor_msgs/LaserScan"),
         (Kind::Odometry, "nav_msgs/Odometry"),
         (Kind::JointState, "sensor_msgs/JointState"),
@@ -108,12 +112,16 @@ impl Kind {
         (Kind::TwistStamped, "geometry_msgs/TwistStamped"),
         (Kind::Range, "sensor_msgs/Range"),
         (Kind::PoseStamped, "geometry_msgs/PoseStamped"),
+        (Kind::Tf, "tf2_msgs/TFMessage"),
     ];
 
     /// The kind of a schema name (`sensor_msgs/msg/LaserScan` or `sensor_msgs/LaserScan`).
     #[must_use]
     pub fn of(type_name: &str) -> Option<Self> {
         let name = type_name.replace("/msg/", "/");
+        if name == "tf/tfMessage" {
+            return Some(Self::Tf);
+        }
         Self::NAMES
             .iter()
             .find(|(_, n)| *n == name)
@@ -162,22 +170,26 @@ pub type TopicTypes = BTreeMap<String, String>;
 /// The topics chosen: role → (topic, kind).
 pub type Chosen = BTreeMap<Role, (String, Kind)>;
 
-/// Collects a bag's topics from its files' channels.
+/// Collects a bag's topics from its channels' (topic, type name) pairs (an MCAP file's
+/// channels, a ROS 1 bag's connections).
 ///
 /// # Errors
-/// One topic with two types in different files, or a non-CDR topic.
-pub fn topic_types(bag: &Path, channels: &[Channel]) -> Result<TopicTypes, Error> {
+/// One topic with two types.
+pub fn topic_types<'a>(
+    bag: &Path,
+    channels: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> Result<TopicTypes, Error> {
     let mut topics = TopicTypes::new();
-    for c in channels {
-        if let Some(old) = topics.insert(c.topic.clone(), c.type_name.clone()) {
-            if old != c.type_name {
+    for (topic, type_name) in channels {
+        if let Some(old) = topics.insert(topic.to_string(), type_name.to_string()) {
+            if old != type_name {
                 return Err(Error::bag(
                     bag,
                     format!(
                         "topic {} has two types, {} and {}",
-                        printable(&c.topic),
+                        printable(topic),
                         printable(&old),
-                        printable(&c.type_name)
+                        printable(type_name)
                     ),
                 ));
             }

@@ -10,7 +10,8 @@ use std::path::Path;
 use byteorder::{BigEndian, LittleEndian};
 use hilsim_recording::{OdometrySample, Recording};
 use hilsim_ros2::msgs::{
-    Header, JointState, LaserScan, Odometry, Quaternion, Range, Time, Vector3,
+    Header, JointState, LaserScan, Odometry, Quaternion, Range, TfMessage, Time, Transform,
+    TransformStamped, Vector3,
 };
 use hilsim_ros2::{import, ImportOptions, Role};
 use mcap::records::MessageHeader;
@@ -638,4 +639,105 @@ fn messages_with_nan_are_skipped_and_counted() {
         let note = format!("1 {role} messages with a value that is not finite (NaN, inf) skipped");
         assert!(report.notes.contains(&note), "{note}: {:?}", report.notes);
     }
+}
+
+fn transform(t_ns: i64, parent: &str, child: &str, x: f64, yaw: f64) -> TransformStamped {
+    TransformStamped {
+        header: header(t_ns, parent),
+        child_frame_id: child.to_string(),
+        transform: Transform {
+            translation: Vector3 { x, y: 0.0, z: 0.3 },
+            rotation: Quaternion::from_yaw(yaw),
+        },
+    }
+}
+
+fn tf_message(topic: &'static str, t_ns: i64, transforms: Vec<TransformStamped>) -> Message {
+    Message {
+        topic,
+        type_name: "tf2_msgs/msg/TFMessage",
+        t_ns,
+        data: cdr(&TfMessage { transforms }),
+    }
+}
+
+/// A ROS 2 robot's TF: the laser's mount from /tf_static (over base_link → laser_mount →
+/// laser, from the odometry's base_footprint) into meta.toml, unless the user's meta.toml has
+/// one; without /odom, the odometry from /tf's odom → base_footprint.
+#[test]
+fn the_lidar_mount_and_odometry_come_from_tf() {
+    let dir = tempfile::tempdir().unwrap();
+    let statics = tf_message(
+        "/tf_static",
+        0,
+        vec![
+            transform(0, "base_footprint", "base_link", 0.0, 0.0),
+            transform(
+                0,
+                "base_link",
+                "laser_mount",
+                0.2,
+                -std::f64::consts::FRAC_PI_2,
+            ),
+            transform(0, "laser_mount", "laser", 0.05, 0.0),
+        ],
+    );
+    let mut messages = vec![statics];
+    for k in 0..5 {
+        let t_ns = i64::from(k) * 100_000_000;
+        let mut laser = scan(t_ns, 0.0, 0.5f32.to_radians(), vec![1.0; 4]);
+        laser.header.frame_id = "laser".into();
+        messages.push(Message {
+            topic: "/scan",
+            type_name: "sensor_msgs/msg/LaserScan",
+            t_ns,
+            data: cdr(&laser),
+        });
+        messages.push(tf_message(
+            "/tf",
+            t_ns,
+            vec![transform(
+                t_ns,
+                "odom",
+                "base_footprint",
+                0.1 * f64::from(k),
+                0.0,
+            )],
+        ));
+    }
+    let bag = dir.path().join("tf.mcap");
+    write_mcap(&bag, "ros2msg", &messages);
+    let out = dir.path().join("rec");
+    let report = import(&bag, &out, &ImportOptions::default()).unwrap();
+    let rec = Recording::read_dir(&out).unwrap();
+    let mount = rec.meta.lidar.unwrap();
+    assert_eq!((mount.x_m, mount.y_m, mount.yaw_deg), (0.2, -0.05, -90.0));
+    assert!(report
+        .notes
+        .iter()
+        .any(|n| n
+            == "lidar mount from /tf_static base_footprint→laser: x 0.2 m, y -0.05 m, yaw -90°"));
+    let odometry = rec.odometry.unwrap();
+    assert_eq!(odometry.len(), 5);
+    assert!((odometry[4].left_m - 0.4).abs() < 1e-9);
+
+    // The user's meta.toml's mount stands.
+    let meta = hilsim_recording::Meta {
+        lidar: Some(hilsim_recording::Mount {
+            x_m: 0.3,
+            y_m: 0.0,
+            yaw_deg: 0.0,
+        }),
+        ..hilsim_recording::Meta::default()
+    };
+    let given = ImportOptions {
+        meta: Some(meta),
+        ..ImportOptions::default()
+    };
+    let report = import(&bag, &out, &given).unwrap();
+    assert_eq!(
+        Recording::read_dir(&out).unwrap().meta.lidar.unwrap().x_m,
+        0.3
+    );
+    assert!(!report.notes.iter().any(|n| n.contains("lidar mount")));
 }

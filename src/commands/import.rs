@@ -1,6 +1,6 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
 //! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP or SQLite3)
-//! into a recording; `hilsim import LOG --out DIR [--log-poses truth|odometry]`: a real robot's
+//! or a ROS 1 bag (`.bag`) into a recording, the lidar's mount from its TF; `hilsim import LOG --out DIR [--log-poses truth|odometry]`: a real robot's
 //! log (CARMEN `.log`/`.clf`, gzipped or not; CoreSLAM `.dat`) into a recording.
 
 use std::collections::BTreeMap;
@@ -14,20 +14,24 @@ use hilsim_ros2::{ImportOptions, Role};
 #[derive(Debug, clap::Args)]
 pub struct ImportArgs {
     /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files);
-    /// or a robot's log: CARMEN (`.log`, `.clf`, either gzipped: `.gz`) or CoreSLAM (`.dat`).
+    /// a ROS 1 bag (`.bag`, rosbag format 2.0; chunks uncompressed, bz2 or lz4); or a robot's
+    /// log: CARMEN (`.log`, `.clf`, either gzipped: `.gz`) or CoreSLAM (`.dat`). A bag's
+    /// `/tf_static` (else `/tf`) gives the lidar's mount unless --meta has one, and `/tf`'s odom →
+    /// base transforms the odometry when the bag has no odometry topic; each guess is a note.
     pub bag: PathBuf,
     /// The recording directory to write (replaced atomically when complete).
     #[arg(long)]
     pub out: PathBuf,
-    /// The robot's `meta.toml` (wheel base, sensor mounts, what is known of the world); default:
-    /// a minimal one, said so.
+    /// The robot's `meta.toml` (wheel base, sensor mounts, what is known of the world); its
+    /// `[lidar]` mount overrides the bag's TF. Default: a minimal one (the wheel base a guess),
+    /// said so.
     #[arg(long, value_name = "FILE")]
     pub meta: Option<PathBuf>,
     /// The lidar's topic (sensor_msgs/LaserScan).
     #[arg(long, value_name = "TOPIC")]
     pub lidar: Option<String>,
-    /// The odometer's topic (nav_msgs/Odometry, or sensor_msgs/JointState with
-    /// --wheel-radius-m).
+    /// The odometer's topic (nav_msgs/Odometry; sensor_msgs/JointState with --wheel-radius-m;
+    /// or tf2_msgs/TFMessage, its odom → base transforms).
     #[arg(long, value_name = "TOPIC")]
     pub odom: Option<String>,
     /// The commands' topic (geometry_msgs/Twist or TwistStamped).
@@ -92,7 +96,7 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<(
     ];
     if let Some((flag, _)) = bag_only.iter().find(|(_, given)| *given) {
         bail!(
-            "{flag} is for ROS 2 bags; {} is a robot's log",
+            "{flag} is for ROS bags; {} is a robot's log",
             args.bag.display()
         );
     }
@@ -149,7 +153,7 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     }
     if args.log_poses.is_some() {
         bail!(
-            "--log-poses is for CARMEN logs; {} is a ROS 2 bag",
+            "--log-poses is for CARMEN logs; {} is a ROS bag",
             args.bag.display()
         );
     }

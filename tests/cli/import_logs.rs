@@ -85,7 +85,7 @@ fn bag_options_with_a_log_are_one_line_errors() {
         &["import", "run.log", "--out", "r", "--lidar", "/scan"],
     );
     let err = assert_bad_input(&out);
-    assert!(err.contains("--lidar is for ROS 2 bags"), "{err}");
+    assert!(err.contains("--lidar is for ROS bags"), "{err}");
     std::fs::write(tmp.path().join("exp.dat"), coreslam()).unwrap();
     let args = ["import", "exp.dat", "--out", "r", "--log-poses", "odometry"];
     let err = assert_bad_input(&hilsim(tmp.path(), &args));

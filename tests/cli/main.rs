@@ -10,6 +10,7 @@ mod dataset;
 mod diagnose;
 mod hil;
 mod import_logs;
+mod import_ros1;
 mod limits;
 mod outputs;
 mod record;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Third-party ROS 2 libraries (rosbags, mcap and mcap-ros2-support from PyPI, in a virtual
-# environment made here): a bag rosbags writes is what `hilsim import` reads, and `hilsim
-# export`'s file is what rosbags and mcap-ros2-support read, message for message.
+# Third-party ROS libraries (rosbags, mcap and mcap-ros2-support from PyPI, in a virtual
+# environment made here): a bag rosbags writes (ROS 2, and ROS 1) is what `hilsim import` reads,
+# its /tf_static the lidar's mount in meta.toml, and `hilsim export`'s file is what rosbags and
+# mcap-ros2-support read, message for message.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 cd "$root"
@@ -17,7 +18,8 @@ tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 check="tests/third_party/rosbags_check.py"
 
-# rosbags → hilsim import (a bag directory, metadata.yaml and MCAP), with the robot's meta.toml.
+# rosbags → hilsim import (a bag directory, metadata.yaml and MCAP), with the robot's meta.toml
+# (no [lidar]: the mount is /tf_static's).
 "$venv/bin/python" "$check" write "$tmp/bag"
 printf 'format = "hilsim-recording/1"\n[robot]\nwheel_base_m = 0.3\n' > "$tmp/meta.toml"
 "$hilsim" import "$tmp/bag" --out "$tmp/imported" --meta "$tmp/meta.toml"
@@ -35,6 +37,14 @@ for mode in file message sqlite3; do
     "$venv/bin/python" "$check" write "$tmp/bag-$mode" "$mode"
     "$hilsim" import "$tmp/bag-$mode" --out "$tmp/rec-$mode" --meta "$tmp/meta.toml"
     "$venv/bin/python" "$check" imported "$tmp/bag-$mode" "$tmp/rec-$mode"
+done
+
+# The same messages as ROS 1 bags (rosbags.rosbag1, several chunks each: uncompressed, bz2,
+# lz4): the same recording, the lidar's mount from /tf_static as in the ROS 2 bags.
+for compression in none bz2 lz4; do
+    "$venv/bin/python" "$check" write-ros1 "$tmp/ros1-$compression.bag" "$compression"
+    "$hilsim" import "$tmp/ros1-$compression.bag" --out "$tmp/ros1-$compression" --meta "$tmp/meta.toml"
+    "$venv/bin/python" "$check" imported "$tmp/ros1-$compression.bag" "$tmp/ros1-$compression"
 done
 
 # Another robot's bag: namespaced topics, a clockwise scan without intensities, NaN and inf,

@@ -1,8 +1,10 @@
-"""Third-party ROS 2 libraries against `hilsim import` and `hilsim export` (issue 17).
+"""Third-party ROS libraries against `hilsim import` and `hilsim export` (issue 17).
 
     rosbags_check.py write BAGDIR [VARIANT]  write a ROS 2 bag with rosbags (MCAP storage;
                                              VARIANT: rosbag2 compression, file or message,
                                              or sqlite3 storage)
+    rosbags_check.py write-ros1 BAG C        the same messages as a ROS 1 bag (rosbags.rosbag1;
+                                             chunks compressed with C: none, bz2, lz4)
     rosbags_check.py rewrite BAGDIR OUT C    the same messages through the mcap library's
                                              writer, chunks compressed with C (zstd, lz4)
     rosbags_check.py imported BAGDIR RECDIR  check hilsim's import of that bag
@@ -23,6 +25,7 @@ import bisect
 import csv
 import math
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -65,18 +68,24 @@ def odom_pose(j):
     return 0.2 * t * math.cos(0.2 * t), 0.2 * t * math.sin(0.2 * t), yaw
 
 
-def write(bagdir, variant="none"):
-    """`variant`: rosbag2's compression mode, `none`, `file` (each file one zstd stream) or
-    `message`; or `sqlite3`, rosbag2's other storage (rosbags' default), uncompressed."""
-    from rosbags.rosbag2.writer import CompressionFormat, CompressionMode
+# The lidar's mount the bag's /tf_static says: base_link -> laser_mount -> laser, the laser
+# 0.12 m ahead and 0.03 m to the left of the robot's centre, turned round (180 degrees).
+MOUNT = (0.12, 0.03, 180.0)
 
-    store = get_typestore(Stores.ROS2_HUMBLE)
+
+def events(store):
+    """The bag's messages, in log-time order: (log ns, topic, message, type), for a ROS 2 or a
+    ROS 1 typestore (whose Header has a `seq`)."""
     t = store.types
     Time = t["builtin_interfaces/msg/Time"]
     Header = t["std_msgs/msg/Header"]
+    ros1 = "seq" in Header.__dataclass_fields__
 
     def header(ns, frame):
-        return Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=frame)
+        stamp = Time(sec=ns // 10**9, nanosec=ns % 10**9)
+        if ros1:
+            return Header(seq=0, stamp=stamp, frame_id=frame)
+        return Header(stamp=stamp, frame_id=frame)
 
     Vector3 = t["geometry_msgs/msg/Vector3"]
     Point = t["geometry_msgs/msg/Point"]
@@ -84,68 +93,118 @@ def write(bagdir, variant="none"):
     Pose = t["geometry_msgs/msg/Pose"]
     Twist = t["geometry_msgs/msg/Twist"]
     cov = np.zeros(36, dtype=np.float64)
+
+    def yaw_quaternion(yaw):
+        return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+
+    def transform(parent, child, x, y, yaw_deg):
+        return t["geometry_msgs/msg/TransformStamped"](
+            header=header(T0_NS, parent),
+            child_frame_id=child,
+            transform=t["geometry_msgs/msg/Transform"](
+                translation=Vector3(x=x, y=y, z=0.1),
+                rotation=yaw_quaternion(math.radians(yaw_deg)),
+            ),
+        )
+
+    x, y, yaw = MOUNT
+    # laser_mount at (x - 0.01, y) facing left; the laser 0.01 m to its right, turned a further
+    # 90 degrees: composed, the mount above.
+    tf_static = t["tf2_msgs/msg/TFMessage"](
+        transforms=[
+            transform("base_link", "laser_mount", x - 0.01, y, 90.0),
+            transform("laser_mount", "laser", 0.0, -0.01, yaw - 90.0),
+        ]
+    )
+    out = [(T0_NS - 1_000_000, "/tf_static", tf_static, "tf2_msgs/msg/TFMessage")]
+    for k in range(SCANS):
+        ns = T0_NS + k * 100_000_000
+        msg = t["sensor_msgs/msg/LaserScan"](
+            header=header(ns, "laser"),
+            angle_min=0.0,
+            angle_max=math.radians(359.5),
+            angle_increment=math.radians(0.5),
+            time_increment=0.1 / READINGS,
+            scan_time=0.1,
+            range_min=RANGE_MIN,
+            range_max=RANGE_MAX,
+            ranges=scan_ranges(k),
+            intensities=np.full(READINGS, 100.0 + k, dtype=np.float32),
+        )
+        # Logged when the revolution ends, after the odometry stamped later: t = 0 is
+        # still the first scan's stamp.
+        out.append((ns + 100_000_000, "/scan", msg, "sensor_msgs/msg/LaserScan"))
+        sonar = t["sensor_msgs/msg/Range"](
+            header=header(ns + 5_000_000, "sonar"),
+            radiation_type=0,
+            field_of_view=math.radians(30.0),
+            min_range=0.02,
+            max_range=4.0,
+            range=float("inf") if k == 3 else 1.0 + 0.01 * k,
+        )
+        out.append((ns + 5_000_000, "/range", sonar, "sensor_msgs/msg/Range"))
+    for j in range(2 * SCANS):
+        ns = T0_NS + ODOM_AFTER_NS + j * 50_000_000
+        x, y, yaw = odom_pose(j)
+        odom = t["nav_msgs/msg/Odometry"](
+            header=header(ns, "odom"),
+            child_frame_id="base_link",
+            pose=t["geometry_msgs/msg/PoseWithCovariance"](
+                pose=Pose(position=Point(x=x, y=y, z=0.0), orientation=yaw_quaternion(yaw)),
+                covariance=cov,
+            ),
+            twist=t["geometry_msgs/msg/TwistWithCovariance"](
+                twist=Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4)),
+                covariance=cov,
+            ),
+        )
+        out.append((ns, "/odom", odom, "nav_msgs/msg/Odometry"))
+    for c in range(SCANS // 2):
+        # Unstamped: the recorder's log time is its time (on the stamps' clock here).
+        ns = T0_NS + c * 200_000_000 + 1_000_000
+        twist = Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4 + 0.01 * c))
+        out.append((ns, "/cmd_vel", twist, "geometry_msgs/msg/Twist"))
+    return sorted(out, key=lambda e: e[0])
+
+
+def write(bagdir, variant="none"):
+    """`variant`: rosbag2's compression mode, `none`, `file` (each file one zstd stream) or
+    `message`; or `sqlite3`, rosbag2's other storage (rosbags' default), uncompressed."""
+    from rosbags.rosbag2.writer import CompressionFormat, CompressionMode
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
     storage = StoragePlugin.SQLITE3 if variant == "sqlite3" else StoragePlugin.MCAP
     writer = Writer(bagdir, version=8, storage_plugin=storage)
     if variant in ("file", "message"):
         writer.set_compression(CompressionMode[variant.upper()], CompressionFormat.ZSTD)
     with writer:
-        scan_c = writer.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
-        odom_c = writer.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=store)
-        cmd_c = writer.add_connection("/cmd_vel", "geometry_msgs/msg/Twist", typestore=store)
-        sonar_c = writer.add_connection("/range", "sensor_msgs/msg/Range", typestore=store)
-        events = []
-        for k in range(SCANS):
-            ns = T0_NS + k * 100_000_000
-            msg = t["sensor_msgs/msg/LaserScan"](
-                header=header(ns, "laser"),
-                angle_min=0.0,
-                angle_max=math.radians(359.5),
-                angle_increment=math.radians(0.5),
-                time_increment=0.1 / READINGS,
-                scan_time=0.1,
-                range_min=RANGE_MIN,
-                range_max=RANGE_MAX,
-                ranges=scan_ranges(k),
-                intensities=np.full(READINGS, 100.0 + k, dtype=np.float32),
-            )
-            # Logged when the revolution ends, after the odometry stamped later: t = 0 is
-            # still the first scan's stamp.
-            events.append((ns + 100_000_000, scan_c, msg, "sensor_msgs/msg/LaserScan"))
-            sonar = t["sensor_msgs/msg/Range"](
-                header=header(ns + 5_000_000, "sonar"),
-                radiation_type=0,
-                field_of_view=math.radians(30.0),
-                min_range=0.02,
-                max_range=4.0,
-                range=float("inf") if k == 3 else 1.0 + 0.01 * k,
-            )
-            events.append((ns + 5_000_000, sonar_c, sonar, "sensor_msgs/msg/Range"))
-        for j in range(2 * SCANS):
-            ns = T0_NS + ODOM_AFTER_NS + j * 50_000_000
-            x, y, yaw = odom_pose(j)
-            odom = t["nav_msgs/msg/Odometry"](
-                header=header(ns, "odom"),
-                child_frame_id="base_link",
-                pose=t["geometry_msgs/msg/PoseWithCovariance"](
-                    pose=Pose(
-                        position=Point(x=x, y=y, z=0.0),
-                        orientation=Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
-                    ),
-                    covariance=cov,
-                ),
-                twist=t["geometry_msgs/msg/TwistWithCovariance"](
-                    twist=Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4)),
-                    covariance=cov,
-                ),
-            )
-            events.append((ns, odom_c, odom, "nav_msgs/msg/Odometry"))
-        for c in range(SCANS // 2):
-            # Unstamped: the recorder's log time is its time (on the stamps' clock here).
-            ns = T0_NS + c * 200_000_000 + 1_000_000
-            twist = Twist(linear=Vector3(x=0.2, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.4 + 0.01 * c))
-            events.append((ns, cmd_c, twist, "geometry_msgs/msg/Twist"))
-        for ns, conn, msg, kind in sorted(events, key=lambda e: e[0]):
-            writer.write(conn, ns, store.serialize_cdr(msg, kind))
+        connections = {}
+        for ns, topic, msg, kind in events(store):
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, kind, typestore=store)
+            writer.write(connections[topic], ns, store.serialize_cdr(msg, kind))
+
+
+def write_ros1(path, compression):
+    """The same messages as a ROS 1 bag, rosbags' rosbag1 writer, chunks of 64 kB (several)
+    compressed with `compression` (none, bz2, lz4)."""
+    from rosbags.rosbag1 import Writer as Ros1Writer
+
+    from rosbags.typesys import get_types_from_msg
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    # Noetic's store lacks tf2_msgs: its one message, as tf2_msgs/msg/TFMessage.msg has it.
+    store.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms", "tf2_msgs/msg/TFMessage"))
+    writer = Ros1Writer(path)
+    if compression != "none":
+        writer.set_compression(Ros1Writer.CompressionFormat[compression.upper()])
+    writer.chunk_threshold = 64 * 1024
+    with writer:
+        connections = {}
+        for ns, topic, msg, kind in events(store):
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, kind, typestore=store)
+            writer.write(connections[topic], ns, store.serialize_ros1(msg, kind))
 
 
 # The foreign bag: a robot under a namespace, its lidar mounted upside down (clockwise from
@@ -401,6 +460,11 @@ def imported(bagdir, rec):
     for row, k in zip(sonar, [k for k in range(SCANS) if k != 3]):
         close(float(row["range_m"]), 1.0 + 0.01 * k, 1e-6, f"sonar {k}")
         close(float(row["t_s"]), 0.1 * k + 0.005, 1e-9, f"sonar {k} t_s")
+    with open(rec / "meta.toml", "rb") as f:
+        lidar_mount = tomllib.load(f).get("lidar", {})
+    got = tuple(lidar_mount.get(k, 0.0) for k in ("x_m", "y_m", "yaw_deg"))
+    for g, want, what in zip(got, MOUNT, ("x_m", "y_m", "yaw_deg")):
+        close(g, want, 1e-9, f"meta.toml [lidar] {what} (from /tf_static)")
     print(f"rosbags_check: hilsim imported the rosbags bag: {len(lidar)} lidar readings, "
           f"{len(odometry)} odometry, {len(commands)} commands, {len(sonar)} sonar rows agree")
 
@@ -604,6 +668,8 @@ if __name__ == "__main__":
     mode = sys.argv[1]
     if mode == "write":
         write(Path(sys.argv[2]), *sys.argv[3:4])
+    elif mode == "write-ros1":
+        write_ros1(Path(sys.argv[2]), sys.argv[3])
     elif mode == "rewrite":
         rewrite(Path(sys.argv[2]), sys.argv[3], sys.argv[4])
     elif mode == "imported":

@@ -88,6 +88,8 @@ pub(crate) struct Conclusion {
     pub located: Option<Evidence>,
     pub effects: Vec<NamedEffect>,
     pub unexplained: Vec<Evidence>,
+    /// Departures the world's own error can make (a map's cells), strongest first.
+    pub world: Vec<Evidence>,
     pub explanation: String,
 }
 
@@ -137,6 +139,20 @@ pub(crate) fn conclude(
         }
     }
     unexplained.sort_by(|a, b| b.score.total_cmp(&a.score));
+    // What is significant and above the floors, but within the world's reach: the map's error
+    // as likely as the sensor's.
+    let mut world: Vec<Evidence> = left
+        .iter()
+        .filter(|l| unexplained.iter().all(|u| u.sensor != l.sensor))
+        .filter_map(|l| {
+            l.evidence
+                .iter()
+                .filter(|e| e.within_world(threshold, floors))
+                .max_by(|a, b| a.score.total_cmp(&b.score))
+                .cloned()
+        })
+        .collect();
+    world.sort_by(|a, b| b.score.total_cmp(&a.score));
     let cone = declared_cone(ctx);
     let mut explanation = effects
         .iter()
@@ -165,10 +181,23 @@ pub(crate) fn conclude(
             format!("the {} ({}{size})", u.sensor, u.place)
         })
         .collect();
-    let verdict = match (effects.first(), unexplained.first()) {
-        (Some(e), _) => Verdict::Effect(e.fit.effect),
-        (None, Some(_)) => Verdict::Unexplained,
-        (None, None) => Verdict::None,
+    let world_words: Vec<String> = world
+        .iter()
+        .map(|w| {
+            format!(
+                "the {} ({}, {:.1} mm, where the map's cells can move a reading by {:.1} mm)",
+                w.sensor,
+                w.place,
+                w.size_m * 1000.0,
+                w.world_m * 1000.0
+            )
+        })
+        .collect();
+    let verdict = match (effects.first(), unexplained.first(), world.first()) {
+        (Some(e), _, _) => Verdict::Effect(e.fit.effect),
+        (None, Some(_), _) => Verdict::Unexplained,
+        (None, None, Some(_)) => Verdict::WorldMismatch,
+        (None, None, None) => Verdict::None,
     };
     match verdict {
         Verdict::Effect(_) if !left_words.is_empty() => {
@@ -205,6 +234,14 @@ pub(crate) fn conclude(
                 )
             };
         }
+        Verdict::WorldMismatch => {
+            explanation = format!(
+                "A mismatch is located in {} within what the world's own error can make: the \
+                 map is as likely off there as the sensor, so no sensor physics is named from \
+                 this world.",
+                world_words.join("; ")
+            );
+        }
         Verdict::None => {
             explanation = "The recording agrees with the simulation within its noise: no \
                            test finds structure in the residuals larger than the sensors' \
@@ -212,15 +249,22 @@ pub(crate) fn conclude(
                 .to_string();
         }
     }
+    if !matches!(verdict, Verdict::WorldMismatch) && !world_words.is_empty() {
+        explanation += &format!(
+            " Within the world's own error (the map as likely off as the sensor): {}.",
+            world_words.join("; ")
+        );
+    }
     let located = match effects.first() {
         Some(e) => e.located.clone(),
-        None => unexplained.first().cloned(),
+        None => unexplained.first().or(world.first()).cloned(),
     };
     Conclusion {
         verdict,
         located,
         effects,
         unexplained,
+        world,
         explanation,
     }
 }

@@ -197,6 +197,7 @@ pub fn diagnose_with_progress(
         located,
         effects,
         unexplained,
+        world,
         explanation,
     } = conclude(&ctx, &nominal, named, &left, &dead, options);
     let significant: Vec<Evidence> = nominal
@@ -231,6 +232,7 @@ pub fn diagnose_with_progress(
         fitted,
         effects,
         unexplained,
+        world,
         candidates,
         sensors: nominal.sensors,
         evidence: significant,
@@ -682,6 +684,8 @@ fn misaligned_evidence(sensor: Sensor, wild: f64) -> Evidence {
         range: None,
         size_m: f64::NAN,
         noise_m: f64::NAN,
+        world_m: 0.0,
+        beyond_world_m: f64::NAN,
     }
 }
 

@@ -111,12 +111,25 @@ fn predictive_mean(p: &Predictive) -> f64 {
 /// edge between two surfaces metres apart, which would make a millimetre's effect look a metre
 /// large. The encoders' and the drive's predictions have no such jumps, and an effect of
 /// theirs acts on few readings (a lag on the windows after a change of command): their RMS.
-fn effect_size(before: &[Predictive], after: &[Predictive], ranges: bool) -> (f64, f64) {
+fn effect_size(
+    before: &[Predictive],
+    after: &[Predictive],
+    ranges: bool,
+    world_reach_m: &[f64],
+) -> (f64, f64) {
     let mut change: Vec<(f64, f64)> = before
         .iter()
         .zip(after)
-        .filter_map(|(b, a)| {
-            let d = predictive_mean(a) - predictive_mean(b);
+        .enumerate()
+        .filter_map(|(k, (b, a))| {
+            // Beyond what the world's own error can move the reading (a map's cells).
+            let reach = world_reach_m.get(k).copied().unwrap_or(0.0);
+            let raw = (predictive_mean(a) - predictive_mean(b)).abs();
+            let d = if raw.is_finite() {
+                (raw - reach).max(0.0)
+            } else {
+                raw
+            };
             let sd = a.iter().map(|g| g.weight * g.sd_m).sum::<f64>()
                 / a.iter().map(|g| g.weight).sum::<f64>();
             (d.is_finite() && sd.is_finite()).then_some((d.abs(), sd))
@@ -171,14 +184,16 @@ pub(crate) fn score(
     let (rmse_before, _, _) = rmse(&before, both);
     let (rmse_after, noise_floor, heldout_n) = rmse(&after, both);
     let ranges = matches!(data.sensor, Sensor::Lidar | Sensor::Sonar);
+    let reach: Vec<f64> = heldout.iter().map(|&i| data.world_reach(i)).collect();
     let (size_m, size_noise_m) = if ctx.conditions(data) {
         effect_size(
             &ctx.predict_unconditioned(data, base, &heldout),
             &ctx.predict_unconditioned(data, &fitted, &heldout),
             ranges,
+            &reach,
         )
     } else {
-        effect_size(&before_p, &after_p, ranges)
+        effect_size(&before_p, &after_p, ranges, &reach)
     };
     let train_gain = best - train_base;
     CandidateFit {

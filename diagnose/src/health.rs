@@ -157,6 +157,8 @@ fn evidence(sensor: Sensor, place: &str, detail: String) -> Evidence {
         range: None,
         size_m: f64::NAN,
         noise_m: f64::NAN,
+        world_m: 0.0,
+        beyond_world_m: f64::NAN,
     }
 }
 

@@ -58,6 +58,13 @@ pub struct Evidence {
     pub size_m: f64,
     /// The declared noise there: the RMS of the predicted standard deviations, metres.
     pub noise_m: f64,
+    /// How far the world's own error can move those readings, metres (their mean; 0 in a world
+    /// drawn exactly).
+    pub world_m: f64,
+    /// The departure's size beyond what the world's error can make, metres: measured as
+    /// `size_m` is, on each reading's residual less its world reach (a bias), or on the spread
+    /// less the reach's (a spread). `size_m` in a world drawn exactly.
+    pub beyond_world_m: f64,
 }
 
 impl Evidence {
@@ -68,7 +75,24 @@ impl Evidence {
     #[must_use]
     pub fn counts(&self, threshold: f64, floors: &Floors) -> bool {
         self.score > threshold
+            && (self.size_m.is_nan()
+                || self.beyond_world_m > floors.floor_m(self.sensor, self.noise_m))
+    }
+
+    /// Whether this departure is significant and above its floor (whether or not the world's
+    /// error could make it).
+    #[must_use]
+    pub fn beyond_floor(&self, threshold: f64, floors: &Floors) -> bool {
+        self.score > threshold
             && (self.size_m.is_nan() || self.size_m > floors.floor_m(self.sensor, self.noise_m))
+    }
+
+    /// Whether the world's own error can make this departure (what is left of it beyond the
+    /// world's reach is under the floor): a sensor's physics then cannot be told from the
+    /// map's error.
+    #[must_use]
+    pub fn within_world(&self, threshold: f64, floors: &Floors) -> bool {
+        self.beyond_floor(threshold, floors) && !self.counts(threshold, floors)
     }
 }
 
@@ -348,6 +372,46 @@ impl<'a> Scores<'a> {
         }
     }
 
+    /// The mean of the world's reach at the positions `ks`, metres.
+    fn world(&self, ks: &[usize]) -> f64 {
+        if ks.is_empty() {
+            return 0.0;
+        }
+        ks.iter().map(|&k| self.reach(k)).sum::<f64>() / ks.len() as f64
+    }
+
+    /// The world's reach of the reading at position `k`, metres.
+    fn reach(&self, k: usize) -> f64 {
+        self.rows.get(k).map_or(0.0, |&i| self.data.world_reach(i))
+    }
+
+    /// The mean residual (metres) of the positions `ks`, each less what the world's error can
+    /// make of it (its residual moved toward 0 by its reach, not past it).
+    fn mean_beyond_world(&self, ks: &[usize]) -> f64 {
+        let r: Vec<f64> = ks
+            .iter()
+            .map(|&k| (self.fits[k].residual, self.reach(k)))
+            .filter(|(r, _)| r.is_finite())
+            .map(|(r, reach)| r.signum() * (r.abs() - reach).max(0.0))
+            .collect();
+        if r.is_empty() {
+            f64::NAN
+        } else {
+            r.iter().sum::<f64>() / r.len() as f64
+        }
+    }
+
+    /// An excess spread `excess_m` at `ks` less the spread the world's error can make there
+    /// (a reach `u` spreads a reading by up to `u/√3`, a surface anywhere within ±u), metres.
+    fn spread_beyond_world(&self, excess_m: f64, ks: &[usize]) -> f64 {
+        if ks.is_empty() || !excess_m.is_finite() {
+            return excess_m;
+        }
+        let world_var =
+            ks.iter().map(|&k| self.reach(k).powi(2) / 3.0).sum::<f64>() / ks.len() as f64;
+        (excess_m * excess_m - world_var).max(0.0).sqrt()
+    }
+
     /// The RMS of the predicted standard deviations at the positions `ks`, metres.
     fn noise(&self, ks: &[usize]) -> f64 {
         let v: Vec<f64> = ks
@@ -404,6 +468,8 @@ impl<'a> Scores<'a> {
                 range: None,
                 size_m: self.mean_residual(&all).abs(),
                 noise_m: self.noise(&all),
+                world_m: self.world(&all),
+                beyond_world_m: self.mean_beyond_world(&all).abs(),
             },
             Evidence {
                 sensor,
@@ -419,6 +485,8 @@ impl<'a> Scores<'a> {
                 range: None,
                 size_m: self.excess_spread(&all),
                 noise_m: self.noise(&all),
+                world_m: self.world(&all),
+                beyond_world_m: self.spread_beyond_world(self.excess_spread(&all), &all),
             },
         ]
     }
@@ -477,6 +545,7 @@ impl<'a> Scores<'a> {
         let (mb, _, ks) = &stats[g];
         let everywhere: Vec<usize> = (0..self.rows.len()).collect();
         let overall_residual = self.mean_residual(&everywhere);
+        let overall_beyond = self.mean_beyond_world(&everywhere);
         let bias = Evidence {
             sensor,
             test: TestKind::BiasAgainst,
@@ -494,6 +563,8 @@ impl<'a> Scores<'a> {
             range: (!c.categorical()).then_some(*lim),
             size_m: (self.mean_residual(ks) - overall_residual).abs(),
             noise_m: self.noise(ks),
+            world_m: self.world(ks),
+            beyond_world_m: (self.mean_beyond_world(ks) - overall_beyond).abs(),
         };
         let (sb, g) = best_spread;
         let (lim, _) = &groups[g];
@@ -514,6 +585,8 @@ impl<'a> Scores<'a> {
             range: (!c.categorical()).then_some(*lim),
             size_m: self.excess_spread(ks),
             noise_m: self.noise(ks),
+            world_m: self.world(ks),
+            beyond_world_m: self.spread_beyond_world(self.excess_spread(ks), ks),
         };
         Some([bias, spread])
     }
@@ -557,6 +630,8 @@ impl<'a> Scores<'a> {
             range: None,
             size_m: self.noise(&ks) * (r / (1.0 - r)).sqrt(),
             noise_m: self.noise(&ks),
+            world_m: self.world(&ks),
+            beyond_world_m: self.spread_beyond_world(self.noise(&ks) * (r / (1.0 - r)).sqrt(), &ks),
         })
     }
 }

@@ -85,6 +85,9 @@ pub enum Verdict {
     Effect(Effect),
     /// A mismatch is located but no catalogued effect explains it.
     Unexplained,
+    /// A mismatch is located within what the world's own error can make (a map's cells): the
+    /// world is as likely off there as the sensor.
+    WorldMismatch,
 }
 
 impl Verdict {
@@ -95,6 +98,7 @@ impl Verdict {
             Verdict::None => "none",
             Verdict::Effect(e) => e.name(),
             Verdict::Unexplained => "unexplained",
+            Verdict::WorldMismatch => "world_mismatch",
         }
     }
 }
@@ -144,6 +148,9 @@ pub struct Diagnosis {
     /// Every located mismatch no named effect explains (at most one a sensor: the strongest
     /// structure left in its residuals under its named effects), with its size.
     pub unexplained: Vec<Evidence>,
+    /// Every located mismatch within what the world's own error can make (an occupancy map's
+    /// cells): the world as likely off there as the sensor (at most one a sensor).
+    pub world: Vec<Evidence>,
     /// Every candidate tried, best held-out score first.
     pub candidates: Vec<CandidateFit>,
     /// Each sensor compared.

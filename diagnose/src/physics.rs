@@ -143,6 +143,9 @@ pub struct LidarPrediction {
     pub reflectivity: f64,
     /// Whether the beam's direction noise or footprint reaches another surface.
     pub near_edge: bool,
+    /// How far the world's own uncertainty (a map's cells) can move the reading, metres; 0 in
+    /// a world drawn exactly.
+    pub world_reach_m: f64,
 }
 
 /// The predictive distribution of one sonar ping.
@@ -191,7 +194,7 @@ pub struct OdometryPrediction {
 ///             LidarPrediction {
 ///                 components: [Gaussian::new(1.0, d, 0.01)].into_iter().collect(),
 ///                 true_range_m: Some(d), incidence_deg: q.angle_deg, object: Some(0),
-///                 reflectivity: 0.8, near_edge: false,
+///                 reflectivity: 0.8, near_edge: false, world_reach_m: 0.0,
 ///             }
 ///         }).collect()
 ///     }

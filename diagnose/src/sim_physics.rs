@@ -293,6 +293,7 @@ impl Physics for SimPhysics {
                         object: e.obstacle.map(|o| self.object_id(o)),
                         reflectivity: e.reflectivity,
                         near_edge: e.near_edge,
+                        world_reach_m: e.world_reach_m,
                     }
                 })
             })
@@ -417,5 +418,6 @@ fn empty_lidar() -> LidarPrediction {
         object: None,
         reflectivity: 0.0,
         near_edge: false,
+        world_reach_m: 0.0,
     }
 }

@@ -110,6 +110,7 @@ impl Physics for Corridor {
                     object: Some(0),
                     reflectivity: 0.8,
                     near_edge: false,
+                    world_reach_m: 0.0,
                 }
             })
             .collect()

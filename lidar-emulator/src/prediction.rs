@@ -49,14 +49,44 @@ const GH_WEIGHTS: [f64; 7] = [
 ];
 
 /// The obliquest incidence a surface's uncertainty is carried along the beam at: |cos θ| of
-/// 84° (ten times the normal's).
-const MIN_SURFACE_COS: f64 = 0.1;
+/// 87° (twenty times the normal's).
+const MIN_SURFACE_COS: f64 = 0.05;
 
 /// The variance a reading gets from the uncertainty of the surface it hit (a map's cell): the
-/// surface's along its normal, carried along the beam (divided by |cos θ|).
+/// surface anywhere within ±u of where the map puts it along its normal (variance u²/3),
+/// carried along the beam (divided by |cos θ|).
 fn surface_var_m2(ret: &BeamReturn) -> f64 {
-    let sd = ret.hit.surface_sd_m / ret.cos_incidence.max(MIN_SURFACE_COS);
-    sd * sd
+    let u = ret.hit.surface_uncertainty_m / ret.cos_incidence.max(MIN_SURFACE_COS);
+    u * u / 3.0
+}
+
+/// How far the world's own uncertainty can move the reading of a beam whose centre ray
+/// returned `centre`: its surface moved ±u along the normal (`u / |cos θ|` along the beam), or
+/// across the beam (the beam then meeting what lies beside: the change of range of the rays
+/// `u` to either side at the hit). 0 for an exactly drawn surface.
+fn world_reach_m(
+    world: &World,
+    origin: [f64; 2],
+    heading: f64,
+    centre: Option<&BeamReturn>,
+    cast_limit_m: f64,
+) -> f64 {
+    let Some(c) = centre else {
+        return 0.0;
+    };
+    let u = c.hit.surface_uncertainty_m;
+    if u <= 0.0 {
+        return 0.0;
+    }
+    let d = c.hit.distance.max(u);
+    let along = u / c.cos_incidence.max(MIN_SURFACE_COS);
+    let aside = (u / d).atan();
+    let beside = [-aside, aside].map(|o| {
+        world
+            .cast_ray(origin, heading + o, cast_limit_m)
+            .map_or(cast_limit_m - d, |h| (h.distance - d).abs())
+    });
+    along.max(beside[0]).max(beside[1])
 }
 
 /// Directions sampled across an edge: every half σ over ±3.5 σ of the direction noise (the
@@ -86,6 +116,9 @@ pub struct ExpectedLidar {
     pub reflectivity: f64,
     /// Whether the beam's direction noise (or its footprint) reaches another surface.
     pub near_edge: bool,
+    /// How far the world's own uncertainty (a map's cells) can move the reading, metres; 0 in
+    /// a world drawn exactly.
+    pub world_reach_m: f64,
 }
 
 /// What a beam's quadrature directions see: the geometry of one reading, before any range
@@ -101,6 +134,8 @@ pub struct BeamNodes {
     /// Whether the nodes sample the direction densely (an edge within reach) rather than by
     /// Gauss–Hermite quadrature.
     pub dense: bool,
+    /// How far the world's own uncertainty can move the reading, metres.
+    pub world_reach_m: f64,
 }
 
 /// A beam's nodes as cast, on the stack (at most [`DENSE_NODES`]).
@@ -109,6 +144,7 @@ struct CastNodes {
     len: usize,
     centre: usize,
     dense: bool,
+    world_reach_m: f64,
 }
 
 impl CastNodes {
@@ -172,12 +208,24 @@ impl LidarPredictor {
             nodes: cast.nodes().to_vec(),
             centre: cast.centre,
             dense: cast.dense,
+            world_reach_m: cast.world_reach_m,
         }
     }
 
     /// [`LidarPredictor::beam_nodes`] on the stack: a prediction that is not kept allocates
     /// nothing for its nodes.
     fn cast_nodes(&self, world: &World, robot: &Pose, angle_deg: f64) -> CastNodes {
+        let mut out = self.cast_directions(world, robot, angle_deg);
+        let (origin, heading) = self.beam(robot, angle_deg);
+        let centre = out.at[out.centre].1;
+        out.world_reach_m =
+            world_reach_m(world, origin, heading, centre.as_ref(), self.cast_limit_m);
+        out
+    }
+
+    /// The beam's directions and what each returns ([`LidarPredictor::cast_nodes`] without the
+    /// world's reach).
+    fn cast_directions(&self, world: &World, robot: &Pose, angle_deg: f64) -> CastNodes {
         let (origin, heading) = self.beam(robot, angle_deg);
         let cast = |o: f64| {
             self.effects
@@ -188,6 +236,7 @@ impl LidarPredictor {
             len: 1,
             centre: 0,
             dense: false,
+            world_reach_m: 0.0,
         };
         if self.angle_noise_rad <= 0.0 {
             out.at[0] = (1.0, cast(0.0));
@@ -257,7 +306,9 @@ impl LidarPredictor {
     /// (and the skew of the mean) its direction noise gives, and an edge a mixture.
     #[must_use]
     pub fn predict_nodes(&self, beam: &BeamNodes, t_s: f64) -> ExpectedLidar {
-        self.predict_from(&beam.nodes, beam.centre, beam.dense, t_s)
+        let mut e = self.predict_from(&beam.nodes, beam.centre, beam.dense, t_s);
+        e.world_reach_m = beam.world_reach_m;
+        e
     }
 
     /// [`LidarPredictor::predict_nodes`] of the nodes `beam` (centre `centre`, sampled densely
@@ -277,6 +328,7 @@ impl LidarPredictor {
             obstacle: centre.map(|c| c.hit.obstacle),
             reflectivity: centre.map_or(0.0, |c| c.hit.reflectivity),
             near_edge: false,
+            world_reach_m: 0.0,
         };
         // (weight × chance of a valid reading, mean, variance, surface, weight) per node whose
         // reading can be valid.
@@ -372,7 +424,9 @@ impl LidarPredictor {
     #[must_use]
     pub fn predict(&self, world: &World, robot: &Pose, angle_deg: f64, t_s: f64) -> ExpectedLidar {
         let cast = self.cast_nodes(world, robot, angle_deg);
-        self.predict_from(cast.nodes(), cast.centre, cast.dense, t_s)
+        let mut e = self.predict_from(cast.nodes(), cast.centre, cast.dense, t_s);
+        e.world_reach_m = cast.world_reach_m;
+        e
     }
 }
 

@@ -33,10 +33,11 @@ pub struct RayHit {
     pub normal: [f64; 2],
     /// The surface material's reflectivity, (0, 1].
     pub reflectivity: f64,
-    /// How uncertain the surface's position is along its normal, metres (one standard
-    /// deviation): 0 for a scenario's drawn shapes, the quantisation of a map's cell
-    /// (`resolution / √12`, the surface anywhere across the cell) for a map's.
-    pub surface_sd_m: f64,
+    /// How far the surface may be from where the world puts it, along its normal and across
+    /// the beam, metres: 0 for a scenario's drawn shapes, a cell for a map's (the surface
+    /// anywhere across its cell, and a map's rasterised outline a cell fatter or thinner than
+    /// the object).
+    pub surface_uncertainty_m: f64,
 }
 
 /// The physics world: obstacles plus the robot's body.
@@ -276,7 +277,7 @@ impl World {
                 obstacle,
                 normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
                 reflectivity,
-                surface_sd_m: 0.0,
+                surface_uncertainty_m: 0.0,
             })
         });
         let Some((map, reflectivity)) = &self.map else {
@@ -289,7 +290,7 @@ impl World {
                 obstacle: Obstacle::Map,
                 normal: cell.normal,
                 reflectivity: *reflectivity,
-                surface_sd_m: map.resolution_m() / 12f64.sqrt(),
+                surface_uncertainty_m: map.resolution_m(),
             }),
             _ => shape_hit,
         }

@@ -103,16 +103,21 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
     let scenario = Scenario::from_toml(&world.scenario_toml(&files, &noiseless), &files.scenario)?;
     let fit = compare(&scenario, &args.recording)?;
     if !noise_calibrated && fit.spread_m.is_finite() {
-        // The spread of the log against its twin: the log's noise and the map's error
-        // together, an upper bound of the lidar's own.
-        declared.lidar_noise = vec![(fit.spread_m * 1e4).round() / 1e4];
+        // The spread of the log against its twin by range, as the papers' noise polynomial:
+        // the map's quantisation taken out (the diagnosis carries it itself), what is left is
+        // an upper bound of the lidar's noise.
+        let cell = scenario
+            .files
+            .map
+            .as_ref()
+            .map_or(0.0, |m| m.resolution_m());
+        declared.lidar_noise = fit.noise_polynomial(cell);
     }
     world.write(&files, &declared)?;
     writeln!(
         out,
         "twin: {} of {} readings within {COMPARED_WITHIN_M} m paired ({:.1} %); |twin − log| \
-         median {:.1} mm, 90th percentile {:.1} mm; log − twin median {:+.1} mm, spread {:.1} mm \
-         {}",
+         median {:.1} mm, 90th percentile {:.1} mm; log − twin median {:+.1} mm, spread {:.1} mm",
         fit.paired,
         fit.compared,
         100.0 * fit.paired_share(),
@@ -120,12 +125,15 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         1000.0 * fit.p90_abs_m,
         1000.0 * fit.median_m,
         1000.0 * fit.spread_m,
-        if noise_calibrated {
-            ""
-        } else {
-            " (declared as the lidar's noise)"
-        }
     )?;
+    if !noise_calibrated {
+        writeln!(
+            out,
+            "declared the lidar's noise (its spread against the twin by range, less the map's \
+             cells): {:?} (β₀, β₁, β₂ of σ = β₀ + β₁ d + β₂ d², metres)",
+            declared.lidar_noise
+        )?;
+    }
     writeln!(out, "wrote {}", files.scenario.display())?;
     Ok(())
 }

@@ -36,6 +36,97 @@ pub struct TwinFit {
     /// Robust spread of log − twin (1.4826 × the median absolute deviation), metres: the log's
     /// noise and the map's error together.
     pub spread_m: f64,
+    /// The robust spread by the twin's range: (the bin's middle, metres; spread, metres;
+    /// readings), bins of [`RANGE_BIN_M`] with at least [`MIN_BIN_READINGS`] readings.
+    pub spread_by_range: Vec<(f64, f64, u64)>,
+}
+
+/// Width of the range bins the spread is measured in, metres.
+pub const RANGE_BIN_M: f64 = 0.5;
+/// Fewest readings a range bin's spread is measured from.
+pub const MIN_BIN_READINGS: u64 = 200;
+
+impl TwinFit {
+    /// The lidar's noise as the papers' eq. 2 polynomial `β₀ + β₁ d + β₂ d²` (standard
+    /// deviation, metres) fitted to the spread by range, less a map quantisation's variance
+    /// `cell_m² / 12` (which the diagnosis carries itself), weighted by each bin's readings:
+    /// of the forms with every coefficient non-negative, the closest. The spread is the log's
+    /// noise and the map's error together: an upper bound of the lidar's own.
+    #[must_use]
+    pub fn noise_polynomial(&self, cell_m: f64) -> Vec<f64> {
+        let quantisation = cell_m * cell_m / 12.0;
+        let bins: Vec<(f64, f64, f64)> = self
+            .spread_by_range
+            .iter()
+            .map(|&(d, sd, n)| (d, (sd * sd - quantisation).max(0.0).sqrt(), n as f64))
+            .collect();
+        let fallback = (self.spread_m * self.spread_m - quantisation)
+            .max(0.0)
+            .sqrt();
+        let mut best: Option<(f64, Vec<f64>)> = None;
+        for terms in [&[0usize][..], &[0, 2], &[0, 1], &[0, 1, 2]] {
+            let Some(c) = weighted_fit(&bins, terms) else {
+                continue;
+            };
+            if c.iter().any(|v| *v < 0.0) {
+                continue;
+            }
+            let mut coeffs = vec![0.0; terms.iter().max().map_or(1, |m| m + 1)];
+            for (t, v) in terms.iter().zip(&c) {
+                coeffs[*t] = *v;
+            }
+            let sse: f64 = bins
+                .iter()
+                .map(|(d, sd, n)| {
+                    let p: f64 = coeffs.iter().rev().fold(0.0, |acc, c| acc * d + c);
+                    n * (sd - p).powi(2)
+                })
+                .sum();
+            if best.as_ref().is_none_or(|(b, _)| sse < *b) {
+                best = Some((sse, coeffs));
+            }
+        }
+        let mut coeffs = best.map_or_else(|| vec![fallback], |(_, c)| c);
+        // A millimetre at least: a noiseless declaration makes every reading's likelihood a spike.
+        coeffs[0] = coeffs[0].max(0.001);
+        coeffs.iter().map(|c| (c * 1e6).round() / 1e6).collect()
+    }
+}
+
+/// Weighted least squares of `sd = Σ c_t d^t` over `terms` (at most three); `None` when
+/// singular.
+fn weighted_fit(bins: &[(f64, f64, f64)], terms: &[usize]) -> Option<Vec<f64>> {
+    let k = terms.len();
+    let mut a = [[0.0; 3]; 3];
+    let mut b = [0.0; 3];
+    for &(d, sd, n) in bins {
+        let x: Vec<f64> = terms.iter().map(|&t| d.powi(t as i32)).collect();
+        for i in 0..k {
+            b[i] += n * x[i] * sd;
+            for j in 0..k {
+                a[i][j] += n * x[i] * x[j];
+            }
+        }
+    }
+    // Gaussian elimination with partial pivoting on the k × k system.
+    for col in 0..k {
+        let pivot = (col..k).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() < 1e-12 {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in 0..k {
+            if row != col {
+                let f = a[row][col] / a[col][col];
+                for j in col..k {
+                    a[row][j] -= f * a[col][j];
+                }
+                b[row] -= f * b[col];
+            }
+        }
+    }
+    Some((0..k).map(|i| b[i] / a[i][i]).collect())
 }
 
 impl TwinFit {
@@ -84,6 +175,17 @@ impl Histogram {
         }
     }
 
+    /// The robust spread of the values: 1.4826 × their median absolute deviation.
+    fn spread(&self) -> f64 {
+        let median = self.quantile(0.5);
+        let mut deviation = Histogram::new(0.0, 2.0 * (self.counts.len() as f64) * BIN_M);
+        for (k, &c) in self.counts.iter().enumerate() {
+            deviation.add_n((self.from_m + k as f64 * BIN_M - median).abs(), c);
+        }
+        deviation.above += self.below + self.above;
+        1.4826 * deviation.quantile(0.5)
+    }
+
     fn total(&self) -> u64 {
         self.below + self.above + self.counts.iter().sum::<u64>()
     }
@@ -123,6 +225,10 @@ pub fn compare(scenario: &Scenario, recording: &Path) -> Result<TwinFit, TwinErr
         Emulation::new(scenario, scenario.seed).map_err(|e| TwinError::Model(e.to_string()))?;
     let mut abs = Histogram::new(0.0, SPAN_M);
     let mut signed = Histogram::new(-SPAN_M, SPAN_M);
+    let range_bins = (COMPARED_WITHIN_M / RANGE_BIN_M).ceil() as usize;
+    let mut by_range: Vec<Histogram> = (0..range_bins)
+        .map(|_| Histogram::new(-SPAN_M, SPAN_M))
+        .collect();
     let (mut compared, mut paired) = (0_u64, 0_u64);
     // The log's reading being paired and its index within its revolution.
     let mut pending: Option<(LidarSample, u64)> = None;
@@ -162,25 +268,30 @@ pub fn compare(scenario: &Scenario, recording: &Path) -> Result<TwinFit, TwinErr
                     let d = r.range_m - f64::from(twin.distance_mm) / 1000.0;
                     abs.add(d.abs());
                     signed.add(d);
+                    let bin = (f64::from(twin.distance_mm) / 1000.0 / RANGE_BIN_M) as usize;
+                    if let Some(h) = by_range.get_mut(bin) {
+                        h.add(d);
+                    }
                 }
             }
             next_log(&mut pending)?;
         }
     }
     let median_m = signed.quantile(0.5);
-    // The median absolute deviation, from the signed histogram's bins.
-    let mut deviation = Histogram::new(0.0, 2.0 * SPAN_M);
-    for (k, &c) in signed.counts.iter().enumerate() {
-        deviation.add_n((signed.from_m + k as f64 * BIN_M - median_m).abs(), c);
-    }
-    deviation.above += signed.below + signed.above;
+    let spread_by_range = by_range
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.total() >= MIN_BIN_READINGS)
+        .map(|(k, h)| ((k as f64 + 0.5) * RANGE_BIN_M, h.spread(), h.total()))
+        .collect();
     Ok(TwinFit {
         compared,
         paired,
         median_abs_m: abs.quantile(0.5),
         p90_abs_m: abs.quantile(0.9),
         median_m,
-        spread_m: 1.4826 * deviation.quantile(0.5),
+        spread_m: signed.spread(),
+        spread_by_range,
     })
 }
 
@@ -198,5 +309,32 @@ mod tests {
         assert!((h.quantile(0.9) - 0.090).abs() <= BIN_M);
         h.add(5.0);
         assert_eq!(h.total(), 101);
+    }
+
+    #[test]
+    fn a_noise_growing_with_range_is_fitted_as_the_papers_polynomial() {
+        // 3 mm + 2 mm/m² × d², the landmark paper's XV-11 noise form, measured in six bins.
+        let spread_by_range = (1..=6)
+            .map(|k| {
+                let d = f64::from(k) - 0.25;
+                (d, 0.003 + 0.002 * d * d, 1000)
+            })
+            .collect();
+        let fit = TwinFit {
+            compared: 6000,
+            paired: 6000,
+            median_abs_m: 0.01,
+            p90_abs_m: 0.03,
+            median_m: 0.0,
+            spread_m: 0.02,
+            spread_by_range,
+        };
+        let c = fit.noise_polynomial(0.0);
+        let at = |d: f64| c.iter().rev().fold(0.0, |acc, v| acc * d + v);
+        assert!(
+            (at(1.0) - 0.005).abs() < 2e-4 && (at(5.0) - 0.053).abs() < 5e-4,
+            "{c:?}"
+        );
+        assert!(c.iter().all(|v| *v >= 0.0), "{c:?}");
     }
 }

@@ -124,6 +124,10 @@ pub(crate) struct SensorData {
     /// Groups of readings that share an error (of an estimated trajectory), by row; `None`:
     /// every reading's error is its own.
     pub clusters: Option<Vec<u32>>,
+    /// How far the world's own error can move each reading, metres, by row: a map's surface
+    /// anywhere across its cell, carried along the beam (`DeclaredLidar::world_uncertainty_m`
+    /// over |cos θ|); empty when the world is drawn exactly.
+    pub world_reach_m: Vec<f64>,
 }
 
 /// One reading's predictive distribution (empty: no reading expected).
@@ -139,6 +143,11 @@ impl SensorData {
         (0..self.len())
             .filter(|&i| half.is_none_or(|h| self.heldout[i] == h))
             .collect()
+    }
+
+    /// How far the world's own error can move reading `row`, metres (0 in an exact world).
+    pub fn world_reach(&self, row: usize) -> f64 {
+        self.world_reach_m.get(row).copied().unwrap_or(0.0)
     }
 
     pub fn covariate(&self, c: Covariate) -> Option<&[f64]> {

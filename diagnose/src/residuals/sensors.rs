@@ -122,6 +122,11 @@ pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
         epsilon: 0.002,
         outlier_density: 0.002 / declared.max_range_m,
         clusters: None,
+        world_reach_m: if declared.world_uncertainty_m > 0.0 {
+            nominal.iter().map(|p| p.world_reach_m).collect()
+        } else {
+            Vec::new()
+        },
     }))
 }
 
@@ -251,6 +256,7 @@ pub(crate) fn sonar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
         epsilon: 0.002,
         outlier_density: 0.002 / 5.0,
         clusters: None,
+        world_reach_m: Vec::new(),
     }))
 }
 
@@ -303,6 +309,7 @@ pub(crate) fn odometer(ctx: &Context<'_>) -> Result<Option<SensorData>, Mismatch
         epsilon: 1e-4,
         outlier_density: 1e-4 / 1.0,
         clusters: None,
+        world_reach_m: Vec::new(),
     }))
 }
 
@@ -387,5 +394,6 @@ pub(crate) fn drive(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
         epsilon: 1e-4,
         outlier_density: 1e-4 / 0.5,
         clusters: None,
+        world_reach_m: Vec::new(),
     }))
 }

@@ -30,7 +30,7 @@ th {{ background: #f3f3f3; }} code {{ background: #f3f3f3; padding: 0 .2em; }} i
     let class = match d.verdict {
         Verdict::None => "none",
         Verdict::Effect(_) => "effect",
-        Verdict::Unexplained => "unexplained",
+        Verdict::Unexplained | Verdict::WorldMismatch => "unexplained",
     };
     let _ = writeln!(
         s,
@@ -105,6 +105,24 @@ fn fix(s: &mut String, d: &Diagnosis) {
                 escape(&params.join(", ")),
                 mm(f.rmse_before),
                 mm(f.rmse_after)
+            );
+        }
+        let _ = writeln!(s, "</table>");
+    }
+    if !d.world.is_empty() {
+        let _ = writeln!(
+            s,
+            "<h2>Within the world's error</h2><p>Mismatches the world's own error (its map's cells) can make: the map as likely off there as the sensor.</p><table><tr><th>sensor</th><th>where</th><th>size</th><th>the map's reach there</th><th>evidence</th></tr>"
+        );
+        for w in &d.world {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                w.sensor,
+                escape(&w.place),
+                mm(w.size_m),
+                mm(w.world_m),
+                escape(&w.detail)
             );
         }
         let _ = writeln!(s, "</table>");

@@ -130,8 +130,24 @@ pub fn to_json(d: &Diagnosis) -> Value {
                 "sensor": u.sensor.name(),
                 "where": u.place,
                 "size_m": num(u.size_m),
+                "world_m": num(u.world_m),
+                "beyond_world_m": num(u.beyond_world_m),
                 "evidence": u.detail,
                 "score": num(u.score),
+            })
+        })
+        .collect();
+    let world: Vec<Value> = d
+        .world
+        .iter()
+        .map(|w| {
+            json!({
+                "sensor": w.sensor.name(),
+                "where": w.place,
+                "size_m": num(w.size_m),
+                "world_m": num(w.world_m),
+                "evidence": w.detail,
+                "score": num(w.score),
             })
         })
         .collect();
@@ -145,6 +161,7 @@ pub fn to_json(d: &Diagnosis) -> Value {
         "fit": fit,
         "effects": effects,
         "unexplained": unexplained,
+        "world": world,
         "candidates": candidates,
         "alignment": d.alignment.name(),
         "references": d

@@ -57,6 +57,19 @@ pub fn summary(d: &Diagnosis) -> String {
             mm(f.size_m)
         );
     }
+    for w in &d.world {
+        let _ = writeln!(
+            s,
+            "within the world's error: {} — {} ({}; the map's cells can move a reading {} there; \
+             {:.1}σ)",
+            w.sensor,
+            w.place,
+            mm(w.size_m),
+            mm(w.world_m),
+            w.score
+        );
+        let _ = writeln!(s, "  {}", w.detail);
+    }
     for u in &d.unexplained {
         let _ = writeln!(
             s,

@@ -53,10 +53,12 @@ impl Scan {
         self.t_s + f64::from(i) * self.beam_period_s
     }
 
-    /// Beam `i`'s angle, degrees in [0, 360).
+    /// Beam `i`'s angle, degrees in [0, 360), to the micro-degree (so that a log's whole
+    /// degrees stay whole after `i` steps of rounding).
     #[must_use]
     pub fn beam_deg(&self, i: u32) -> f64 {
-        (self.first_deg + f64::from(i) * self.step_deg).rem_euclid(360.0)
+        let deg = (self.first_deg + f64::from(i) * self.step_deg).rem_euclid(360.0);
+        ((deg * 1e6).round() / 1e6).rem_euclid(360.0)
     }
 
     fn check(&self) -> Result<(), String> {

@@ -19,3 +19,4 @@ mod ros2;
 mod run;
 mod scenario_test;
 mod serve;
+mod world;

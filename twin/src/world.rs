@@ -36,9 +36,10 @@ impl Default for WorldOptions {
             // between the hits of a beam spacing of 0.5–1° at a few metres.
             resolution_m: 0.03,
             poses: PoseSource::Auto,
-            // The range the twin is compared over; beyond it a 0.5° heading error moves a cell
-            // by more than 7 cm.
-            max_range_m: 8.0,
+            // An indoor SICK's or Hokuyo's farthest readings: a wall seen only from afar is still
+            // in the map (less exactly: a 0.1° heading error moves it 5 cm at 30 m), so that the
+            // twin reads it too.
+            max_range_m: 30.0,
         }
     }
 }
@@ -377,6 +378,15 @@ impl TwinWorld {
     pub fn write(&self, files: &TwinFiles, declared: &Declared) -> Result<(), TwinError> {
         let inputs = [self.recording.as_path()];
         check_output_file(&files.scenario, SCENARIO_KIND, &inputs)?;
+        // A missing directory is made, as `hilsim record` makes a recording's.
+        if let Some(dir) = files
+            .scenario
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+        {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| TwinError::Input(format!("{}: {e}", dir.display())))?;
+        }
         check_output_file(&files.path, PATH_KIND, &inputs)?;
         check_output_file(&files.schedule, SCHEDULE_KIND, &inputs)?;
         if let TwinMap::Built(map) = &self.map {

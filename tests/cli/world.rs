@@ -1,0 +1,155 @@
+//! `hilsim world`: a recorded run's twin (a map built from its scans or the user's, its path,
+//! its scans) that `hilsim record` replays and `hilsim diagnose` holds the run against.
+
+use std::path::Path;
+
+use hilsim_recording::Recording;
+
+use crate::common::{assert_bad_input, hilsim, stderr, stdout};
+
+/// A room with a pillar, a short drive; an unbiased lidar with 5 mm of noise, exact encoders.
+const ROOM: &str = r#"
+name = "twin-room"
+seed = 3
+[world]
+walls = [
+  { from = [-1.0, -1.5], to = [4.0, -1.5] },
+  { from = [4.0, -1.5], to = [4.0, 2.5] },
+  { from = [4.0, 2.5], to = [-1.0, 2.5] },
+  { from = [-1.0, 2.5], to = [-1.0, -1.5] },
+]
+cylinders = [{ center = [2.5, 1.2], radius = 0.15 }]
+[robot]
+start = { x = 0.0, y = 0.0 }
+wheel_base_m = 0.23
+[[drive]]
+speed_mps = 0.3
+distance_m = 0.9
+[[drive]]
+turn_deg = 60.0
+[[drive]]
+speed_mps = 0.3
+distance_m = 0.6
+[[drive]]
+turn_deg = -90.0
+[[drive]]
+speed_mps = 0.3
+distance_m = 0.6
+[sensors.lidar]
+noise = [0.005]
+[sensors.odometer]
+"#;
+
+/// Records the room's run into `dir/rec`.
+fn record(dir: &Path) {
+    std::fs::write(dir.join("room.toml"), ROOM).unwrap();
+    let out = hilsim(dir, &["record", "room.toml", "--out", "rec"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// The share of readings paired that `world` printed.
+fn paired_share(printed: &str) -> f64 {
+    let line = printed.lines().find(|l| l.starts_with("twin: ")).unwrap();
+    let open = line.find('(').unwrap();
+    let close = line.find(" %)").unwrap();
+    line[open + 1..close].parse().unwrap()
+}
+
+#[test]
+fn a_run_gets_a_world_and_its_twin_replays_it_reading_for_reading() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path());
+    let out = hilsim(tmp.path(), &["world", "rec", "--out", "twin/room.toml"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let printed = stdout(&out);
+    assert!(
+        printed.contains("the path is the recording's truth.csv"),
+        "{printed}"
+    );
+    // Every reading of a wall the scans saw twice is in the map: a few at the pillar's edge
+    // and at grazing incidence are not.
+    assert!(paired_share(&printed) > 95.0, "{printed}");
+    for file in [
+        "room.toml",
+        "room.map.yaml",
+        "room.map.pgm",
+        "room.path.csv",
+        "room.scans.csv",
+    ] {
+        assert!(tmp.path().join("twin").join(file).is_file(), "{file}");
+    }
+    // Written again over its own files.
+    let again = hilsim(tmp.path(), &["world", "rec", "--out", "twin/room.toml"]);
+    assert!(again.status.success(), "{}", stderr(&again));
+    let twin = hilsim(
+        tmp.path(),
+        &["record", "twin/room.toml", "--out", "twin-rec"],
+    );
+    assert!(twin.status.success(), "{}", stderr(&twin));
+    let real = Recording::read_dir(&tmp.path().join("rec")).unwrap();
+    let replayed = Recording::read_dir(&tmp.path().join("twin-rec")).unwrap();
+    let (real, replayed) = (real.lidar.unwrap(), replayed.lidar.unwrap());
+    assert_eq!(real.len(), replayed.len());
+    for (a, b) in real.iter().zip(&replayed) {
+        assert_eq!((a.rev, a.angle_deg), (b.rev, b.angle_deg));
+        // Both stamped to the microsecond; the schedule's beam period is the scan's span over
+        // its beams, so a beam's time may round to the next microsecond.
+        assert!((a.t_s - b.t_s).abs() < 1.5e-6, "{a:?} {b:?}");
+    }
+}
+
+#[test]
+fn the_run_held_against_its_own_twin_names_no_sensor_physics() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path());
+    let out = hilsim(tmp.path(), &["world", "rec", "--out", "twin.toml"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let diagnosis = hilsim(
+        tmp.path(),
+        &["diagnose", "--sim", "twin.toml", "--real", "rec"],
+    );
+    assert!(diagnosis.status.success(), "{}", stderr(&diagnosis));
+    let said = stdout(&diagnosis);
+    let verdict = said.lines().next().unwrap_or_default();
+    // The map's 3 cm cells are all that differs from the world the run was made in.
+    assert!(
+        verdict == "verdict: none" || verdict == "verdict: world_mismatch",
+        "{said}"
+    );
+}
+
+#[test]
+fn what_is_in_the_way_or_missing_is_one_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    record(tmp.path());
+    // A file of the user's where the path would go is never replaced.
+    std::fs::write(tmp.path().join("twin.path.csv"), "my notes\n").unwrap();
+    let err = assert_bad_input(&hilsim(tmp.path(), &["world", "rec", "--out", "twin.toml"]));
+    assert!(err.contains("twin.path.csv"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("twin.path.csv")).unwrap(),
+        "my notes\n"
+    );
+    // Nor the user's scenario.
+    let err = assert_bad_input(&hilsim(tmp.path(), &["world", "rec", "--out", "room.toml"]));
+    assert!(err.contains("room.toml"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("room.toml")).unwrap(),
+        ROOM
+    );
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["world", "nothing", "--out", "w.toml"],
+    ));
+    assert!(err.contains("nothing"), "{err}");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["world", "rec", "--map", "missing.yaml", "--out", "w.toml"],
+    ));
+    assert!(err.contains("missing.yaml"), "{err}");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["world", "rec", "--resolution-m", "0", "--out", "w.toml"],
+    ));
+    assert!(err.contains("--resolution-m"), "{err}");
+}

@@ -116,13 +116,14 @@ fn weighted_fit(bins: &[(f64, f64, f64)], terms: &[usize]) -> Option<Vec<f64>> {
         }
         a.swap(col, pivot);
         b.swap(col, pivot);
-        for row in 0..k {
+        let (pivot_row, pivot_b) = (a[col], b[col]);
+        for (row, (a_row, b_row)) in a.iter_mut().zip(b.iter_mut()).enumerate().take(k) {
             if row != col {
-                let f = a[row][col] / a[col][col];
-                for j in col..k {
-                    a[row][j] -= f * a[col][j];
+                let f = a_row[col] / pivot_row[col];
+                for (x, p) in a_row.iter_mut().zip(pivot_row).take(k).skip(col) {
+                    *x -= f * p;
                 }
-                b[row] -= f * b[col];
+                *b_row -= f * pivot_b;
             }
         }
     }

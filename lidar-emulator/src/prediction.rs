@@ -182,7 +182,13 @@ impl LidarPredictor {
             // a valid reading is one whose unrounded value lies within these.
             min_m: ((config.min_range_m * 1000.0).ceil() - 0.5) / 1000.0,
             max_m: ((config.max_range_m * 1000.0).floor() + 0.5) / 1000.0,
-            cast_limit_m: (config.max_range_m * 2.0).min(f64::from(MAX_DISTANCE_MM) / 1000.0),
+            // As the emulated unit casts (`Lidar::cast_limit_m`): the XV-11's 14-bit field, or a
+            // log's scans' 16 bits.
+            cast_limit_m: (config.max_range_m * 2.0).min(if config.schedule.is_some() {
+                f64::from(u16::MAX) / 1000.0
+            } else {
+                f64::from(MAX_DISTANCE_MM) / 1000.0
+            }),
             effects,
         })
     }

@@ -3,6 +3,7 @@
 
 use hilsim_calibrator::{groundtruth::invert, Sensor};
 use hilsim_recording::{LidarSample, Pose};
+use hilsim_sim::occupancy::{Cell, OccupancyMap};
 use hilsim_sim::Scenario;
 
 use crate::colours;
@@ -157,7 +158,53 @@ fn world_extent(s: &Scenario) -> (Vec<f64>, Vec<f64>) {
             ys.push(y);
         }
     }
+    if let Some(map) = &s.files.map {
+        for (x0, y0, x1, y1) in occupied_runs(map, 1) {
+            xs.extend([x0, x1]);
+            ys.extend([y0, y1]);
+        }
+    }
     (xs, ys)
+}
+
+/// The most rectangles a map is drawn with: beyond it, cells are drawn in blocks (a block
+/// occupied when any of its cells is), so the page stays a few megabytes.
+const MAX_MAP_RECTS: usize = 60_000;
+
+/// The occupied cells of `map` in blocks of `block × block` cells, as rectangles `(x0, y0, x1,
+/// y1)` in metres, each a run of occupied blocks along a row.
+fn occupied_runs(map: &OccupancyMap, block: usize) -> Vec<(f64, f64, f64, f64)> {
+    let (width, height) = map.size();
+    let (r, [ox, oy]) = (map.resolution_m(), map.origin());
+    let size = r * block as f64;
+    let occupied = |bx: usize, by: usize| {
+        (by * block..((by + 1) * block).min(height)).any(|iy| {
+            (bx * block..((bx + 1) * block).min(width))
+                .any(|ix| map.cell(ix, iy) == Some(Cell::Occupied))
+        })
+    };
+    let (bw, bh) = (width.div_ceil(block), height.div_ceil(block));
+    let mut runs = Vec::new();
+    for by in 0..bh {
+        let mut start = None;
+        for bx in 0..=bw {
+            match (bx < bw && occupied(bx, by), start) {
+                (true, None) => start = Some(bx),
+                (false, Some(from)) => {
+                    let y0 = oy + by as f64 * size;
+                    runs.push((
+                        ox + from as f64 * size,
+                        y0,
+                        ox + bx as f64 * size,
+                        y0 + size,
+                    ));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+    }
+    runs
 }
 
 /// A board's four corners, world frame.
@@ -171,8 +218,17 @@ fn board_corners(b: &hilsim_sim::scenario::Board) -> [(f64, f64); 4] {
     })
 }
 
-/// Walls as lines, boards as filled rectangles, cylinders as circles.
+/// Walls as lines, boards as filled rectangles, cylinders as circles, a map's occupied cells.
 fn draw_world(chart: &mut Chart, s: &Scenario) {
+    if let Some(map) = &s.files.map {
+        let mut block = 1;
+        let mut runs = occupied_runs(map, block);
+        while runs.len() > MAX_MAP_RECTS && block < 64 {
+            block *= 2;
+            runs = occupied_runs(map, block);
+        }
+        chart.rects(&runs, colours::WORLD);
+    }
     let wall = Stroke::solid(colours::WORLD, 3.0);
     for w in &s.world.walls {
         chart.line(&[(w.from[0], w.from[1]), (w.to[0], w.to[1])], wall);
@@ -259,4 +315,31 @@ fn scan(view: &View<'_>, rev: u64) -> Scan {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod map_cells {
+    use super::*;
+
+    #[test]
+    fn a_maps_occupied_cells_are_drawn_as_runs_along_rows_and_in_blocks_when_coarse() {
+        let mut map = OccupancyMap::new(0.1, [-1.0, 2.0], 8, 4).unwrap();
+        for ix in 2..6 {
+            map.set_cell(ix, 1, Cell::Occupied);
+        }
+        map.set_cell(7, 3, Cell::Occupied);
+        let runs = occupied_runs(&map, 1);
+        assert_eq!(runs.len(), 2, "{runs:?}");
+        let (x0, y0, x1, y1) = runs[0];
+        assert!(
+            (x0 + 0.8).abs() < 1e-12 && (x1 + 0.4).abs() < 1e-12,
+            "{runs:?}"
+        );
+        assert!(
+            (y0 - 2.1).abs() < 1e-12 && (y1 - 2.2).abs() < 1e-12,
+            "{runs:?}"
+        );
+        // In 2 × 2 blocks: the row of four is two blocks, one run; the lone cell its own.
+        assert_eq!(occupied_runs(&map, 2).len(), 2);
+    }
 }

@@ -453,6 +453,21 @@ impl Chart {
         );
     }
 
+    /// Axis-aligned rectangles `(x0, y0, x1, y1)` in data units, filled, as one path (a map's
+    /// occupied cells: thousands of them cost one element).
+    pub fn rects(&mut self, rects: &[(f64, f64, f64, f64)], fill: &str) {
+        if rects.is_empty() {
+            return;
+        }
+        let mut d = String::with_capacity(rects.len() * 24);
+        for &(x0, y0, x1, y1) in rects {
+            let (left, right) = (self.sx(x0), self.sx(x1));
+            let (top, bottom) = (self.sy(y1), self.sy(y0));
+            let _ = write!(d, "M{left:.1} {top:.1}H{right:.1}V{bottom:.1}H{left:.1}Z",);
+        }
+        let _ = writeln!(self.body, r#"<path d="{d}" fill="{fill}" stroke="none"/>"#);
+    }
+
     /// A circle of data radius `radius` (meaningful on a chart [`Chart::to_scale`]).
     pub fn circle(&mut self, centre: (f64, f64), radius: f64, fill: &str, stroke: Stroke) {
         let _ = writeln!(

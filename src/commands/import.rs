@@ -1,6 +1,6 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
 //! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP or SQLite3)
-//! or a ROS 1 bag (`.bag`) into a recording, the lidar's mount from its TF; `hilsim import LOG --out DIR [--log-poses truth|odometry]`: a real robot's
+//! or a ROS 1 bag (`.bag`) into a recording, the lidar's mount from its TF; `hilsim import LOG --out DIR [--poses truth|odometry]`: a real robot's
 //! log (CARMEN `.log`/`.clf`, gzipped or not; CoreSLAM `.dat`) into a recording.
 
 use std::collections::BTreeMap;
@@ -52,8 +52,8 @@ pub struct ImportArgs {
     #[arg(long, value_name = "LEFT,RIGHT")]
     pub wheel_joints: Option<String>,
     /// What a CARMEN log's poses are: `truth` (a corrected log's: truth.csv) or `odometry`
-    /// (odometry.csv, as wheel travel); default truth.
-    #[arg(long, value_name = "KIND", value_parser = ["truth", "odometry"])]
+    /// (odometry.csv, as wheel travel); default truth. (`--log-poses` is the same.)
+    #[arg(long = "poses", alias = "log-poses", value_name = "KIND", value_parser = ["truth", "odometry"])]
     pub log_poses: Option<String>,
 }
 
@@ -101,7 +101,7 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<(
         );
     }
     if kind == LogKind::CoreSlam && args.log_poses.is_some() {
-        bail!("--log-poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses");
+        bail!("--poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses");
     }
     hilsim_recording::check_input_outside(&args.bag, &args.out)?;
     let text = hilsim_logs::read_text(&args.bag)?;
@@ -153,7 +153,7 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     }
     if args.log_poses.is_some() {
         bail!(
-            "--log-poses is for CARMEN logs; {} is a ROS bag",
+            "--poses is for CARMEN logs; {} is a ROS bag",
             args.bag.display()
         );
     }

@@ -57,6 +57,14 @@ fn a_carmen_log_imports_with_notes() {
     let rec = Recording::read_dir(&tmp.path().join("r")).unwrap();
     assert_eq!(rec.lidar.unwrap().len(), 360);
     assert_eq!(rec.truth.unwrap()[1].x_m, 1.1);
+    // The scan lines' poses as the odometry's instead: no truth.
+    let out = hilsim(
+        tmp.path(),
+        &["import", "run.clf", "--out", "o", "--poses", "odometry"],
+    );
+    assert!(out.status.success(), "{}", crate::common::stderr(&out));
+    let rec = Recording::read_dir(&tmp.path().join("o")).unwrap();
+    assert!(rec.truth.is_none() && rec.odometry.is_some());
 }
 
 #[test]
@@ -89,5 +97,5 @@ fn bag_options_with_a_log_are_one_line_errors() {
     std::fs::write(tmp.path().join("exp.dat"), coreslam()).unwrap();
     let args = ["import", "exp.dat", "--out", "r", "--log-poses", "odometry"];
     let err = assert_bad_input(&hilsim(tmp.path(), &args));
-    assert!(err.contains("--log-poses is for CARMEN logs"), "{err}");
+    assert!(err.contains("--poses is for CARMEN logs"), "{err}");
 }

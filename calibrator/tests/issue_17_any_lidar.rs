@@ -99,7 +99,7 @@ fn readings_1080() -> &'static Recording {
 
 /// The landmark paper's pipeline on the raw scans of a finer lidar: the five cylinders and
 /// nothing else, and the configured model recovered as well as from the XV-11
-/// (`issue_6_landmarks_recording`: MSE ratio above 10, order 2).
+/// (`landmarks_recording`: MSE ratio above 10, order 2).
 #[test]
 fn the_landmark_detector_and_calibration_take_any_angular_grid() {
     for (rec, what) in [(half_degree(), "0.5°"), (readings_1080(), "1080 readings")] {

@@ -49,7 +49,7 @@ fn a_calibration_trained_at_one_speed_smooths_another() {
         .all(|e| e.distance_m.is_finite() && e.sd_m() >= 0.0 && e.sd_m() < 0.05));
     // Both runs' speed-scale errors (each within 3σ = 6 %) bound what the commands and the
     // trained bias can be wrong by: ≤ 6 % of the travel, against a raw error of ~13 % at 4 m
-    // (the bias), so the NMSE falls by more than 3 as in EM itself (issue_5_em.rs).
+    // (the bias), so the NMSE falls by more than 3 as in EM itself (em.rs).
     let (raw, smoothed) = nmse(&test, &est);
     assert!(
         smoothed < raw / 3.0,

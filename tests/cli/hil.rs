@@ -502,7 +502,7 @@ fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
 /// stop half a metre from the board; the scenario's `when = "hil"` assertions hold and the
 /// summary counts the faults. The start is moved to 1.5 m to keep the test short.
 #[test]
-fn issue_19_both_example_firmwares_converge_over_the_capture_link() {
+fn both_example_firmwares_converge_over_the_capture_link() {
     let tmp = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(repo_file("scenarios/hil-capture-link.toml")).unwrap();
     let moved = text.replace("start = { x = 2.5,", "start = { x = 1.5,");

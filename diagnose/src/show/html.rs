@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use super::format::{escape, fmt_sig, given_past, mm};
+use crate::locate::Evidence;
 use crate::outcome::{Diagnosis, Verdict};
 
 /// The report page: the verdict, the evidence, the map, the fit and the plots (`plot_files[i]`
@@ -109,41 +110,20 @@ fn fix(s: &mut String, d: &Diagnosis) {
         }
         let _ = writeln!(s, "</table>");
     }
-    if !d.world.is_empty() {
-        let _ = writeln!(
-            s,
-            "<h2>Within the world's error</h2><p>Mismatches the world's own error (its map's cells) can make: the map as likely off there as the sensor.</p><table><tr><th>sensor</th><th>where</th><th>size</th><th>the map's reach there</th><th>evidence</th></tr>"
-        );
-        for w in &d.world {
-            let _ = writeln!(
-                s,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                w.sensor,
-                escape(&w.place),
-                mm(w.size_m),
-                mm(w.world_m),
-                escape(&w.detail)
-            );
-        }
-        let _ = writeln!(s, "</table>");
-    }
-    if !d.unexplained.is_empty() {
-        let _ = writeln!(
-            s,
-            "<h2>Unexplained</h2><p>Mismatches located above their sensor's floor that no named effect explains.</p><table><tr><th>sensor</th><th>where</th><th>size</th><th>evidence</th></tr>"
-        );
-        for u in &d.unexplained {
-            let _ = writeln!(
-                s,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                u.sensor,
-                escape(&u.place),
-                mm(u.size_m),
-                escape(&u.detail)
-            );
-        }
-        let _ = writeln!(s, "</table>");
-    }
+    evidence_table(
+        s,
+        &d.world,
+        "Within the world's error",
+        "Mismatches the world's own error (its map's cells) can make: the map as likely off there as the sensor.",
+        true,
+    );
+    evidence_table(
+        s,
+        &d.unexplained,
+        "Unexplained",
+        "Mismatches located above their sensor's floor that no named effect explains.",
+        false,
+    );
     if let Some(f) = &d.fitted {
         let _ = writeln!(
             s,
@@ -244,4 +224,37 @@ fn evidence(s: &mut String, d: &Diagnosis) {
         }
         let _ = writeln!(s, "</table>");
     }
+}
+
+/// A table of located mismatches under `title` (nothing when there are none); with
+/// `world_reach`, a column of how far the map's cells can move the readings there.
+fn evidence_table(s: &mut String, rows: &[Evidence], title: &str, what: &str, world_reach: bool) {
+    if rows.is_empty() {
+        return;
+    }
+    let reach_head = if world_reach {
+        "<th>the map's reach there</th>"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        s,
+        "<h2>{title}</h2><p>{what}</p><table><tr><th>sensor</th><th>where</th><th>size</th>{reach_head}<th>evidence</th></tr>"
+    );
+    for e in rows {
+        let reach = if world_reach {
+            format!("<td>{}</td>", mm(e.world_m))
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{}</td>{reach}<td>{}</td></tr>",
+            e.sensor,
+            escape(&e.place),
+            mm(e.size_m),
+            escape(&e.detail)
+        );
+    }
+    let _ = writeln!(s, "</table>");
 }

@@ -6,13 +6,15 @@
 pub mod effects;
 mod emulation;
 pub mod lidar;
-pub mod neato_packet;
 pub mod normal;
 mod odometer;
 pub mod prediction;
 mod range_model;
 mod sonar;
 pub mod wire;
+
+/// The Neato XV-11 serial packet codec (its home is `hilsim_lidar_protocols::xv11`).
+pub use hilsim_lidar_protocols::xv11 as neato_packet;
 
 pub use emulation::{Emulation, Run, StepSamples};
 pub use lidar::{Lidar, LidarReading};

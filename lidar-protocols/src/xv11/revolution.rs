@@ -78,7 +78,7 @@ impl Revolution {
 /// packet then opens the next revolution.
 ///
 /// ```
-/// use hilsim_lidar_emulator::neato_packet::{Packet, RevolutionAssembler};
+/// use hilsim_lidar_protocols::xv11::{Packet, RevolutionAssembler};
 ///
 /// let mut assembler = RevolutionAssembler::new();
 /// let mut done = Vec::new();

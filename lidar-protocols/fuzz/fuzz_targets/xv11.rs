@@ -1,7 +1,7 @@
 //! Feeds arbitrary bytes to the XV-11 decoder and checks what must hold for any input.
 #![no_main]
 
-use hilsim_lidar_emulator::neato_packet::{
+use hilsim_lidar_protocols::xv11::{
     checksum, Decoder, Packet, PacketSummary, INDEX_BASE, PACKETS_PER_REVOLUTION, PACKET_LEN,
     START_BYTE,
 };

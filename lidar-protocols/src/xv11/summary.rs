@@ -10,7 +10,7 @@ use super::packet::{Packet, READINGS_PER_PACKET};
 /// wire's fixed-point values (at most 65,536 distinct), which also makes the median exact.
 ///
 /// ```
-/// use hilsim_lidar_emulator::neato_packet::{Packet, PacketSummary};
+/// use hilsim_lidar_protocols::xv11::{Packet, PacketSummary};
 ///
 /// let mut summary = PacketSummary::new();
 /// assert_eq!(summary.rpm_median(), 0.0); // no packets: 0.0, never NaN
@@ -129,7 +129,7 @@ fn fixed_to_rpm(fixed: u16) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::neato_packet::Reading;
+    use crate::xv11::Reading;
 
     fn packet_at(rpm_fixed: u16) -> Packet {
         Packet {

@@ -38,7 +38,7 @@ pub struct DecoderStats {
 /// past each packet accepted. A packet whose checksum fails is never returned.
 ///
 /// ```
-/// use hilsim_lidar_emulator::neato_packet::{Decoder, Packet};
+/// use hilsim_lidar_protocols::xv11::{Decoder, Packet};
 ///
 /// let mut wire = vec![0xFA, 0xA3, 0x00]; // a torn packet
 /// wire.extend_from_slice(&Packet { index: 4, ..Packet::default() }.encode());
@@ -202,7 +202,7 @@ impl Decoder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::neato_packet::Reading;
+    use crate::xv11::Reading;
 
     fn packet(index: u8, tag: u16) -> Packet {
         Packet {

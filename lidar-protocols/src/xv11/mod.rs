@@ -8,7 +8,7 @@
 //! ([`PacketSummary`], [`DecoderStats`]).
 //!
 //! ```
-//! use hilsim_lidar_emulator::neato_packet::{encode_revolution, Decoder, Reading};
+//! use hilsim_lidar_protocols::xv11::{encode_revolution, Decoder, Reading};
 //!
 //! let mut readings = [Reading::distance(1000, 200); 360];
 //! readings[90] = Reading::error(0x35);

@@ -25,7 +25,8 @@ pub enum Command {
     Record(RecordArgs),
     /// Stream the emulated lidar over a serial link in the Neato XV-11 format.
     Serve(ServeArgs),
-    /// Decode a raw Neato XV-11 byte capture (a file or a serial device path) into readings.
+    /// Decode a lidar's raw byte stream (a capture file or a serial device path) into readings:
+    /// the Neato XV-11's, or another unit's with `--model`.
     Decode(DecodeArgs),
     /// Calibrate the sensors from a recording.
     Calibrate(CalibrateArgs),
@@ -110,7 +111,8 @@ pub struct ServeArgs {
     /// Create a pseudo-terminal pair and print the path a client should open (the default).
     #[arg(long, conflicts_with = "port")]
     pub pty: bool,
-    /// Write to this existing serial device instead (opened at 115200 8N1).
+    /// Write to this existing serial device instead (opened 8N1 at the unit's speed: 115200 for
+    /// the XV-11).
     #[arg(long, value_name = "PATH")]
     pub port: Option<PathBuf>,
     /// Pace the stream as a real unit would (the default).
@@ -136,6 +138,10 @@ pub struct ServeArgs {
 pub struct DecodeArgs {
     /// A raw byte capture, or a serial device path.
     pub input: PathBuf,
+    /// The unit whose protocol the bytes are in: xv11 (the default), rplidar-a1, lds-01,
+    /// lds-02rr, ld06, ydlidar-x4, urg-04lx.
+    #[arg(long, default_value = "xv11")]
+    pub model: hilsim_sim::scenario::LidarModel,
     /// Write one CSV row per reading to this file.
     #[arg(long)]
     pub csv: Option<PathBuf>,

@@ -35,10 +35,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => commands::calibrate::calibrate(args, &mut out),
         Command::Smooth(args) => commands::calibrate::smooth(args, &mut out),
         Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
-        Command::Decode(args) => {
-            commands::decode::run(&args.input, args.csv.as_deref(), args.json, &mut out)
-                .map(|()| ExitCode::SUCCESS)
-        }
+        Command::Decode(args) => commands::decode::run(args, &mut out).map(|()| ExitCode::SUCCESS),
         Command::Scenario(ScenarioCommand::Test(args)) => {
             commands::scenario_test::test(args, &mut out)
         }

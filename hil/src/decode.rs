@@ -10,6 +10,7 @@ use std::io::{self, ErrorKind, Read};
 use hilsim_lidar_emulator::neato_packet::{
     Decoder, DecoderStats, Packet, PacketSummary, Revolution, RevolutionAssembler,
 };
+use hilsim_lidar_protocols::{HostDecoder, LidarModel, Point};
 use serde::Serialize;
 
 /// Bytes read from the input at a time.
@@ -164,4 +165,127 @@ fn packet_rows(rev: u64, packet: &Packet, out: &mut String) {
             packet.rpm(),
         );
     }
+}
+
+/// What a stream of a unit other than the XV-11 held: `hilsim decode --model M --json`'s
+/// object.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnitDecodeCounts {
+    /// The unit (`rplidar-a1`, …).
+    pub model: &'static str,
+    /// Bytes read.
+    pub bytes: u64,
+    /// Packets (or replies) accepted.
+    pub packets: u64,
+    /// Packets refused for their checksum or check bits.
+    pub bad_checksum: u64,
+    /// Bytes skipped while resynchronising.
+    pub skipped_bytes: u64,
+    /// Readings decoded.
+    pub readings: u64,
+    /// Of them, without a return (distance 0).
+    pub no_return: u64,
+    /// Revolutions begun (readings the unit marked as a revolution's first).
+    pub revolutions: u64,
+    /// The median revolution rate the packets reported, Hz (0.0 when they report none).
+    pub rev_hz_median: f64,
+}
+
+/// What is handed each decoded reading, with its revolution's number.
+pub type PointSink<'a, E> = &'a mut dyn FnMut(u64, &Point) -> Result<(), E>;
+
+/// Reads `source` to its end and decodes it with `decoder` (the unit `model`'s host side);
+/// with `on_point`, hands it each reading with its revolution's number (counted from 0, a
+/// partial first one included). Memory stays bounded: the rate's median comes from a
+/// histogram of 0.01 Hz bins up to 100 Hz.
+///
+/// # Errors
+/// A read error other than an interruption or a closed pty, or `on_point`'s.
+pub fn decode_unit_stream<E>(
+    source: &mut dyn Read,
+    model: LidarModel,
+    decoder: &mut dyn HostDecoder,
+    mut on_point: Option<PointSink<'_, E>>,
+) -> Result<UnitDecodeCounts, DecodeError<E>> {
+    const RATE_BINS: usize = 10_000;
+    let mut rates = vec![0_u64; RATE_BINS];
+    let mut chunk = vec![0; CHUNK_LEN];
+    let mut points = Vec::new();
+    let mut counts = UnitDecodeCounts {
+        model: model.name(),
+        bytes: 0,
+        packets: 0,
+        bad_checksum: 0,
+        skipped_bytes: 0,
+        readings: 0,
+        no_return: 0,
+        revolutions: 0,
+        rev_hz_median: 0.0,
+    };
+    let mut rev: Option<u64> = None;
+    loop {
+        let len = match source.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(len) => len,
+            Err(err) if err.kind() == ErrorKind::Interrupted => continue,
+            Err(err) if is_closed_pty(&err) => break,
+            Err(err) => return Err(DecodeError::Read(err)),
+        };
+        points.clear();
+        decoder.feed(&chunk[..len], &mut points);
+        for point in &points {
+            if point.starts_revolution || rev.is_none() {
+                rev = Some(rev.map_or(0, |r| r + 1));
+                if point.starts_revolution {
+                    counts.revolutions += 1;
+                }
+            }
+            counts.readings += 1;
+            counts.no_return += u64::from(point.distance_mm == 0);
+            if let Some(hz) = point.rev_hz.filter(|hz| hz.is_finite() && *hz >= 0.0) {
+                rates[((hz * 100.0).round() as usize).min(RATE_BINS - 1)] += 1;
+            }
+            if let Some(sink) = on_point.as_mut() {
+                sink(rev.unwrap_or(0), point).map_err(DecodeError::Sink)?;
+            }
+        }
+    }
+    let stats = decoder.stats();
+    counts.bytes = stats.bytes;
+    counts.packets = stats.packets;
+    counts.bad_checksum = stats.bad_checksum;
+    counts.skipped_bytes = stats.skipped_bytes;
+    let total: u64 = rates.iter().sum();
+    if total > 0 {
+        let mut seen = 0;
+        for (bin, n) in rates.iter().enumerate() {
+            seen += n;
+            if 2 * seen >= total {
+                counts.rev_hz_median = bin as f64 / 100.0;
+                break;
+            }
+        }
+    }
+    Ok(counts)
+}
+
+/// The header of a unit's decoded readings' CSV (`hilsim decode --model M --csv`).
+pub const UNIT_CSV_HEADER: &str = "rev,angle_deg,distance_mm,range_m,intensity,rev_hz";
+
+/// One CSV row under [`UNIT_CSV_HEADER`]: the angle in the unit's own convention, the
+/// distance 0 without a return, the rate empty when the packet reports none.
+pub fn unit_csv_row(rev: u64, point: &Point, out: &mut String) {
+    let rate = point
+        .rev_hz
+        .map(|hz| format!("{hz:.3}"))
+        .unwrap_or_default();
+    // Writing to a String cannot fail.
+    let _ = writeln!(
+        out,
+        "{rev},{:.3},{},{:.3},{},{rate}",
+        point.angle_deg,
+        point.distance_mm,
+        f64::from(point.distance_mm) / 1000.0,
+        point.intensity,
+    );
 }

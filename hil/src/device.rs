@@ -20,12 +20,20 @@ pub struct DeviceLink {
 }
 
 impl DeviceLink {
-    /// Opens `path` at 115200 8N1.
+    /// Opens `path` at the XV-11's 115200 8N1.
     ///
     /// # Errors
     /// `path` is not a terminal device (kind `InvalidInput`, saying what it is instead), or the
     /// device cannot be opened or configured.
     pub fn open(path: &str) -> io::Result<Self> {
+        Self::open_at(path, XV11_BAUD)
+    }
+
+    /// Opens `path` at `baud`, 8N1 (the unit's speed: `UnitSpec::baud`).
+    ///
+    /// # Errors
+    /// As [`DeviceLink::open`].
+    pub fn open_at(path: &str, baud: u32) -> io::Result<Self> {
         let not_a_device = |what: &str| {
             io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -38,7 +46,7 @@ impl DeviceLink {
         if !kind.is_char_device() {
             return Err(not_a_device(describe_file_type(kind)));
         }
-        let port = serialport::new(path, XV11_BAUD)
+        let port = serialport::new(path, baud)
             .data_bits(DataBits::Eight)
             .parity(Parity::None)
             .stop_bits(StopBits::One)
@@ -97,6 +105,10 @@ impl Write for DeviceLink {
 }
 
 impl SerialLink for DeviceLink {
+    fn read_host(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        crate::link::read_now(&mut self.port, buf)
+    }
+
     fn backlog(&mut self) -> io::Result<usize> {
         Ok(self.port.bytes_to_write().map_err(io::Error::from)? as usize)
     }

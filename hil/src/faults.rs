@@ -62,15 +62,58 @@ impl WireFaults {
         self.counts
     }
 
+    /// Appends to `out` a packet of any unit but the XV-11 (or a command's reply) as the wire
+    /// delivers it, for a packet due at simulated time `t_s`: nothing while the link is away (a
+    /// reply that never comes) or when the unit drops it, else perhaps with a bit flipped after
+    /// its first `sync_len` bytes (whether the host notices is the protocol's business: an
+    /// RPLIDAR node has only check bits) and bytes lost.
+    pub fn apply_unit_packet(
+        &mut self,
+        packet: &[u8],
+        sync_len: usize,
+        t_s: f64,
+        out: &mut Vec<u8>,
+    ) {
+        if self.silent_at(t_s) {
+            self.counts.silenced_packets += 1;
+            return;
+        }
+        if self.rng.random::<f64>() < self.faults.dropped_packet_rate {
+            self.counts.dropped_packets += 1;
+            return;
+        }
+        let start = out.len();
+        out.extend_from_slice(packet);
+        if packet.len() > sync_len && self.rng.random::<f64>() < self.faults.corrupt_packet_rate {
+            let at = start + self.rng.random_range(sync_len..packet.len());
+            out[at] ^= 1 << self.rng.random_range(0..8);
+            self.counts.corrupted_packets += 1;
+        }
+        if self.faults.dropped_byte_rate > 0.0 {
+            let mut k = start;
+            for i in start..out.len() {
+                if self.rng.random::<f64>() < self.faults.dropped_byte_rate {
+                    self.counts.dropped_bytes += 1;
+                } else {
+                    out[k] = out[i];
+                    k += 1;
+                }
+            }
+            out.truncate(k);
+        }
+    }
+
+    fn silent_at(&self, t_s: f64) -> bool {
+        self.faults
+            .silent
+            .is_some_and(|(from, until)| (from..until).contains(&t_s))
+    }
+
     /// Appends to `out` the bytes of `packet` as the wire delivers them, for a packet complete at
     /// simulated time `t_s`: nothing while the link is away or when the unit drops it, else
     /// perhaps with a byte flipped (so that its checksum fails) and bytes lost.
     pub fn apply(&mut self, packet: &[u8], t_s: f64, out: &mut Vec<u8>) {
-        if self
-            .faults
-            .silent
-            .is_some_and(|(from, until)| (from..until).contains(&t_s))
-        {
+        if self.silent_at(t_s) {
             self.counts.silenced_packets += 1;
             return;
         }

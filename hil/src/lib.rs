@@ -19,6 +19,7 @@ pub mod process;
 mod pty;
 pub mod serve;
 mod streamer;
+mod unit_streamer;
 
 pub use device::{DeviceLink, XV11_BAUD};
 pub use link::{MemoryLink, SerialLink};
@@ -26,3 +27,4 @@ pub use pty::PtyLink;
 pub use streamer::{
     Pacing, StreamStats, Streamer, BACKLOG_LIMIT, FAST_STALL_GRACE, LOSSLESS_TIMEOUT, STALL_DETECT,
 };
+pub use unit_streamer::UnitStreamer;

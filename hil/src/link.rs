@@ -1,7 +1,7 @@
 //! The one trait every serial link implements: bytes out without ever blocking, and a view of
 //! the backlog a slow or absent reader leaves behind.
 
-use std::io::{self, Write};
+use std::io::{self, Read, Write};
 
 /// A byte link to a serial client (a pty, a device, or memory in tests).
 ///
@@ -28,6 +28,35 @@ pub trait SerialLink: Write + Send {
     fn allow_reconnect(&mut self) -> io::Result<()> {
         Ok(())
     }
+
+    /// Reads what the client wrote (a command-driven unit's commands) into `buf`, without
+    /// waiting: `Ok(0)` when nothing is there. The default has no way back and reads nothing.
+    ///
+    /// # Errors
+    /// The link failed.
+    fn read_host(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let _ = buf;
+        Ok(0)
+    }
+}
+
+/// Reads what is there now from a non-blocking port: nothing (`Ok(0)`) rather than an error when
+/// the read would wait, and nothing once no client holds the other side (`EIO` on a pty).
+pub(crate) fn read_now(port: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
+    match port.read(buf) {
+        Ok(n) => Ok(n),
+        Err(err)
+            if matches!(
+                err.kind(),
+                io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut | io::ErrorKind::Interrupted
+            ) =>
+        {
+            Ok(0)
+        }
+        // EIO: a pty whose client side nobody holds open.
+        Err(err) if err.raw_os_error() == Some(5) => Ok(0),
+        Err(err) => Err(err),
+    }
 }
 
 /// An in-memory link: a bounded buffer that a test drains by hand.
@@ -45,6 +74,8 @@ pub struct MemoryLink {
     buffer: Vec<u8>,
     capacity: usize,
     discarded: usize,
+    /// What the test's client wrote, not yet read by the unit.
+    from_client: std::collections::VecDeque<u8>,
 }
 
 impl MemoryLink {
@@ -55,7 +86,13 @@ impl MemoryLink {
             buffer: Vec::new(),
             capacity,
             discarded: 0,
+            from_client: std::collections::VecDeque::new(),
         }
+    }
+
+    /// The client writes `bytes` (a command to the unit).
+    pub fn client_writes(&mut self, bytes: &[u8]) {
+        self.from_client.extend(bytes);
     }
 
     /// What a reader would read now; empties the buffer.
@@ -95,5 +132,13 @@ impl SerialLink for MemoryLink {
         self.discarded += self.buffer.len();
         self.buffer.clear();
         Ok(())
+    }
+
+    fn read_host(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = buf.len().min(self.from_client.len());
+        for (slot, byte) in buf.iter_mut().zip(self.from_client.drain(..n)) {
+            *slot = byte;
+        }
+        Ok(n)
     }
 }

@@ -111,6 +111,10 @@ impl Write for PtyLink {
 }
 
 impl SerialLink for PtyLink {
+    fn read_host(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        crate::link::read_now(&mut self.master, buf)
+    }
+
     fn backlog(&mut self) -> io::Result<usize> {
         let queued = self.client_side.bytes_to_read().map_err(io::Error::from)?;
         Ok(queued as usize)

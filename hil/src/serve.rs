@@ -1,13 +1,14 @@
-//! `hilsim serve`: the emulated lidar streamed over a serial link in the Neato format.
+//! `hilsim serve`: the emulated lidar streamed over a serial link in its unit's format.
 
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use hilsim_lidar_emulator::wire::RevolutionCollector;
+use hilsim_lidar_emulator::wire::{to_unit_reading, RevolutionCollector};
 use hilsim_lidar_emulator::Emulation;
 
 use crate::link::SerialLink;
 use crate::streamer::{StreamStats, Streamer};
+use crate::unit_streamer::UnitStreamer;
 
 /// What a serve run did.
 #[derive(Debug, Clone)]
@@ -62,6 +63,54 @@ pub fn serve_with_progress<L: SerialLink>(
             }
         }
         if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+    }
+    if !interrupted {
+        streamer.drain()?;
+    }
+    Ok(ServeReport {
+        stream: streamer.stats().clone(),
+        simulated_s: emulation.simulation().time_s(),
+        interrupted,
+        link_faults: streamer.fault_counts(),
+    })
+}
+
+/// As [`serve_with_progress`], for a unit other than the XV-11 ([`UnitStreamer`]): each reading
+/// handed to the unit at its instant, the host's commands answered as they come.
+///
+/// # Errors
+/// The link failed.
+pub fn serve_unit_with_progress<L: SerialLink>(
+    mut emulation: Emulation,
+    streamer: &mut UnitStreamer<L>,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(&StreamStats, f64),
+) -> io::Result<ServeReport> {
+    let Some(spec) = emulation.lidar().map(|l| l.unit().spec()) else {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the scenario has no lidar",
+        ));
+    };
+    let mut readings = Vec::new();
+    let mut interrupted = false;
+    while let Some(samples) = emulation.step() {
+        readings.clear();
+        readings.extend_from_slice(&samples.lidar);
+        for reading in &readings {
+            streamer.take(&to_unit_reading(reading, spec), stop)?;
+            if reading.index == 0 {
+                progress(streamer.stats(), reading.t_s);
+            }
+            if stop.load(Ordering::Relaxed) {
+                interrupted = true;
+                break;
+            }
+        }
+        if interrupted || stop.load(Ordering::Relaxed) {
             interrupted = true;
             break;
         }

@@ -92,6 +92,12 @@ impl StreamStats {
         ))
     }
 
+    /// Counts one packet written `late` after its due time.
+    pub(crate) fn record_lateness(&mut self, late: Duration) {
+        let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
+        self.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
+    }
+
     /// The `q`-quantile (0..=1) of packet lateness: how long after its due time each packet was
     /// written, to 0.1 ms. `None` without paced packets.
     #[must_use]
@@ -320,9 +326,8 @@ impl<L: SerialLink> Streamer<L> {
             self.stats.revolutions_dropped += 1;
             return Ok(());
         }
-        let late = Instant::now().saturating_duration_since(due);
-        let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
-        self.stats.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
+        self.stats
+            .record_lateness(Instant::now().saturating_duration_since(due));
         if index == PACKETS_PER_REVOLUTION - 1 {
             self.packets_whole = None;
             self.stats.revolutions_sent += 1;
@@ -429,9 +434,8 @@ impl<L: SerialLink> Streamer<L> {
                 all_sent = false;
                 break;
             }
-            let late = Instant::now().saturating_duration_since(due);
-            let bucket = (late.as_micros() / LATENESS_BUCKET.as_micros()) as usize;
-            self.stats.lateness[bucket.min(LATENESS_BUCKETS - 1)] += 1;
+            self.stats
+                .record_lateness(Instant::now().saturating_duration_since(due));
         }
         self.packet_spans = spans;
         self.bytes = bytes;

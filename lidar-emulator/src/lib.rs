@@ -11,6 +11,7 @@ mod odometer;
 pub mod prediction;
 mod range_model;
 mod sonar;
+mod unit_scans;
 pub mod wire;
 
 /// The Neato XV-11 serial packet codec (its home is `hilsim_lidar_protocols::xv11`).

@@ -5,7 +5,8 @@ use hilsim_recording::LidarSample;
 use hilsim_sim::pose::wrap_angle;
 use std::sync::Arc;
 
-use hilsim_sim::scan_schedule::ScanSchedule;
+use hilsim_sim::scan_schedule::{Scan, ScanSchedule};
+use hilsim_sim::scenario::LidarModel;
 use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
@@ -13,6 +14,7 @@ use rand_distr::{Distribution, StandardNormal};
 use crate::effects::LidarEffects;
 use crate::neato_packet::{rpm_to_fixed, MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
+use crate::unit_scans::UnitScans;
 use hilsim_recording::Mount;
 
 /// Error code for "no return": nothing within range, or the reading fell beyond the maximum.
@@ -66,6 +68,8 @@ pub struct LidarReading {
     pub warning: bool,
     /// The true range along the beam (`None`: nothing hit).
     pub true_range_m: Option<f64>,
+    /// The rate of its revolution, Hz (what a unit's packets report).
+    pub rev_hz: f64,
 }
 
 impl LidarReading {
@@ -112,9 +116,47 @@ pub struct Lidar {
     /// The motor's speed of each revolution while it spins up (`[link] spin_up_s`); empty when
     /// it starts at speed.
     spin_up_rpm: Vec<f64>,
-    /// `[sensors.lidar] schedule`: a log's scans to take instead of the XV-11's revolutions, and
-    /// the next scan and beam to take.
-    schedule: Option<(Arc<ScanSchedule>, usize, u32)>,
+    /// The scans taken instead of the XV-11's revolutions, and the next beam to take.
+    scans: Option<(Scans, u32)>,
+    /// Whether the unit reports its strength in one byte (every model but the XV-11).
+    byte_strength: bool,
+    /// The unit.
+    unit: LidarModel,
+}
+
+/// Where the scans come from when the lidar is not the XV-11 as it is.
+enum Scans {
+    /// `[sensors.lidar] schedule`: a log's scans, and the one being taken.
+    Log(Arc<ScanSchedule>, usize),
+    /// `[sensors.lidar] model`: another unit's revolutions.
+    Unit(UnitScans),
+}
+
+impl Scans {
+    /// The scan being taken (`None`: a log's scans are all taken).
+    fn current(&self) -> Option<&Scan> {
+        match self {
+            Scans::Log(schedule, k) => schedule.scans().get(*k),
+            Scans::Unit(unit) => Some(unit.current()),
+        }
+    }
+
+    fn advance(&mut self) {
+        match self {
+            Scans::Log(_, k) => *k += 1,
+            Scans::Unit(unit) => unit.advance(),
+        }
+    }
+
+    /// The rate of the revolution being taken, Hz.
+    fn rev_hz(&self) -> f64 {
+        match self {
+            Scans::Log(..) => self
+                .current()
+                .map_or(0.0, |s| 1.0 / (f64::from(s.beams) * s.beam_period_s)),
+            Scans::Unit(unit) => unit.current_hz(),
+        }
+    }
 }
 
 impl Lidar {
@@ -165,7 +207,19 @@ impl Lidar {
                 && effects.lidar_motion_skew.is_none(),
             rev_pose: None,
             spin_up_rpm: Vec::new(),
-            schedule: None,
+            byte_strength: config.model != LidarModel::Xv11,
+            unit: config.model,
+            scans: (config.model != LidarModel::Xv11).then(|| {
+                (
+                    Scans::Unit(UnitScans::new(
+                        config.model,
+                        config.rpm,
+                        config.rpm_wobble,
+                        seed,
+                    )),
+                    0,
+                )
+            }),
         };
         lidar.rev_rpm = lidar.rpm_of_revolution(0);
         Ok(lidar)
@@ -176,15 +230,23 @@ impl Lidar {
     /// scan's times and angles.
     #[must_use]
     pub fn with_schedule(mut self, schedule: Option<Arc<ScanSchedule>>) -> Self {
-        self.schedule = schedule.map(|s| (s, 0, 0));
+        if let Some(schedule) = schedule {
+            self.scans = Some((Scans::Log(schedule, 0), 0));
+        }
         self
     }
 
-    /// Whether the lidar takes a log's scans rather than the XV-11's revolutions (it then has
-    /// no XV-11 wire format).
+    /// Whether the lidar takes a log's scans rather than a unit's revolutions (it then has no
+    /// wire format).
     #[must_use]
     pub fn is_scheduled(&self) -> bool {
-        self.schedule.is_some()
+        matches!(self.scans, Some((Scans::Log(..), _)))
+    }
+
+    /// The unit (`[sensors.lidar] model`).
+    #[must_use]
+    pub fn unit(&self) -> LidarModel {
+        self.unit
     }
 
     /// The range model.
@@ -222,7 +284,7 @@ impl Lidar {
     /// The largest distance a reading carries, millimetres: the XV-11's 14-bit field, or for a
     /// log's scans (never on the XV-11's wire) the reading's 16 bits.
     fn largest_mm(&self) -> f64 {
-        if self.schedule.is_some() {
+        if self.is_scheduled() {
             f64::from(u16::MAX)
         } else {
             f64::from(MAX_DISTANCE_MM)
@@ -270,8 +332,8 @@ impl Lidar {
     /// Takes every reading whose instant falls in `[step.t0, step.t1)`.
     pub fn observe(&mut self, world: &World, step: &StepState, out: &mut Vec<LidarReading>) {
         let track = SensorTrack::new(step, self.mount);
-        if self.schedule.is_some() {
-            self.observe_schedule(world, step, &track, out);
+        if self.scans.is_some() {
+            self.observe_scans(world, step, &track, out);
             return;
         }
         loop {
@@ -302,36 +364,47 @@ impl Lidar {
         }
     }
 
-    /// The scheduled scans' beams whose instant falls in `[step.t0, step.t1)`, each from the
-    /// lidar's pose at its own instant.
-    fn observe_schedule(
+    /// The scans' beams whose instant falls in `[step.t0, step.t1)`, each from the lidar's pose
+    /// at its own instant (or, as a snapshot, at its scan's start).
+    fn observe_scans(
         &mut self,
         world: &World,
         step: &StepState,
         track: &SensorTrack,
         out: &mut Vec<LidarReading>,
     ) {
-        let Some((schedule, mut scan_index, mut beam)) = self.schedule.take() else {
+        let Some((mut scans, mut beam)) = self.scans.take() else {
             return;
         };
-        while let Some(scan) = schedule.scans().get(scan_index) {
+        while let Some(scan) = scans.current() {
             let t = scan.beam_time_s(beam);
             if t >= step.t1 {
                 break;
             }
+            let (beams, rev, angle_deg) = (scan.beams, scan.rev, scan.beam_deg(beam));
             if t >= step.t0 {
-                let (origin, yaw) = track.at(t);
-                self.rev = scan.rev;
+                // A log's scans are replayed as they were taken, reading by reading.
+                let snapshot = self.snapshot && matches!(scans, Scans::Unit(_));
+                let (origin, yaw) = if snapshot {
+                    if beam == 0 || self.rev_pose.is_none() {
+                        self.rev_pose = Some(track.at(t));
+                    }
+                    self.rev_pose.unwrap_or_else(|| track.at(t))
+                } else {
+                    track.at(t)
+                };
+                self.rev = rev;
                 self.index = u16::try_from(beam).unwrap_or(u16::MAX);
-                out.push(self.read(world, origin, yaw, t, scan.beam_deg(beam)));
+                self.rev_rpm = scans.rev_hz() * 60.0;
+                out.push(self.read(world, origin, yaw, t, angle_deg));
             }
             beam += 1;
-            if beam >= scan.beams {
+            if beam >= beams {
                 beam = 0;
-                scan_index += 1;
+                scans.advance();
             }
         }
-        self.schedule = Some((schedule, scan_index, beam));
+        self.scans = Some((scans, beam));
     }
 
     /// One reading at the current (rev, index) at `angle_deg` in the lidar's frame, from the
@@ -358,6 +431,7 @@ impl Lidar {
             strength: 0,
             warning: false,
             true_range_m: None,
+            rev_hz: self.rev_rpm / 60.0,
         };
         let Some(ret) = self.effects.beam_return(world, origin, beam, cast_limit) else {
             return reading;
@@ -389,7 +463,12 @@ impl Lidar {
         reading.error_code = error;
         if error.is_none() {
             reading.distance_mm = measured_mm.min(self.largest_mm()) as u16;
-            reading.strength = strength;
+            // A unit other than the XV-11 reports its strength in one byte.
+            reading.strength = if self.byte_strength {
+                strength.min(u16::from(u8::MAX))
+            } else {
+                strength
+            };
             reading.warning = strength < STRENGTH_WARNING_BELOW;
         }
         reading

@@ -1,6 +1,8 @@
-//! Between the emulated lidar and the Neato wire format: readings into whole revolutions of
-//! packets, and decoded revolutions back into recording rows with their timestamps.
+//! Between the emulated lidar and the wire: readings into whole revolutions of Neato packets,
+//! decoded revolutions back into recording rows with their timestamps, and readings into the
+//! terms of any other unit's protocol ([`to_unit_reading`]).
 
+use hilsim_lidar_protocols::{Direction, UnitReading, UnitSpec};
 use hilsim_recording::LidarSample;
 
 use crate::lidar::{next_revolution_start_s, reading_time_s, LidarReading};
@@ -18,6 +20,31 @@ pub fn to_wire(reading: &LidarReading) -> Reading {
             strength_warning: reading.warning,
             strength: reading.strength,
         },
+    }
+}
+
+/// An emulated reading in the terms of a unit's protocol: its angle from the unit's 0° in the
+/// unit's direction, no distance when invalid, its strength in one byte.
+#[must_use]
+pub fn to_unit_reading(reading: &LidarReading, spec: &UnitSpec) -> UnitReading {
+    let angle_deg = match spec.direction {
+        Direction::CounterClockwise => reading.angle_deg,
+        Direction::Clockwise => (360.0 - reading.angle_deg).rem_euclid(360.0),
+    };
+    UnitReading {
+        t_s: reading.t_s,
+        rev: reading.rev,
+        index: u32::from(reading.index),
+        // 360 - 1e-13 is 360 in the unit's terms.
+        angle_deg: if angle_deg >= 360.0 { 0.0 } else { angle_deg },
+        distance_mm: if reading.error_code.is_some() {
+            0
+        } else {
+            u32::from(reading.distance_mm)
+        },
+        intensity: u8::try_from(reading.strength).unwrap_or(u8::MAX),
+        rev_hz: reading.rev_hz,
+        starts_revolution: reading.index == 0,
     }
 }
 

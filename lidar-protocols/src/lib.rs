@@ -27,3 +27,22 @@ pub mod ydlidar;
 
 pub use model::{Direction, LidarModel, Sampling, UnitSpec};
 pub use unit::{DecodeStats, HostDecoder, Output, PacketSpan, Point, Unit, UnitReading};
+
+/// The unit's side of `model`'s protocol (`None` for the XV-11, whose revolutions [`xv11`]
+/// encodes whole).
+#[must_use]
+pub fn unit_for(model: LidarModel) -> Option<Box<dyn Unit>> {
+    match model {
+        LidarModel::Xv11 => None,
+        _ => None,
+    }
+}
+
+/// The host's side of `model`'s protocol (`None` for the XV-11: [`xv11::Decoder`]).
+#[must_use]
+pub fn decoder_for(model: LidarModel) -> Option<Box<dyn HostDecoder>> {
+    match model {
+        LidarModel::Xv11 => None,
+        _ => None,
+    }
+}

@@ -1,4 +1,5 @@
-//! `hilsim decode INPUT [--csv OUT] [--json]`: decode a raw Neato XV-11 byte stream.
+//! `hilsim decode INPUT [--model M] [--csv OUT] [--json]`: decode a lidar's raw byte stream, the
+//! Neato XV-11's by default.
 //!
 //! INPUT is a capture file or a serial device path. Either is opened read-only and read until
 //! the stream ends, in chunks, so a capture of any size or a live port works in constant memory
@@ -21,6 +22,10 @@
 //! `--json` prints one object: `bytes`, `packets`, `bad_checksum`, `skipped_bytes`,
 //! `index_gaps`, `readings`, `invalid`, `strength_warning` (integers) and `rpm_min`,
 //! `rpm_median`, `rpm_max` (floats over accepted packets, 0.0 when there are none).
+//!
+//! With `--model M` for another unit, the rows are `rev,angle_deg,distance_mm,range_m,intensity,
+//! rev_hz` (the angle in the unit's own convention, the rate empty when its packets carry none)
+//! and the JSON object is `hilsim_hil::decode::UnitDecodeCounts`.
 
 use std::convert::Infallible;
 use std::fs::File;
@@ -29,8 +34,12 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context};
 use hilsim_hil::decode::{
-    decode_stream, decoded_csv_rows, DecodeCounts, DecodeError, DECODED_CSV_HEADER,
+    decode_stream, decode_unit_stream, decoded_csv_rows, unit_csv_row, DecodeCounts, DecodeError,
+    UnitDecodeCounts, DECODED_CSV_HEADER, UNIT_CSV_HEADER,
 };
+use hilsim_sim::scenario::LidarModel;
+
+use crate::cli::DecodeArgs;
 use hilsim_recording::{check_output_file, AtomicFile, FileKind, OutputTarget};
 
 /// `decode --csv`'s table, as a previous one is recognised: by its header.
@@ -39,13 +48,123 @@ const DECODED_CSV: FileKind = FileKind {
     starts_with: DECODED_CSV_HEADER.as_bytes(),
 };
 
+/// `decode --csv --model M`'s table, recognised by its header.
+const UNIT_CSV: FileKind = FileKind {
+    name: "a table of decoded readings",
+    starts_with: UNIT_CSV_HEADER.as_bytes(),
+};
+
+/// `hilsim decode`: the XV-11's stream, or with `--model` another unit's.
+///
+/// # Errors
+/// As [`run_xv11`].
+pub fn run(args: &DecodeArgs, stdout: &mut dyn Write) -> anyhow::Result<()> {
+    let csv = args.csv.as_deref();
+    match hilsim_lidar_protocols::decoder_for(args.model) {
+        None => run_xv11(&args.input, csv, args.json, stdout),
+        Some(mut decoder) => run_unit(
+            &args.input,
+            args.model,
+            &mut *decoder,
+            csv,
+            args.json,
+            stdout,
+        ),
+    }
+}
+
+/// Decodes a unit's stream as [`run_xv11`] does the XV-11's.
+fn run_unit(
+    input: &Path,
+    model: LidarModel,
+    decoder: &mut dyn hilsim_lidar_protocols::HostDecoder,
+    csv: Option<&Path>,
+    json: bool,
+    stdout: &mut dyn Write,
+) -> anyhow::Result<()> {
+    let mut source = open_input(input)?;
+    let cannot_read = |err: std::io::Error| anyhow!("{}: cannot read: {err}", input.display());
+    let counts =
+        match csv {
+            None => decode_unit_stream::<Infallible>(&mut source, model, decoder, None).map_err(
+                |err| match err {
+                    DecodeError::Read(err) => cannot_read(err),
+                    DecodeError::Sink(never) => match never {},
+                },
+            )?,
+            Some(path) => {
+                check_output_file(path, UNIT_CSV, &[input])?;
+                let mut out = AtomicFile::create(path)?;
+                writeln!(out, "{UNIT_CSV_HEADER}")
+                    .with_context(|| format!("{}: cannot write", path.display()))?;
+                let mut row = String::new();
+                let mut write = |rev: u64, point: &_| -> std::io::Result<()> {
+                    row.clear();
+                    unit_csv_row(rev, point, &mut row);
+                    out.write_all(row.as_bytes())
+                };
+                let counts = decode_unit_stream(&mut source, model, decoder, Some(&mut write))
+                    .map_err(|err| match err {
+                        DecodeError::Read(err) => cannot_read(err),
+                        DecodeError::Sink(err) => anyhow::Error::new(err)
+                            .context(format!("{}: cannot write", path.display())),
+                    })?;
+                out.commit()?;
+                counts
+            }
+        };
+    let mut stdout: &mut dyn Write = stdout;
+    let mut stderr = std::io::stderr();
+    if csv.is_some_and(|path| OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout)) {
+        stdout = &mut stderr;
+    }
+    report_unit(input, &counts, json, stdout).context("cannot write the counts")
+}
+
+fn report_unit(
+    input: &Path,
+    counts: &UnitDecodeCounts,
+    json: bool,
+    stdout: &mut dyn Write,
+) -> anyhow::Result<()> {
+    if json {
+        serde_json::to_writer(&mut *stdout, counts)?;
+        writeln!(stdout)?;
+    } else {
+        writeln!(
+            stdout,
+            "{} ({}): {} bytes, {} packets ({} readings, {} without a return), {} bad checksums, \
+             {} bytes skipped",
+            input.display(),
+            counts.model,
+            counts.bytes,
+            counts.packets,
+            counts.readings,
+            counts.no_return,
+            counts.bad_checksum,
+            counts.skipped_bytes,
+        )?;
+        if counts.rev_hz_median > 0.0 {
+            writeln!(
+                stdout,
+                "revolutions: {} begun, {:.2} Hz median as reported",
+                counts.revolutions, counts.rev_hz_median
+            )?;
+        } else {
+            writeln!(stdout, "revolutions: {} begun", counts.revolutions)?;
+        }
+    }
+    stdout.flush()?;
+    Ok(())
+}
+
 /// Decodes `input`, optionally writes the readings to `csv`, and reports the counts on `stdout`
 /// (one JSON object with `json`, else a short human summary).
 ///
 /// # Errors
 /// The input cannot be opened or read (a directory, a missing file…), the CSV cannot be
 /// written, or `stdout` fails; each message names the path concerned.
-pub fn run(
+pub fn run_xv11(
     input: &Path,
     csv: Option<&Path>,
     json: bool,
@@ -182,7 +301,8 @@ mod tests {
         std::fs::write(&input, bytes).expect("write capture");
         let csv_path = dir.path().join("out.csv");
         let mut stdout = Vec::new();
-        run(&input, csv.then_some(csv_path.as_path()), json, &mut stdout).expect("decode runs");
+        run_xv11(&input, csv.then_some(csv_path.as_path()), json, &mut stdout)
+            .expect("decode runs");
         let leftovers: Vec<_> = std::fs::read_dir(dir.path())
             .expect("list dir")
             .filter_map(|entry| entry.ok())

@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{write_file_atomically, RecordingStream};
 use hilsim_scenarios::{builtin, Via};
@@ -28,6 +28,18 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
     }
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
+    let model = scenario
+        .sensors
+        .lidar
+        .as_ref()
+        .map(|l| l.model)
+        .unwrap_or_default();
+    if args.via == cli::Via::Serial && model != hilsim_sim::scenario::LidarModel::Xv11 {
+        bail!(
+            "{origin}: `--via serial` reads the Neato XV-11's wire, and the lidar is a {model}: \
+             `hilsim serve` streams its protocol"
+        );
+    }
     let via = match args.via {
         cli::Via::Memory => Via::Memory,
         cli::Via::Serial => Via::Serial,

@@ -6,9 +6,10 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result};
 use hilsim_hil::faults::WireFaults;
-use hilsim_hil::serve::{serve_with_progress, ServeReport};
-use hilsim_hil::{DeviceLink, Pacing, PtyLink, SerialLink, Streamer};
+use hilsim_hil::serve::{serve_unit_with_progress, serve_with_progress, ServeReport};
+use hilsim_hil::{DeviceLink, Pacing, PtyLink, SerialLink, StreamStats, Streamer, UnitStreamer};
 use hilsim_lidar_emulator::Emulation;
+use hilsim_sim::scenario::LidarModel;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::cli::ServeArgs;
@@ -23,8 +24,8 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     }
     if scenario.files.schedule.is_some() {
         anyhow::bail!(
-            "{}: the lidar replays a log's scans (`schedule`), which have no Neato XV-11 packets \
-             to serve; `hilsim record` makes its twin",
+            "{}: the lidar replays a log's scans (`schedule`), which have no unit's packets to \
+             serve; `hilsim record` makes its twin",
             args.scenario.display()
         );
     }
@@ -33,6 +34,12 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     } else {
         Pacing::Realtime
     };
+    let model = scenario
+        .sensors
+        .lidar
+        .as_ref()
+        .map(|l| l.model)
+        .unwrap_or_default();
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
     let stop = AtomicBool::new(false);
@@ -41,16 +48,17 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     let wire_faults = || WireFaults::new(&link_faults, scenario.seed);
     let report = match &args.port {
         Some(path) => {
-            let link = DeviceLink::open(&path.to_string_lossy()).map_err(|err| {
-                let path = path.display();
-                match err.kind() {
-                    std::io::ErrorKind::InvalidInput => anyhow::anyhow!("{path}: {err}"),
-                    _ => anyhow::anyhow!("{path}: cannot open: {err}"),
-                }
-            })?;
+            let link =
+                DeviceLink::open_at(&path.to_string_lossy(), model.spec().baud).map_err(|err| {
+                    let path = path.display();
+                    match err.kind() {
+                        std::io::ErrorKind::InvalidInput => anyhow::anyhow!("{path}: {err}"),
+                        _ => anyhow::anyhow!("{path}: cannot open: {err}"),
+                    }
+                })?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
-            run(emulation, link, pacing, &stop, false, wire_faults())?
+            run(emulation, link, pacing, &stop, false, wire_faults(), model)?
         }
         None => {
             let link = PtyLink::open().context("cannot create a pseudo-terminal")?;
@@ -62,7 +70,15 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
                 writeln!(out, "client connected: streaming")?;
                 out.flush()?;
             }
-            run(emulation, link, pacing, &stop, connected, wire_faults())?
+            run(
+                emulation,
+                link,
+                pacing,
+                &stop,
+                connected,
+                wire_faults(),
+                model,
+            )?
         }
     };
     let s = &report.stream;
@@ -104,11 +120,8 @@ fn run<L: SerialLink>(
     stop: &AtomicBool,
     client_connected: bool,
     faults: Option<WireFaults>,
+    model: LidarModel,
 ) -> Result<ServeReport> {
-    let mut streamer = Streamer::new(link, pacing).with_faults(faults);
-    if client_connected {
-        streamer.reader_connected();
-    }
     // What is sent, as a status line on a terminal (stderr; stdout keeps its lines for scripts).
     let status = std::io::stderr().is_terminal().then(|| {
         let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
@@ -117,7 +130,7 @@ fn run<L: SerialLink>(
         }
         bar
     });
-    let report = serve_with_progress(emulation, &mut streamer, stop, &mut |stats, t_s| {
+    let mut progress = |stats: &StreamStats, t_s: f64| {
         if let Some(bar) = &status {
             bar.set_message(format!(
                 "{:.1} s simulated, {} revolutions sent, {} dropped",
@@ -125,7 +138,23 @@ fn run<L: SerialLink>(
             ));
             bar.tick();
         }
-    });
+    };
+    let report = match hilsim_lidar_protocols::unit_for(model) {
+        None => {
+            let mut streamer = Streamer::new(link, pacing).with_faults(faults);
+            if client_connected {
+                streamer.reader_connected();
+            }
+            serve_with_progress(emulation, &mut streamer, stop, &mut progress)
+        }
+        Some(unit) => {
+            let mut streamer = UnitStreamer::new(link, unit, pacing).with_faults(faults);
+            if client_connected {
+                streamer.reader_connected();
+            }
+            serve_unit_with_progress(emulation, &mut streamer, stop, &mut progress)
+        }
+    };
     if let Some(bar) = &status {
         bar.finish_and_clear();
     }

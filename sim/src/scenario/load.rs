@@ -60,6 +60,7 @@ impl Scenario {
         if duration_s.is_some() {
             scenario.duration_s = duration_s;
         }
+        model_defaults(&mut scenario, text);
         scenario.files = super::files::read(&scenario, origin)?;
         if let (None, Some(path)) = (scenario.duration_s, &scenario.files.path) {
             // A replayed log's run lasts as long as its path.
@@ -71,6 +72,38 @@ impl Scenario {
             message: format!("{}: {}", locate::display(&invalid.path), invalid.message),
         })?;
         Ok(scenario)
+    }
+}
+
+/// Fills the lidar keys the file leaves out with its model's datasheet values (serde's defaults
+/// are the XV-11's, which is what a file without a model means).
+fn model_defaults(scenario: &mut Scenario, text: &str) {
+    let Some(lidar) = scenario.sensors.lidar.as_mut() else {
+        return;
+    };
+    if lidar.model == super::LidarModel::Xv11 {
+        return;
+    }
+    // The text parsed once already; this second look only asks which keys it sets.
+    let table: Option<toml::Table> = text.parse().ok();
+    let set = |key: &str| {
+        table
+            .as_ref()
+            .and_then(|t| t.get("sensors")?.get("lidar")?.get(key))
+            .is_some()
+    };
+    let spec = lidar.model.spec();
+    if !set("rpm") {
+        lidar.rpm = spec.rev_hz * 60.0;
+    }
+    if !set("min_range_m") {
+        lidar.min_range_m = spec.min_range_m;
+    }
+    if !set("max_range_m") {
+        lidar.max_range_m = spec.max_range_m;
+    }
+    if let (false, Some(noise)) = (set("noise"), spec.noise) {
+        lidar.noise = noise.to_vec();
     }
 }
 

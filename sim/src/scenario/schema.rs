@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+pub use hilsim_lidar_protocols::LidarModel;
+
 /// A calibration method (the one definition: `hilsim_recording::Method`).
 pub use hilsim_recording::Method;
 
@@ -361,10 +363,15 @@ impl From<Mount> for hilsim_recording::Mount {
     }
 }
 
-/// `[sensors.lidar]`: the Neato XV-11 triangulation lidar.
+/// `[sensors.lidar]`: a spinning 2-D lidar, by default the Neato XV-11 triangulation lidar.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Lidar {
+    /// Which unit: its protocol on the wire, its geometry and timing, and the defaults of
+    /// `rpm`, `min_range_m`, `max_range_m` and `noise` where the file sets none (the unit's
+    /// datasheet: `hilsim_lidar_protocols::UnitSpec`). Default `xv11`.
+    #[serde(default)]
+    pub model: LidarModel,
     /// alpha_0.. of the papers' eq. (2), the range bias polynomial; default `[0, 1]` (unbiased).
     #[serde(default = "unbiased")]
     pub bias: Vec<f64>,
@@ -374,7 +381,8 @@ pub struct Lidar {
     /// Standard deviation of the beam direction, degrees.
     #[serde(default)]
     pub angle_noise_deg: f64,
-    /// Motor speed, revolutions per minute; default 300 (the XV-11's nominal 5 Hz).
+    /// Motor speed, revolutions per minute; default the model's nominal rate (the XV-11's 300,
+    /// 5 Hz).
     #[serde(default = "default_rpm")]
     pub rpm: f64,
     /// Amplitude of a slow sinusoidal rpm wobble, rpm; default 0.

@@ -4,7 +4,7 @@
 use super::check::{fail, toml_number, Check};
 use super::locate::{key_path, Key};
 use super::metrics;
-use super::schema::{DriveStep, Scenario};
+use super::schema::{DriveStep, LidarModel, Scenario};
 use super::validate_effects;
 use crate::world::Obstacle;
 
@@ -377,6 +377,26 @@ fn sensors(s: &Scenario) -> Check {
                 p("rpm"),
                 format!("expected 0 < rpm ≤ 1000, found {}", l.rpm),
             );
+        }
+        if l.model != LidarModel::Xv11 {
+            let spec = l.model.spec();
+            let (low, high) = (spec.rev_hz_range.0 * 60.0, spec.rev_hz_range.1 * 60.0);
+            // A thousandth of slack: datasheet ranges are written in Hz, files in rpm.
+            if l.rpm < low * 0.999 || l.rpm > high * 1.001 {
+                return fail(
+                    p("rpm"),
+                    format!(
+                        "the {} turns at {low:.0}–{high:.0} rpm, found {}",
+                        spec.title, l.rpm
+                    ),
+                );
+            }
+            if l.schedule.is_some() {
+                return fail(
+                    p("schedule"),
+                    "a schedule replays a log's scans, a model takes its unit's: set one",
+                );
+            }
         }
         non_negative(p("rpm_wobble"), l.rpm_wobble)?;
         if l.rpm_wobble >= l.rpm {

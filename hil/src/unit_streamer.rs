@@ -1,0 +1,292 @@
+//! Streaming a unit other than the XV-11: its packets sent as the unit sends them, its host's
+//! commands read and answered as they come (start, stop, info, health), and a slow, stalled or
+//! absent reader never holding up the simulation.
+//!
+//! The XV-11's own [`crate::Streamer`] works in whole revolutions of fixed packets; a unit here
+//! speaks through a [`Unit`], a pure state machine, and this streamer only moves its bytes and
+//! keeps time.
+
+use std::io::{self, ErrorKind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use hilsim_lidar_protocols::{Output, Unit, UnitReading};
+
+use crate::faults::{FaultCounts, WireFaults};
+use crate::link::SerialLink;
+use crate::streamer::{Pacing, StreamStats, FAST_STALL_GRACE, STALL_DETECT};
+
+/// How long the streamer sleeps between looks at the host's commands while it waits: a
+/// command is answered within about this (a real unit answers within a few milliseconds).
+const HOST_POLL: Duration = Duration::from_millis(1);
+/// The backlog a reader may leave before it counts as fallen behind, until a whole
+/// revolution's bytes are known (a revolution of the units here is 1.5–2.5 KB).
+const FIRST_BACKLOG_LIMIT: usize = 4096;
+
+/// Streams one unit's packets over a link and answers its host.
+pub struct UnitStreamer<L: SerialLink> {
+    link: L,
+    unit: Box<dyn Unit>,
+    pacing: Pacing,
+    /// The wall-clock instant of simulated t = 0 (real-time pacing, once started).
+    origin: Option<Instant>,
+    stats: StreamStats,
+    faults: Option<WireFaults>,
+    out: Output,
+    wire: Vec<u8>,
+    /// Bytes written since the last revolution's start, and a whole revolution's.
+    revolution_bytes: usize,
+    backlog_limit: usize,
+    /// Whether a reader has taken data since the stream last found it stalled or absent.
+    reader_reading: bool,
+    /// The simulated time of the latest reading taken.
+    now_s: f64,
+}
+
+impl<L: SerialLink> UnitStreamer<L> {
+    /// A streamer of `unit` over `link`.
+    pub fn new(link: L, unit: Box<dyn Unit>, pacing: Pacing) -> Self {
+        Self {
+            link,
+            unit,
+            pacing,
+            origin: None,
+            stats: StreamStats::default(),
+            faults: None,
+            out: Output::new(),
+            wire: Vec::new(),
+            revolution_bytes: 0,
+            backlog_limit: FIRST_BACKLOG_LIMIT,
+            reader_reading: false,
+            now_s: 0.0,
+        }
+    }
+
+    /// The stream with a scenario's wire faults applied to every packet and reply.
+    #[must_use]
+    pub fn with_faults(mut self, faults: Option<WireFaults>) -> Self {
+        self.faults = faults;
+        self
+    }
+
+    /// Tells the stream that a reader has connected: it is waited for from the start.
+    pub fn reader_connected(&mut self) {
+        self.reader_reading = true;
+    }
+
+    /// What the stream did so far.
+    #[must_use]
+    pub fn stats(&self) -> &StreamStats {
+        &self.stats
+    }
+
+    /// What the wire's faults did so far (`None` without faults).
+    #[must_use]
+    pub fn fault_counts(&self) -> Option<FaultCounts> {
+        self.faults.as_ref().map(WireFaults::counts)
+    }
+
+    /// The link.
+    pub fn link(&mut self) -> &mut L {
+        &mut self.link
+    }
+
+    /// Whether the unit is sending its readings.
+    #[must_use]
+    pub fn scanning(&self) -> bool {
+        self.unit.scanning()
+    }
+
+    /// Hands the unit its next reading at the reading's instant, and sends what it completes.
+    /// In real time it waits for that instant, answering the host meanwhile; otherwise a unit
+    /// that is not scanning holds the simulation until its host starts it (or `stop` is
+    /// raised), and one that is scanning runs as fast as its reader takes it.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn take(&mut self, reading: &UnitReading, stop: &AtomicBool) -> io::Result<()> {
+        self.pace(reading.t_s, stop)?;
+        self.now_s = reading.t_s;
+        let mut out = std::mem::take(&mut self.out);
+        out.clear();
+        self.unit.push(reading, &mut out);
+        let sent = self.send(&out);
+        self.out = out;
+        sent
+    }
+
+    /// Reads and answers the host's commands until the link has no more.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn answer_host(&mut self) -> io::Result<()> {
+        let mut buf = [0_u8; 512];
+        let now_s = self.sim_now_s();
+        loop {
+            let n = self.link.read_host(&mut buf)?;
+            if n == 0 {
+                return Ok(());
+            }
+            let mut out = std::mem::take(&mut self.out);
+            out.clear();
+            self.unit.host_wrote(&buf[..n], now_s, &mut out);
+            let sent = self.send(&out);
+            self.out = out;
+            sent?;
+        }
+    }
+
+    /// Lets a reader that is reading take what is still in the link before the stream ends:
+    /// waits while the backlog shrinks, giving up after [`FAST_STALL_GRACE`] without progress.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn drain(&mut self) -> io::Result<()> {
+        if !self.reader_reading {
+            return Ok(());
+        }
+        let mut backlog = self.link.backlog()?;
+        let mut progress_at = Instant::now();
+        while backlog > 0 && progress_at.elapsed() < FAST_STALL_GRACE {
+            self.answer_host()?;
+            thread::sleep(HOST_POLL);
+            let now = self.link.backlog()?;
+            if now < backlog {
+                progress_at = Instant::now();
+            }
+            backlog = now;
+        }
+        Ok(())
+    }
+
+    /// The simulated time now: on the wall clock in real time, else the latest reading's.
+    fn sim_now_s(&self) -> f64 {
+        match (self.pacing, self.origin) {
+            (Pacing::Realtime, Some(origin)) => origin.elapsed().as_secs_f64(),
+            _ => self.now_s,
+        }
+    }
+
+    fn pace(&mut self, t_s: f64, stop: &AtomicBool) -> io::Result<()> {
+        match self.pacing {
+            Pacing::Realtime => {
+                let origin = *self.origin.get_or_insert_with(|| {
+                    Instant::now()
+                        .checked_sub(Duration::from_secs_f64(t_s.max(0.0)))
+                        .unwrap_or_else(Instant::now)
+                });
+                let due = origin + Duration::from_secs_f64(t_s.max(0.0));
+                loop {
+                    self.answer_host()?;
+                    let now = Instant::now();
+                    // Within a poll of its instant is on time: sleeping is coarser than that.
+                    if now + HOST_POLL >= due || stop.load(Ordering::Relaxed) {
+                        return Ok(());
+                    }
+                    thread::sleep((due - now - HOST_POLL).min(HOST_POLL));
+                }
+            }
+            Pacing::Fast | Pacing::Lossless => {
+                self.answer_host()?;
+                while !self.unit.scanning() && !stop.load(Ordering::Relaxed) {
+                    thread::sleep(HOST_POLL);
+                    self.answer_host()?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Sends `out`'s packets through the faults.
+    fn send(&mut self, out: &Output) -> io::Result<()> {
+        for (packet, span) in out.iter() {
+            if span.starts_revolution {
+                if self.revolution_bytes > 0 {
+                    self.backlog_limit = self.revolution_bytes.max(256);
+                }
+                self.revolution_bytes = 0;
+                self.link.allow_reconnect()?;
+                self.make_room()?;
+            }
+            let mut wire = std::mem::take(&mut self.wire);
+            wire.clear();
+            match self.faults.as_mut() {
+                Some(faults) => {
+                    faults.apply_unit_packet(packet, span.sync_len, span.due_s, &mut wire)
+                }
+                None => wire.extend_from_slice(packet),
+            }
+            let written = self.write_all(&wire);
+            self.wire = wire;
+            if !written? {
+                if span.starts_revolution {
+                    self.stats.revolutions_dropped += 1;
+                }
+                continue;
+            }
+            self.revolution_bytes += packet.len();
+            if span.starts_revolution {
+                self.stats.revolutions_sent += 1;
+            }
+            if let (Pacing::Realtime, Some(origin)) = (self.pacing, self.origin) {
+                let due = origin + Duration::from_secs_f64(span.due_s.max(0.0));
+                self.stats
+                    .record_lateness(Instant::now().saturating_duration_since(due));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes `bytes` without blocking; `false` when the link could not take them all.
+    fn write_all(&mut self, bytes: &[u8]) -> io::Result<bool> {
+        let mut at = 0;
+        while at < bytes.len() {
+            match self.link.write(&bytes[at..]) {
+                Ok(0) => break,
+                Ok(n) => at += n,
+                Err(err) if err.kind() == ErrorKind::Interrupted => {}
+                Err(err) if matches!(err.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                    break
+                }
+                Err(err) => return Err(err),
+            }
+        }
+        self.stats.bytes_written += at as u64;
+        Ok(at == bytes.len())
+    }
+
+    /// Brings the backlog under one revolution at a revolution's start: waits for a reader
+    /// that is making progress (fast pacing), and throws away what a stalled or absent one left
+    /// (at once in real time: live data first).
+    fn make_room(&mut self) -> io::Result<()> {
+        let mut backlog = self.link.backlog()?;
+        let mut progress_at = Instant::now();
+        while backlog > self.backlog_limit {
+            let patience = match self.pacing {
+                Pacing::Realtime => Duration::ZERO,
+                _ if self.reader_reading => FAST_STALL_GRACE,
+                _ => STALL_DETECT,
+            };
+            if progress_at.elapsed() >= patience {
+                self.link.discard_backlog()?;
+                self.stats.bytes_discarded += backlog as u64;
+                let revolutions = (backlog / self.backlog_limit.max(1)) as u64;
+                self.stats.revolutions_sent =
+                    self.stats.revolutions_sent.saturating_sub(revolutions);
+                self.stats.revolutions_dropped += revolutions;
+                self.reader_reading = false;
+                return Ok(());
+            }
+            self.answer_host()?;
+            thread::sleep(Duration::from_micros(200));
+            let now = self.link.backlog()?;
+            if now < backlog {
+                progress_at = Instant::now();
+                self.reader_reading = true;
+            }
+            backlog = now;
+        }
+        Ok(())
+    }
+}

@@ -290,3 +290,120 @@ impl<L: SerialLink> UnitStreamer<L> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MemoryLink;
+
+    /// A toy command-driven unit: `S` starts it, `T` stops it, `I` asks for its info; each
+    /// reading is a 3-byte packet.
+    #[derive(Default)]
+    struct ToyUnit {
+        scanning: bool,
+    }
+
+    impl Unit for ToyUnit {
+        fn host_wrote(&mut self, bytes: &[u8], now_s: f64, out: &mut Output) {
+            for &b in bytes {
+                match b {
+                    b'S' => self.scanning = true,
+                    b'T' => self.scanning = false,
+                    b'I' => out.packet(now_s, 0, false, |o| o.extend_from_slice(b"INFO")),
+                    _ => {}
+                }
+            }
+        }
+
+        fn scanning(&self) -> bool {
+            self.scanning
+        }
+
+        fn push(&mut self, reading: &UnitReading, out: &mut Output) {
+            if self.scanning {
+                out.packet(reading.t_s, 1, reading.starts_revolution, |o| {
+                    o.extend_from_slice(&[0xAB, reading.index as u8, reading.distance_mm as u8]);
+                });
+            }
+        }
+    }
+
+    fn reading(k: u32) -> UnitReading {
+        UnitReading {
+            t_s: f64::from(k) * 1e-3,
+            rev: u64::from(k / 10),
+            index: k % 10,
+            angle_deg: f64::from(k % 10) * 36.0,
+            distance_mm: 100 + k,
+            intensity: 50,
+            rev_hz: 100.0,
+            starts_revolution: k % 10 == 0,
+        }
+    }
+
+    #[test]
+    fn a_command_driven_unit_answers_its_host_and_streams_only_between_start_and_stop() {
+        let stop = AtomicBool::new(false);
+        let link = MemoryLink::with_capacity(1 << 16);
+        let mut s = UnitStreamer::new(link, Box::new(ToyUnit::default()), Pacing::Fast);
+        s.link().client_writes(b"I");
+        s.answer_host().unwrap();
+        assert_eq!(s.link().take(), b"INFO");
+        // Started: every reading goes out, and a question is answered between readings.
+        s.link().client_writes(b"S");
+        for k in 0..20 {
+            if k == 5 {
+                s.link().client_writes(b"I");
+            }
+            s.take(&reading(k), &stop).unwrap();
+        }
+        let bytes = s.link().take();
+        assert_eq!(bytes.len(), 20 * 3 + 4);
+        assert_eq!(&bytes[..3], &[0xAB, 0, 100]);
+        assert_eq!(&bytes[15..19], b"INFO");
+        assert_eq!(s.stats().revolutions_sent, 2);
+        // Stopped: nothing more, though the head turns on (a stop flag lets the fast stream
+        // through: it would otherwise wait for the next start).
+        s.link().client_writes(b"T");
+        stop.store(true, Ordering::Relaxed);
+        for k in 20..30 {
+            s.take(&reading(k), &stop).unwrap();
+        }
+        assert!(s.link().take().is_empty());
+    }
+
+    #[test]
+    fn faults_reach_the_unit_packets_and_silence_swallows_replies() {
+        let stop = AtomicBool::new(false);
+        let faults = hilsim_sim::scenario::LinkFaults {
+            silent: Some((0.0, 1.0)),
+            ..hilsim_sim::scenario::LinkFaults::default()
+        };
+        let link = MemoryLink::with_capacity(1 << 16);
+        let mut s = UnitStreamer::new(link, Box::new(ToyUnit::default()), Pacing::Fast)
+            .with_faults(WireFaults::new(&faults, 1));
+        s.link().client_writes(b"IS");
+        s.take(&reading(0), &stop).unwrap();
+        // Inside the silent second: neither the reply nor the packet comes.
+        assert!(s.link().take().is_empty());
+        assert_eq!(s.fault_counts().unwrap().silenced_packets, 2);
+    }
+
+    #[test]
+    fn an_absent_reader_costs_data_not_time() {
+        let stop = AtomicBool::new(false);
+        let link = MemoryLink::with_capacity(1 << 20);
+        let mut s = UnitStreamer::new(link, Box::new(ToyUnit { scanning: true }), Pacing::Fast);
+        for k in 0..10_000 {
+            s.take(&reading(k), &stop).unwrap();
+        }
+        // Nobody reads: the backlog is thrown away at revolution starts, never above about
+        // two revolutions' bytes (a revolution here is 30 bytes; the floor is 256).
+        assert!(
+            s.link().backlog().unwrap() <= 2 * 256,
+            "{}",
+            s.link().backlog().unwrap()
+        );
+        assert!(s.stats().bytes_discarded > 0);
+    }
+}

@@ -142,8 +142,8 @@ impl Packet {
     #[must_use]
     pub fn angle_deg(&self, i: usize) -> f64 {
         let start = u32::from(self.start_angle_cdeg);
-        let span = (u32::from(self.end_angle_cdeg) + CENTIDEGREES - start % CENTIDEGREES)
-            % CENTIDEGREES;
+        let span =
+            (u32::from(self.end_angle_cdeg) + CENTIDEGREES - start % CENTIDEGREES) % CENTIDEGREES;
         let step = f64::from(span) / (READINGS_PER_PACKET - 1) as f64;
         (f64::from(start) + i as f64 * step).rem_euclid(f64::from(CENTIDEGREES)) / 100.0
     }
@@ -173,7 +173,10 @@ impl Ld06Unit {
             start_angle_cdeg: centidegrees(start),
             readings: std::array::from_fn(|i| {
                 readings.get(i).map_or((0, 0), |r| {
-                    (u16::try_from(r.distance_mm).unwrap_or(u16::MAX), r.intensity)
+                    (
+                        u16::try_from(r.distance_mm).unwrap_or(u16::MAX),
+                        r.intensity,
+                    )
                 })
             }),
             end_angle_cdeg: centidegrees(end),
@@ -325,8 +328,7 @@ impl Ld06Decoder {
         self.stats.bad_checksum += 1;
         let next = (1..PACKET_LEN)
             .find(|&at| {
-                self.window[at] == HEADER
-                    && self.window.get(at + 1).is_none_or(|&b| b == VER_LEN)
+                self.window[at] == HEADER && self.window.get(at + 1).is_none_or(|&b| b == VER_LEN)
             })
             .unwrap_or(PACKET_LEN);
         self.stats.skipped_bytes += next as u64;

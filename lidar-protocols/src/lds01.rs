@@ -456,7 +456,10 @@ mod tests {
             }),
         };
         let bytes = packet.encode();
-        assert_eq!(&bytes[..8], &[0xFA, 0xAF, 0xB8, 0x0B, 0x64, 0x00, 0xE8, 0x03]);
+        assert_eq!(
+            &bytes[..8],
+            &[0xFA, 0xAF, 0xB8, 0x0B, 0x64, 0x00, 0xE8, 0x03]
+        );
         // lds2d.drivers.hitachi_lg_hls_lfcd2.calc_checksum(bytes[:40]) of this packet.
         assert_eq!(checksum(&bytes), LDS2D_CHECKSUM_OF_VECTOR);
         assert_eq!(Packet::decode(&bytes), Some(packet));
@@ -476,7 +479,10 @@ mod tests {
             assert_eq!(span.sync_len, 2);
         }
         let (points, stats) = decode_all(&out.bytes);
-        assert_eq!((stats.packets, stats.bad_checksum, stats.skipped_bytes), (60, 0, 0));
+        assert_eq!(
+            (stats.packets, stats.bad_checksum, stats.skipped_bytes),
+            (60, 0, 0)
+        );
         for (r, p) in readings.iter().zip(&points) {
             assert_eq!(p.angle_deg, r.angle_deg);
             assert_eq!(p.distance_mm, r.distance_mm);
@@ -504,7 +510,8 @@ mod tests {
         unit.host_wrote(b"xx\ne", 0.1, &mut out);
         assert!(!unit.scanning());
         assert_eq!(out.packets.len(), 1, "no reply");
-        out.bytes.extend(push_all(&mut unit, &readings[9..120]).bytes);
+        out.bytes
+            .extend(push_all(&mut unit, &readings[9..120]).bytes);
         assert_eq!(out.bytes.len(), PACKET_LEN);
         unit.host_wrote(b"b", 0.2, &mut out);
         assert!(unit.scanning());
@@ -538,7 +545,9 @@ mod tests {
         let readings = revolution(0, 5.0, |_| 40_000);
         let out = push_all(&mut Lds01Unit::new(), &readings[..6]);
         let (points, _) = decode_all(&out.bytes);
-        assert!(points.iter().all(|p| p.distance_mm == u32::from(MAX_DISTANCE_MM)));
+        assert!(points
+            .iter()
+            .all(|p| p.distance_mm == u32::from(MAX_DISTANCE_MM)));
     }
 
     #[test]
@@ -562,7 +571,7 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig {
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x1D5_01),
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x01D5_0001),
             failure_persistence: None,
             cases: 256,
             ..ProptestConfig::default()

@@ -85,7 +85,9 @@ impl Unit for Lds02rrUnit {
             let packet = Packet {
                 index: u8::try_from(index).unwrap_or(0),
                 rpm_fixed: rpm_to_fixed(rev_hz * 60.0),
-                readings: slots.each_ref().map(|slot| Self::wire_reading(slot.as_ref())),
+                readings: slots
+                    .each_ref()
+                    .map(|slot| Self::wire_reading(slot.as_ref())),
             };
             out.packet(due_s, 2, starts_revolution, |bytes| {
                 bytes.extend_from_slice(&packet.encode());
@@ -202,7 +204,10 @@ mod tests {
         // The first packet's first reading is a no return: invalid, with its code.
         assert_eq!(&out.bytes[4..6], &[NO_RETURN_CODE, 0x80]);
         let (points, stats) = decode_all(&out.bytes);
-        assert_eq!((stats.packets, stats.bad_checksum, stats.skipped_bytes), (90, 0, 0));
+        assert_eq!(
+            (stats.packets, stats.bad_checksum, stats.skipped_bytes),
+            (90, 0, 0)
+        );
         for (r, p) in readings.iter().zip(&points) {
             assert_eq!(p.angle_deg, r.angle_deg);
             assert_eq!(p.distance_mm, r.distance_mm);
@@ -240,7 +245,7 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig {
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x1D5_02),
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x01D5_0002),
             failure_persistence: None,
             cases: 256,
             ..ProptestConfig::default()

@@ -195,12 +195,16 @@ static RPLIDAR_A1: UnitSpec = UnitSpec {
 
 /// Hitachi-LG HLS-LFCD2 (ROBOTIS e-manual, "LDS-01 specifications"): 300 ± 10 rpm, 1° angular
 /// resolution, 120–3,500 mm; accuracy ±15 mm below 0.5 m and ±5 % to 3.5 m (read here as
-/// σ = 15 mm + 2.5 % of the range: the ±5 % as two standard deviations).
+/// σ = 15 mm + 2.5 % of the range: the ±5 % as two standard deviations). Its degrees grow
+/// clockwise: the ROBOTIS `hls_lfcd_lds_driver` publishes them in chronological order with an
+/// angle increment of −1° (`hlds_laser_publisher.cpp`, `chronological_order`). It streams from
+/// power-on since its 2017.10 firmware (the same driver: its `b` start command "not required
+/// after firmware upgrade"); `e` and `b` stop and restart it.
 static LDS_01: UnitSpec = UnitSpec {
     name: "lds-01",
     title: "Hitachi-LG HLS-LFCD2 (LDS-01)",
     baud: 230_400,
-    direction: Direction::CounterClockwise,
+    direction: Direction::Clockwise,
     sampling: Sampling::Grid {
         steps_per_rev: 360,
         first: 0,
@@ -213,17 +217,19 @@ static LDS_01: UnitSpec = UnitSpec {
     min_range_m: 0.12,
     max_range_m: 3.5,
     noise: Some(&[0.015, 0.025]),
-    command_driven: true,
+    command_driven: false,
 };
 
-/// Xiaomi LDS02RR: an XV-11 descendant with its own packet layout, 360 readings a revolution at
+/// Xiaomi LDS02RR: an XV-11 descendant sending the XV-11's packets, 360 readings a revolution at
 /// about 300 rpm (its motor driven by the host's PWM); no published datasheet, so the
-/// scenario's range model applies. Range 0.15–6 m as for the XV-11 family.
+/// scenario's range model applies. Range 0.15–6 m as for the XV-11 family. Its degrees grow
+/// clockwise, unlike the XV-11's (`lds2d` `xiaomi_lds02rr.py` and kaiaai `LDS` read its index
+/// unmirrored, the XV-11's mirrored).
 static LDS_02RR: UnitSpec = UnitSpec {
     name: "lds-02rr",
     title: "Xiaomi LDS02RR",
     baud: 115_200,
-    direction: Direction::CounterClockwise,
+    direction: Direction::Clockwise,
     sampling: Sampling::Grid {
         steps_per_rev: 360,
         first: 0,

@@ -83,7 +83,7 @@ impl RplidarDecoder {
         if p.is_empty() || self.reply_left > 0 {
             return false;
         }
-        if p[0] == SYNC_BYTE && p.get(1).map_or(true, |&b| b == SYNC_BYTE2) {
+        if p[0] == SYNC_BYTE && p.get(1).is_none_or(|&b| b == SYNC_BYTE2) {
             if p.len() < DESCRIPTOR_LEN {
                 return false;
             }

@@ -66,9 +66,10 @@ pub const SYNC_BYTE2: u8 = 0x5A;
 pub mod info {
     /// Model code.
     pub const MODEL: u8 = 6;
-    /// Firmware major version (the low byte of the firmware field).
+    /// Firmware major version: the field's high byte, as the YDLIDAR SDK and `PyLidar3` read it
+    /// (the X2 manual's prose says the opposite; its drivers win).
     pub const FIRMWARE_MAJOR: u8 = 1;
-    /// Firmware minor version (the high byte).
+    /// Firmware minor version: the low byte.
     pub const FIRMWARE_MINOR: u8 = 5;
     /// Hardware version.
     pub const HARDWARE: u8 = 1;
@@ -79,8 +80,8 @@ pub mod info {
     pub fn bytes() -> [u8; 20] {
         let mut b = [0; 20];
         b[0] = MODEL;
-        b[1] = FIRMWARE_MAJOR;
-        b[2] = FIRMWARE_MINOR;
+        b[1] = FIRMWARE_MINOR;
+        b[2] = FIRMWARE_MAJOR;
         b[3] = HARDWARE;
         b[4..].copy_from_slice(&SERIAL);
         b

@@ -226,7 +226,7 @@ mod tests {
     #[test]
     fn malformed_scan_commands_get_the_specification_statuses() {
         assert_eq!(parse(b"MD00440725010"), Err(SHORT_PARAMETERS));
-        assert_eq!(parse(b"MD004407250100"), Err(LONG_PARAMETERS));
+        assert_eq!(parse(b"MD00440725010000"), Err(LONG_PARAMETERS));
         assert_eq!(parse(b"MDx044072501000"), Err(*b"01"));
         assert_eq!(parse(b"GD00440x2501"), Err(*b"02"));
         assert_eq!(parse(b"GD004407250a"), Err(*b"03"));

@@ -164,9 +164,8 @@ pub fn number(digits: &[u8]) -> Option<u32> {
 /// A scan request's parameters, checked in the specification's status order.
 fn parse_scan(symbol: &[u8], params: &[u8]) -> Result<ScanRequest, Status> {
     let continuous = symbol[0] == b'M';
-    let field = |range: std::ops::Range<usize>, status: &[u8; 2]| {
-        number(&params[range]).ok_or(*status)
-    };
+    let field =
+        |range: std::ops::Range<usize>, status: &[u8; 2]| number(&params[range]).ok_or(*status);
     let start = field(0..4, b"01")?;
     let end = field(4..8, b"02")?;
     let cluster = field(8..10, b"03")?;

@@ -72,13 +72,28 @@ impl ScipDecoder {
         }
         // An empty line: the reply is complete.
         let reply = std::mem::take(&mut self.reply);
-        match parse_reply(&reply, out) {
-            Verdict::Accepted => self.stats.packets += 1,
-            Verdict::BadChecksum => {
-                self.stats.bad_checksum += 1;
-                self.stats.skipped_bytes += reply.len() as u64;
+        // Lines of damage or garbage run into the reply that follows them: a reply may start
+        // at any of its lines, the ones before it skipped.
+        let mut start = 0;
+        loop {
+            match parse_reply(&reply[start..], out) {
+                Verdict::Accepted => {
+                    self.stats.packets += 1;
+                    self.stats.skipped_bytes += start as u64;
+                }
+                Verdict::BadChecksum => {
+                    self.stats.bad_checksum += 1;
+                    self.stats.skipped_bytes += reply.len() as u64;
+                }
+                Verdict::NoReply => match reply[start..].iter().position(|&b| b == b'\n') {
+                    Some(at) if start + at + 2 < reply.len() => {
+                        start += at + 1;
+                        continue;
+                    }
+                    _ => self.stats.skipped_bytes += reply.len() as u64,
+                },
             }
-            Verdict::NoReply => self.stats.skipped_bytes += reply.len() as u64,
+            break;
         }
         self.reply = reply;
         self.reply.clear();

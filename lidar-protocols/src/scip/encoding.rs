@@ -23,7 +23,9 @@ pub const NON_MEASURABLE_CODE: u32 = 19;
 /// The check character of `bytes`: the low 6 bits of their byte sum, plus `0x30`.
 #[must_use]
 pub fn checksum(bytes: &[u8]) -> u8 {
-    let sum = bytes.iter().fold(0u32, |sum, &b| sum.wrapping_add(u32::from(b)));
+    let sum = bytes
+        .iter()
+        .fold(0u32, |sum, &b| sum.wrapping_add(u32::from(b)));
     // The mask keeps 6 bits, so the sum fits a byte.
     (sum & 0x3F) as u8 + 0x30
 }

@@ -44,7 +44,9 @@ pub use commands::{parse, Command, ScanRequest, Status};
 pub use decoder::ScipDecoder;
 pub use encoding::{
     checksum, clock_ms, decode, encode, step_angle_deg, FIRST_STEP, FRONT_STEP, LAST_STEP,
-    MAX_DISTANCE_MM, MAX_STEP, MIN_DISTANCE_MM, NON_MEASURABLE_CODE, NO_OBJECT_CODE,
-    STEPS_PER_REV,
+    MAX_DISTANCE_MM, MAX_STEP, MIN_DISTANCE_MM, NON_MEASURABLE_CODE, NO_OBJECT_CODE, STEPS_PER_REV,
 };
 pub use unit::ScipUnit;
+
+#[cfg(test)]
+mod tests;

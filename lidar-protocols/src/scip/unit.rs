@@ -319,13 +319,7 @@ impl ScipUnit {
 }
 
 /// Sends the scan reply `slot`'s request wants, and retires the request when it is done.
-fn send(
-    slot: &mut Option<Active>,
-    scan: &Scan,
-    due_s: f64,
-    laser_on: &mut bool,
-    out: &mut Output,
-) {
+fn send(slot: &mut Option<Active>, scan: &Scan, due_s: f64, laser_on: &mut bool, out: &mut Output) {
     let Some(active) = slot.as_mut() else {
         return;
     };
@@ -406,7 +400,13 @@ fn distance_field_or_code(value: u32, field_max: u32) -> u32 {
 
 /// Appends a reply: the echo, the status with its check character, what `body` adds, the empty
 /// line.
-fn reply(out: &mut Output, now_s: f64, echo: &[u8], status: Status, body: impl FnOnce(&mut Vec<u8>)) {
+fn reply(
+    out: &mut Output,
+    now_s: f64,
+    echo: &[u8],
+    status: Status,
+    body: impl FnOnce(&mut Vec<u8>),
+) {
     out.packet(now_s, echo.len() + 1, false, |bytes| {
         bytes.extend_from_slice(echo);
         bytes.push(b'\n');

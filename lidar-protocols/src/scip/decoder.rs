@@ -165,7 +165,7 @@ fn parse_reply(reply: &[u8], out: &mut Vec<Point>) -> Verdict {
     let (Some(echo), Some(status)) = (lines.next(), lines.next()) else {
         return Verdict::NoReply;
     };
-    if echo.len() < 2 || status.len() != 3 {
+    if echo.is_empty() || status.len() != 3 {
         return Verdict::NoReply;
     }
     if checksum(&status[..2]) != status[2] {

@@ -334,7 +334,8 @@ proptest! {
     #[test]
     fn random_bytes_never_panic_and_chunking_changes_nothing(
         bytes in proptest::collection::vec(
-            prop_oneof![any::<u8>(), Just(b'\n'), Just(b'0'), Just(b'M'), Just(b'D')], 0..3000),
+            prop_oneof![any::<u8>(), Just(b'\n'), Just(b'0'), Just(b'M'), Just(b'D'), Just(b';')],
+            0..3000),
         chunk in 1usize..64,
     ) {
         let (whole, decoder) = decode_all(&bytes);
@@ -354,5 +355,9 @@ proptest! {
         let mut out = Output::new();
         unit.host_wrote(&bytes, 0.0, &mut out);
         prop_assert!(out.packets.len() <= bytes.len());
+        let mut replies = ScipDecoder::new();
+        replies.feed(&out.bytes, &mut Vec::new());
+        prop_assert_eq!(replies.stats().bad_checksum, 0);
+        prop_assert_eq!(replies.stats().packets, out.packets.len() as u64);
     }
 }

@@ -34,7 +34,12 @@ pub use unit::{DecodeStats, HostDecoder, Output, PacketSpan, Point, Unit, UnitRe
 pub fn unit_for(model: LidarModel) -> Option<Box<dyn Unit>> {
     match model {
         LidarModel::Xv11 => None,
-        _ => None,
+        LidarModel::Lds01 => Some(Box::new(lds01::Lds01Unit::new())),
+        LidarModel::Lds02rr => Some(Box::new(lds02rr::Lds02rrUnit::new())),
+        LidarModel::Ld06 => Some(Box::new(ld06::Ld06Unit::new())),
+        LidarModel::RplidarA1 => Some(Box::new(rplidar::RplidarUnit::new())),
+        LidarModel::YdlidarX4 => Some(Box::new(ydlidar::YdlidarUnit::new())),
+        LidarModel::Urg04lx => Some(Box::new(scip::ScipUnit::new())),
     }
 }
 
@@ -43,6 +48,11 @@ pub fn unit_for(model: LidarModel) -> Option<Box<dyn Unit>> {
 pub fn decoder_for(model: LidarModel) -> Option<Box<dyn HostDecoder>> {
     match model {
         LidarModel::Xv11 => None,
-        _ => None,
+        LidarModel::Lds01 => Some(Box::new(lds01::Lds01Decoder::new())),
+        LidarModel::Lds02rr => Some(Box::new(lds02rr::Lds02rrDecoder::new())),
+        LidarModel::Ld06 => Some(Box::new(ld06::Ld06Decoder::new())),
+        LidarModel::RplidarA1 => Some(Box::new(rplidar::RplidarDecoder::new())),
+        LidarModel::YdlidarX4 => Some(Box::new(ydlidar::YdlidarDecoder::new())),
+        LidarModel::Urg04lx => Some(Box::new(scip::ScipDecoder::new())),
     }
 }

@@ -11,6 +11,7 @@ mod diagnose;
 mod hil;
 mod import_logs;
 mod import_ros1;
+mod lidar_models;
 mod limits;
 mod outputs;
 mod record;

@@ -138,7 +138,8 @@ pub struct UnitSpec {
     /// The revolution rates it can run at, Hz.
     pub rev_hz_range: (f64, f64),
     /// Relative standard deviation of the rate from one revolution to the next (a free-running
-    /// motor's speed loop; 0 for a unit that locks its rate).
+    /// motor's speed loop; 0 for a unit that locks its rate). A modelling choice of a few tenths
+    /// of a percent: no datasheet gives it.
     pub rev_hz_jitter: f64,
     /// Nearest range it reports, metres.
     pub min_range_m: f64,

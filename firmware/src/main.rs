@@ -1,6 +1,7 @@
 //! An example firmware for `hilsim hil`, written as firmware for a real robot would be: it knows
-//! the lidar's device path (`HILSIM_LIDAR_PORT`, a Neato XV-11 stream) and the robot's command
-//! port (`HILSIM_ROBOT_PORT`, the Neato USB command interface), and nothing else of hilsim.
+//! the lidar's device path (`HILSIM_LIDAR_PORT`, a Neato XV-11 stream, or with `--lidar
+//! rplidar-a1` a Slamtec RPLIDAR A1 it starts itself) and the robot's command port
+//! (`HILSIM_ROBOT_PORT`, the Neato USB command interface), and nothing else of hilsim.
 //!
 //! It drives straight at whatever is in front of it and stops 0.50 m from it: each lidar
 //! revolution gives the distance ahead (the median of the readings within ±5°); while that is
@@ -14,9 +15,10 @@
 //! drops packets, a scenario's `[link]`).
 
 mod robot;
+mod rplidar;
 mod xv11;
 
-use std::io::{ErrorKind, Read};
+use std::io::{ErrorKind, Read, Write};
 use std::process::ExitCode;
 use std::sync::mpsc;
 use std::thread;
@@ -69,24 +71,50 @@ fn main() -> ExitCode {
     };
 
     let (tx, revolutions) = mpsc::channel();
+    let rplidar = std::env::args()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .any(|w| w[0] == "--lidar" && w[1] == "rplidar-a1");
+    if rplidar {
+        if let Err(err) = lidar.write_all(&rplidar::START) {
+            eprintln!("example-firmware: lidar port: {err}");
+            return ExitCode::from(2);
+        }
+    }
     thread::spawn(move || {
-        let mut decoder = Decoder::new();
+        let mut xv11 = Decoder::new();
+        let mut rplidar_decoder = rplidar::Decoder::default();
         let mut buf = [0u8; 4096];
         loop {
             match lidar.read(&mut buf) {
                 Ok(0) => return,
                 Ok(n) => {
-                    let mut scans = Vec::new();
-                    decoder.feed(&buf[..n], |scan| {
-                        scans.push(front_mm(scan, FRONT_HALF_WIDTH_DEG))
-                    });
-                    for front in scans {
-                        let report = Revolution {
+                    let mut reports = Vec::new();
+                    if rplidar {
+                        let decoder = &mut rplidar_decoder;
+                        let mut fronts = Vec::new();
+                        decoder.feed(&buf[..n], |scan| {
+                            fronts.push(rplidar::front_mm(scan, FRONT_HALF_WIDTH_DEG as f64))
+                        });
+                        reports.extend(fronts.into_iter().map(|front| Revolution {
                             front_mm: front,
-                            index_gaps: decoder.index_gaps,
-                            bad_checksums: decoder.bad_checksums,
+                            index_gaps: 0,
+                            bad_checksums: decoder.bad_nodes,
                             revolutions: decoder.revolutions,
-                        };
+                        }));
+                    } else {
+                        let mut fronts = Vec::new();
+                        xv11.feed(&buf[..n], |scan| {
+                            fronts.push(front_mm(scan, FRONT_HALF_WIDTH_DEG))
+                        });
+                        reports.extend(fronts.into_iter().map(|front| Revolution {
+                            front_mm: front,
+                            index_gaps: xv11.index_gaps,
+                            bad_checksums: xv11.bad_checksums,
+                            revolutions: xv11.revolutions,
+                        }));
+                    }
+                    for report in reports {
                         if tx.send(report).is_err() {
                             return;
                         }

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use hilsim_lidar_protocols::{Output, Unit, UnitReading};
+use hilsim_lidar_protocols::{Output, PacketSpan, Unit, UnitReading};
 
 use crate::faults::{FaultCounts, WireFaults};
 use crate::link::SerialLink;
@@ -42,6 +42,9 @@ pub struct UnitStreamer<L: SerialLink> {
     reader_reading: bool,
     /// The simulated time of the latest reading taken.
     now_s: f64,
+    /// Packets queued for their time ([`UnitStreamer::queue`]), and how many of them went.
+    queued: Output,
+    queued_sent: usize,
 }
 
 impl<L: SerialLink> UnitStreamer<L> {
@@ -60,6 +63,8 @@ impl<L: SerialLink> UnitStreamer<L> {
             backlog_limit: FIRST_BACKLOG_LIMIT,
             reader_reading: false,
             now_s: 0.0,
+            queued: Output::new(),
+            queued_sent: 0,
         }
     }
 
@@ -114,6 +119,51 @@ impl<L: SerialLink> UnitStreamer<L> {
         let sent = self.send(&out);
         self.out = out;
         sent
+    }
+
+    /// Starts the stream's real-time clock: simulated t = 0 at `origin`. For a caller that paces
+    /// the simulation itself (firmware in the loop) and hands readings over with
+    /// [`UnitStreamer::queue`].
+    pub fn start_clock(&mut self, origin: Instant) {
+        self.origin = Some(origin);
+    }
+
+    /// Hands the unit its next reading without waiting; the packets it completes wait in a
+    /// queue for their time ([`UnitStreamer::send_due`]).
+    pub fn queue(&mut self, reading: &UnitReading) {
+        self.now_s = reading.t_s;
+        if self.queued_sent == self.queued.packets.len() {
+            self.queued.clear();
+            self.queued_sent = 0;
+        }
+        self.unit.push(reading, &mut self.queued);
+    }
+
+    /// When the next queued packet is due, simulated seconds.
+    #[must_use]
+    pub fn next_due_s(&self) -> Option<f64> {
+        self.queued.packets.get(self.queued_sent).map(|p| p.due_s)
+    }
+
+    /// Sends every queued packet due by simulated time `now_s`.
+    ///
+    /// # Errors
+    /// The link failed.
+    pub fn send_due(&mut self, now_s: f64) -> io::Result<()> {
+        let queued = std::mem::take(&mut self.queued);
+        let mut result = Ok(());
+        while let Some(span) = queued.packets.get(self.queued_sent) {
+            if span.due_s > now_s {
+                break;
+            }
+            self.queued_sent += 1;
+            result = self.send_packet(&queued.bytes[span.range.clone()], span);
+            if result.is_err() {
+                break;
+            }
+        }
+        self.queued = queued;
+        result
     }
 
     /// Reads and answers the host's commands until the link has no more.
@@ -201,39 +251,43 @@ impl<L: SerialLink> UnitStreamer<L> {
     /// Sends `out`'s packets through the faults.
     fn send(&mut self, out: &Output) -> io::Result<()> {
         for (packet, span) in out.iter() {
+            self.send_packet(packet, span)?;
+        }
+        Ok(())
+    }
+
+    /// Sends one packet through the faults, making room at a revolution's start.
+    fn send_packet(&mut self, packet: &[u8], span: &PacketSpan) -> io::Result<()> {
+        if span.starts_revolution {
+            if self.revolution_bytes > 0 {
+                self.backlog_limit = self.revolution_bytes.max(256);
+            }
+            self.revolution_bytes = 0;
+            self.link.allow_reconnect()?;
+            self.make_room()?;
+        }
+        let mut wire = std::mem::take(&mut self.wire);
+        wire.clear();
+        match self.faults.as_mut() {
+            Some(faults) => faults.apply_unit_packet(packet, span.sync_len, span.due_s, &mut wire),
+            None => wire.extend_from_slice(packet),
+        }
+        let written = self.write_all(&wire);
+        self.wire = wire;
+        if !written? {
             if span.starts_revolution {
-                if self.revolution_bytes > 0 {
-                    self.backlog_limit = self.revolution_bytes.max(256);
-                }
-                self.revolution_bytes = 0;
-                self.link.allow_reconnect()?;
-                self.make_room()?;
+                self.stats.revolutions_dropped += 1;
             }
-            let mut wire = std::mem::take(&mut self.wire);
-            wire.clear();
-            match self.faults.as_mut() {
-                Some(faults) => {
-                    faults.apply_unit_packet(packet, span.sync_len, span.due_s, &mut wire)
-                }
-                None => wire.extend_from_slice(packet),
-            }
-            let written = self.write_all(&wire);
-            self.wire = wire;
-            if !written? {
-                if span.starts_revolution {
-                    self.stats.revolutions_dropped += 1;
-                }
-                continue;
-            }
-            self.revolution_bytes += packet.len();
-            if span.starts_revolution {
-                self.stats.revolutions_sent += 1;
-            }
-            if let (Pacing::Realtime, Some(origin)) = (self.pacing, self.origin) {
-                let due = origin + Duration::from_secs_f64(span.due_s.max(0.0));
-                self.stats
-                    .record_lateness(Instant::now().saturating_duration_since(due));
-            }
+            return Ok(());
+        }
+        self.revolution_bytes += packet.len();
+        if span.starts_revolution {
+            self.stats.revolutions_sent += 1;
+        }
+        if let (Pacing::Realtime, Some(origin)) = (self.pacing, self.origin) {
+            let due = origin + Duration::from_secs_f64(span.due_s.max(0.0));
+            self.stats
+                .record_lateness(Instant::now().saturating_duration_since(due));
         }
         Ok(())
     }

@@ -235,18 +235,18 @@ impl Emulation {
         while self.advance() {
             let s = &self.samples;
             if let Some(sensor) = &self.lidar {
+                let whole = sensor.readings_per_revolution();
                 for reading in &s.lidar {
                     on_lidar(reading, sensor.rpm_of_revolution(reading.rev));
-                    // A log's scan is whole when the next one starts (its beams vary in number).
-                    if sensor.is_scheduled()
-                        && revolution.first().is_some_and(|r| r.rev != reading.rev)
-                    {
+                    // A unit's revolution or a log's scan is whole when the next one starts
+                    // (their readings vary in number).
+                    if whole.is_none() && revolution.first().is_some_and(|r| r.rev != reading.rev) {
                         for r in revolution.drain(..) {
                             sink.lidar(&r)?;
                         }
                     }
                     revolution.push(reading.to_sample());
-                    if !sensor.is_scheduled() && revolution.len() == READINGS_PER_REVOLUTION {
+                    if whole == Some(revolution.len()) {
                         for r in revolution.drain(..) {
                             sink.lidar(&r)?;
                         }
@@ -262,8 +262,13 @@ impl Emulation {
             let (commands, truth) = self.sim.drain_logs();
             log_into(sink, commands, truth)?;
         }
-        // A log's last scan ends before the run does (its duration covers the schedule).
-        if self.lidar.as_ref().is_some_and(Lidar::is_scheduled) {
+        // A log's last scan ends before the run does (its duration covers the schedule); a
+        // unit's last revolution counts when the run ended just as it was done.
+        if self
+            .lidar
+            .as_ref()
+            .is_some_and(|l| l.is_scheduled() || l.revolution_done())
+        {
             for r in revolution.drain(..) {
                 sink.lidar(&r)?;
             }

@@ -243,6 +243,23 @@ impl Lidar {
         matches!(self.scans, Some((Scans::Log(..), _)))
     }
 
+    /// Readings in every revolution: the XV-11's 360; `None` for a unit or a log's scans, whose
+    /// revolutions vary in length (a revolution is whole when the next one starts).
+    #[must_use]
+    pub fn readings_per_revolution(&self) -> Option<usize> {
+        self.scans.is_none().then_some(READINGS_PER_REVOLUTION)
+    }
+
+    /// Whether the readings taken so far end with a whole revolution: the next reading starts
+    /// one.
+    #[must_use]
+    pub fn revolution_done(&self) -> bool {
+        match &self.scans {
+            Some((_, beam)) => *beam == 0,
+            None => self.index == 0,
+        }
+    }
+
     /// The unit (`[sensors.lidar] model`).
     #[must_use]
     pub fn unit(&self) -> LidarModel {

@@ -17,7 +17,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use hilsim_hil::firmware::{split_command_line, Ended, Firmware};
 use hilsim_hil::hil_run::{self, Ending, HilConfig, HilPorts, HilWorld};
 use hilsim_scenarios::metrics;
-use hilsim_sim::scenario::{LidarModel, MAX_RUN_S};
+use hilsim_sim::scenario::MAX_RUN_S;
 use hilsim_sim::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -76,20 +76,8 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if scenario.files.schedule.is_some() || scenario.files.path.is_some() {
         bail!(
             "{origin}: the scenario replays a log's run (`[robot] path`, `[sensors.lidar] \
-             schedule`): under `hil` the firmware drives and the lidar is an XV-11; `hilsim \
+             schedule`): under `hil` the firmware drives and the lidar turns as its unit does; `hilsim \
              record` makes the run's twin"
-        );
-    }
-    if let Some(lidar) = scenario
-        .sensors
-        .lidar
-        .as_ref()
-        .filter(|l| l.model != LidarModel::Xv11)
-    {
-        bail!(
-            "{origin}: under `hil` the firmware's lidar port speaks the Neato XV-11's protocol, \
-             and the scenario's lidar is a {}: `hilsim serve` streams it to a driver",
-            lidar.model
         );
     }
     let duration_s = scenario.duration_s.ok_or_else(|| {

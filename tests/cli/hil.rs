@@ -742,3 +742,48 @@ fn a_link_wobble_as_large_as_the_rpm_is_refused_before_the_firmware_starts() {
         )
     );
 }
+
+/// Another unit in the loop: with `model = "rplidar-a1"` the lidar port speaks the RPLIDAR's
+/// protocol, and stays silent until the firmware sends SCAN; the example firmware, told its
+/// robot carries an RPLIDAR, starts it, reads its nodes and stops half a metre from the board
+/// as it does with the XV-11; the recording holds whole revolutions of the unit's readings.
+#[test]
+fn a_firmware_that_starts_its_rplidar_reaches_the_target() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = short_approach(tmp.path());
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    let rplidar = text.replace(
+        "[sensors.lidar]\n",
+        "[sensors.lidar]\nmodel = \"rplidar-a1\"\n",
+    );
+    assert_ne!(rplidar, text);
+    std::fs::write(&scenario, rplidar).unwrap();
+    let firmware = format!("{} --lidar rplidar-a1", example_firmware().display());
+    let out = hilsim(
+        tmp.path(),
+        &[
+            "hil",
+            scenario.to_str().unwrap(),
+            "--firmware",
+            &firmware,
+            "--duration",
+            "12",
+            "--out",
+            "rec",
+        ],
+    );
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(
+        text.contains("example-firmware: reached the target"),
+        "{text}"
+    );
+    assert!(text.contains("bad checksums 0"), "{text}");
+    let distance = final_distance(&tmp.path().join("rec"));
+    // As with the XV-11: 0.5 m, give or take a revolution's travel at the approach's speed.
+    assert!((0.4..0.65).contains(&distance), "{distance}");
+    let rec = Recording::read_dir(&tmp.path().join("rec")).unwrap();
+    let lidar = rec.lidar.unwrap();
+    // The RPLIDAR's revolutions hold about 364 readings, not the XV-11's 360 at whole degrees.
+    assert!(lidar.iter().any(|r| r.angle_deg.fract() != 0.0));
+}

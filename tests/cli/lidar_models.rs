@@ -1,7 +1,7 @@
 //! Every lidar model on the wire: `hilsim serve` streams each checked-in `lidar-<model>`
 //! scenario in its unit's protocol (started by the unit's own command where it has one), the
 //! host's decoder reads back the recording's readings one for one, `decode --model` reads a
-//! capture, and the commands that speak only the XV-11 refuse the others.
+//! capture, and `run --via serial`, which reads only the XV-11's wire, refuses the others.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Command, Stdio};
@@ -194,26 +194,17 @@ fn a_model_the_unit_cannot_be_is_refused_naming_the_line() {
     }
 }
 
-/// `run --via serial` and `hil` read the XV-11's wire only: another unit is refused before
-/// anything runs, saying what to use instead.
+/// `run --via serial` reads the XV-11's wire only: another unit is refused before anything
+/// runs, saying what to use instead.
 #[test]
-fn the_xv11_only_commands_refuse_other_units() {
+fn run_via_serial_refuses_other_units() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/lidar-rplidar-a1.toml");
-    let scenario = scenario.to_str().unwrap();
-    let o = hilsim(tmp.path(), &["run", scenario, "--via", "serial"]);
-    let err = stderr(&o);
-    assert_ne!(o.status.code(), Some(0));
-    assert!(
-        err.contains("rplidar-a1") && err.contains("hilsim serve"),
-        "{err}"
-    );
     let o = hilsim(
         tmp.path(),
-        &["hil", scenario, "--firmware", "true", "--duration", "1"],
+        &["run", scenario.to_str().unwrap(), "--via", "serial"],
     );
-    let err = stderr(&o);
-    assert_ne!(o.status.code(), Some(0));
+    let err = assert_bad_input(&o);
     assert!(
         err.contains("rplidar-a1") && err.contains("hilsim serve"),
         "{err}"

@@ -61,6 +61,12 @@ impl fmt::Display for Fault {
                 limits.bytes_per_s, limits.commands_per_s
             ),
             Self::LidarNeverRead {
+                bytes_written: 0, ..
+            } => f.write_str(
+                "the firmware never started the lidar: the unit waits for its start command and \
+                 sent nothing",
+            ),
+            Self::LidarNeverRead {
                 bytes_read,
                 bytes_written,
             } => write!(

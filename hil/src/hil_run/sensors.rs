@@ -18,6 +18,9 @@ pub(super) struct Sensors {
     /// Recent complete revolutions with the instant each was complete, oldest first.
     pub(super) frames: VecDeque<(f64, RevolutionFrame)>,
     pub(super) lidar_rpm: Option<f64>,
+    /// Whether the lidar is the XV-11, whose revolutions `GetLDSScan` reports (another unit's
+    /// readings reach the firmware only on its own port).
+    pub(super) xv11: bool,
 }
 
 /// The robot as the command port sees it at `now_s` (simulation seconds).
@@ -52,7 +55,7 @@ impl Robot for RobotView<'_> {
     }
 
     fn lds_scan(&self) -> Result<&RevolutionFrame, Unavailable> {
-        if self.sensors.lidar.is_none() {
+        if self.sensors.lidar.is_none() || !self.sensors.xv11 {
             return Err(Unavailable::NoSensor);
         }
         self.sensors

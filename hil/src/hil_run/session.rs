@@ -9,7 +9,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use hilsim_lidar_emulator::lidar::reading_period_s;
-use hilsim_lidar_emulator::neato_packet::{Packet, READINGS_PER_REVOLUTION, REVOLUTION_LEN};
+use hilsim_lidar_emulator::neato_packet::{READINGS_PER_REVOLUTION, REVOLUTION_LEN};
 use hilsim_lidar_emulator::wire::RevolutionCollector;
 use hilsim_lidar_emulator::{Emulation, LidarReading, Run};
 use hilsim_recording::Recording;
@@ -19,16 +19,14 @@ use nix::sys::time::TimeSpec;
 
 use super::config::HilConfig;
 use super::flood::FloodMeter;
-use super::packets::PacketBuilder;
+use super::lidar_wire::LidarWire;
 use super::report::{Ending, Fault, HilReport};
 use super::sensors::{RobotView, Sensors};
 use super::setup::{HilPorts, HilWorld};
 use crate::command_port::CommandPort;
 use crate::firmware::{Firmware, StderrTail};
-use crate::link::SerialLink;
 use crate::motion::MotionController;
 use crate::pty::PtyLink;
-use crate::streamer::{Pacing, Streamer};
 
 /// Replies waiting for a firmware that does not read them are capped at this many bytes; later
 /// replies are dropped (and counted).
@@ -87,8 +85,13 @@ pub fn run_with_progress(
     let HilPorts { lidar, robot } = ports;
     let mut firmware = firmware;
     let mut world = world;
-    let streamer = Streamer::new(lidar, Pacing::Realtime).with_faults(world.wire_faults.take());
-    let mut session = Session::new(world, streamer, robot, config);
+    let model = world
+        .emulation
+        .lidar()
+        .map(hilsim_lidar_emulator::Lidar::unit)
+        .unwrap_or_default();
+    let wire = LidarWire::new(lidar, model, world.wire_faults.take());
+    let mut session = Session::new(world, wire, robot, config);
     let ending = session.run(firmware.as_mut(), stop, progress)?;
     session.finish(ending, firmware)
 }
@@ -96,7 +99,7 @@ pub fn run_with_progress(
 /// The loop's state.
 struct Session<'c> {
     emulation: Emulation,
-    streamer: Streamer<PtyLink>,
+    wire: LidarWire,
     robot: PtyLink,
     robot_fd: RawFd,
     config: &'c HilConfig,
@@ -107,10 +110,7 @@ struct Session<'c> {
     motion: MotionController,
     port: CommandPort,
     sensors: Sensors,
-    packets: PacketBuilder,
     collector: RevolutionCollector,
-    /// Packets waiting for their time, with the simulation instant each is due.
-    due_packets: VecDeque<(f64, Packet)>,
     readings: Vec<LidarReading>,
     replies: Vec<u8>,
     replies_sent: usize,
@@ -122,12 +122,7 @@ struct Session<'c> {
 }
 
 impl<'c> Session<'c> {
-    fn new(
-        world: HilWorld,
-        streamer: Streamer<PtyLink>,
-        mut robot: PtyLink,
-        config: &'c HilConfig,
-    ) -> Self {
+    fn new(world: HilWorld, wire: LidarWire, mut robot: PtyLink, config: &'c HilConfig) -> Self {
         let HilWorld {
             emulation,
             sonar_period_s,
@@ -142,13 +137,14 @@ impl<'c> Session<'c> {
             sonar_period_s: sonar_period_s.unwrap_or(1.0),
             frames: VecDeque::new(),
             lidar_rpm: emulation.lidar().map(|l| l.rpm_of_revolution(0)),
+            xv11: wire.is_xv11(),
         };
         let robot_fd = robot.master().as_raw_fd();
         let now = Instant::now();
         Self {
             end_steps: (config.duration.as_secs_f64() / step_s).round() as u64,
             emulation,
-            streamer,
+            wire,
             robot,
             robot_fd,
             config,
@@ -158,9 +154,7 @@ impl<'c> Session<'c> {
             motion: MotionController::new(),
             port: CommandPort::new(),
             sensors,
-            packets: PacketBuilder::default(),
             collector: RevolutionCollector::default(),
-            due_packets: VecDeque::new(),
             readings: Vec::new(),
             replies: Vec::new(),
             replies_sent: 0,
@@ -184,6 +178,7 @@ impl<'c> Session<'c> {
         progress: &mut dyn FnMut(&HilProgress),
     ) -> io::Result<Ending> {
         self.origin = Instant::now();
+        self.wire.start(self.origin);
         self.last_request = self.origin;
         let steps_per_progress = ((PROGRESS_EVERY_S / self.step_s).round() as u64).max(1);
         let mut progress_steps = 0;
@@ -192,7 +187,7 @@ impl<'c> Session<'c> {
             self.simulate_until(now);
             if self.steps_done >= progress_steps + steps_per_progress {
                 progress_steps = self.steps_done;
-                let stream = self.streamer.stats();
+                let stream = self.wire.stats();
                 progress(&HilProgress {
                     t_s: self.steps_done as f64 * self.step_s,
                     revolutions_sent: stream.revolutions_sent,
@@ -267,16 +262,22 @@ impl<'c> Session<'c> {
             let Some(lidar) = self.emulation.lidar() else {
                 continue;
             };
+            let xv11 = self.wire.is_xv11();
             for reading in &self.readings {
-                let rpm = lidar.rpm_of_revolution(reading.rev);
-                // A packet leaves, and a revolution is complete, when its last reading's
-                // period has passed (as `Streamer::send` paces them).
+                let rpm = if xv11 {
+                    lidar.rpm_of_revolution(reading.rev)
+                } else {
+                    reading.rev_hz * 60.0
+                };
+                // A revolution is complete when its last reading's period has passed.
                 let complete_s = reading.t_s + reading_period_s(rpm);
                 if let Some(rows) = &mut self.sensors.lidar {
                     rows.push(reading.to_sample());
                 }
-                if let Some(packet) = self.packets.push(reading, rpm) {
-                    self.due_packets.push_back((complete_s, packet));
+                self.wire.take(reading, rpm);
+                if !xv11 {
+                    self.sensors.lidar_rpm = Some(rpm);
+                    continue;
                 }
                 if let Some(frame) = self.collector.push(reading, rpm) {
                     self.sensors.frames.push_back((complete_s, frame));
@@ -289,17 +290,10 @@ impl<'c> Session<'c> {
         }
     }
 
-    /// Writes every lidar packet whose time has come.
+    /// Writes every lidar packet whose time has come (answering the firmware's commands to a
+    /// unit that takes them).
     fn send_due_packets(&mut self, now: Instant) -> io::Result<()> {
-        while let Some(&(due_s, packet)) = self.due_packets.front() {
-            let due = self.wall(due_s);
-            if due > now {
-                break;
-            }
-            self.due_packets.pop_front();
-            self.streamer.send_packet(&packet, due, due_s)?;
-        }
-        Ok(())
+        self.wire.send_due(self.origin, now)
     }
 
     /// Reads what the firmware sent and answers it; a flood ends the run.
@@ -368,8 +362,8 @@ impl<'c> Session<'c> {
     /// flight is not in the backlog yet: give it a millisecond. Once per run, and at the end.
     fn lidar_bytes_read(&mut self) -> io::Result<u64> {
         thread::sleep(Duration::from_millis(1));
-        let backlog = self.streamer.link().backlog()? as u64;
-        let stats = self.streamer.stats();
+        let backlog = self.wire.backlog()? as u64;
+        let stats = self.wire.stats();
         Ok(stats
             .bytes_written
             .saturating_sub(stats.bytes_discarded)
@@ -383,7 +377,14 @@ impl<'c> Session<'c> {
         if self.sensors.lidar.is_none() {
             return Ok(None);
         }
-        let bytes_written = self.streamer.stats().bytes_written;
+        if self.wire.waiting_for_start() {
+            // A unit the firmware never started sent nothing it could read.
+            return Ok(Some(Fault::LidarNeverRead {
+                bytes_read: 0,
+                bytes_written: 0,
+            }));
+        }
+        let bytes_written = self.wire.stats().bytes_written;
         let bytes_read = self.lidar_bytes_read()?;
         Ok(
             (bytes_written >= min_written && bytes_read < REVOLUTION_LEN as u64).then_some(
@@ -404,7 +405,7 @@ impl<'c> Session<'c> {
         if self.steps_done < self.end_steps {
             next = next.min(self.wall(self.steps_done as f64 * self.step_s));
         }
-        if let Some(&(due_s, _)) = self.due_packets.front() {
+        if let Some(due_s) = self.wire.next_due_s() {
             next = next.min(self.wall(due_s));
         }
         let timeout = next.saturating_duration_since(Instant::now());
@@ -412,7 +413,10 @@ impl<'c> Session<'c> {
         if self.replies_sent < self.replies.len() {
             events |= PollFlags::POLLOUT;
         }
-        let mut fds = [PollFd::new(self.robot_fd, events)];
+        let mut fds = vec![PollFd::new(self.robot_fd, events)];
+        if let Some(fd) = self.wire.command_fd() {
+            fds.push(PollFd::new(fd, PollFlags::POLLIN));
+        }
         match ppoll(&mut fds, Some(TimeSpec::from_duration(timeout)), None) {
             Ok(_) | Err(Errno::EINTR) => Ok(()),
             Err(err) => Err(io::Error::from(err)),
@@ -426,11 +430,11 @@ impl<'c> Session<'c> {
             Some(_) => Some(self.lidar_bytes_read()?),
             None => None,
         };
-        let stream = self.streamer.stats().clone();
-        let link_faults = self.streamer.fault_counts();
+        let stream = self.wire.stats().clone();
+        let link_faults = self.wire.fault_counts();
         // The ports close before the firmware is asked to leave: a firmware blocked on one sees
         // it go and can exit by itself.
-        drop(self.streamer);
+        drop(self.wire);
         drop(self.robot);
         let (firmware, stderr) = match firmware {
             Some(mut fw) => {
@@ -444,7 +448,17 @@ impl<'c> Session<'c> {
         let mut lidar = self.sensors.lidar;
         if let Some(rows) = &mut lidar {
             // Whole revolutions only, as `Emulation::run` records them.
-            rows.truncate(rows.len() - rows.len() % READINGS_PER_REVOLUTION);
+            match self.emulation.lidar() {
+                Some(l) if l.readings_per_revolution().is_none() => {
+                    if !l.revolution_done() {
+                        let last = rows.last().map(|r| r.rev);
+                        while rows.last().is_some_and(|r| Some(r.rev) == last) {
+                            rows.pop();
+                        }
+                    }
+                }
+                _ => rows.truncate(rows.len() - rows.len() % READINGS_PER_REVOLUTION),
+            }
         }
         Ok(HilReport {
             ending,

@@ -57,7 +57,7 @@ impl Decoder {
                 continue;
             }
             let angle = f64::from(u16::from_le_bytes([node[1], node[2]]) >> 1) / 64.0;
-            let distance_mm = (u16::from_le_bytes([node[3], node[4]]) / 4) as u16;
+            let distance_mm = u16::from_le_bytes([node[3], node[4]]) / 4;
             if start == 1 && !self.scan.is_empty() {
                 self.revolutions += 1;
                 on_scan(&self.scan);
@@ -110,7 +110,11 @@ mod tests {
         for rev in 0..3 {
             for k in 0..360 {
                 let angle = f64::from(k);
-                let d = if k < 4 || k > 356 { 800 } else { 2000 + rev };
+                let d = if (4..=356).contains(&k) {
+                    2000 + rev
+                } else {
+                    800
+                };
                 bytes.extend_from_slice(&node(k == 0, angle, d));
             }
         }

@@ -128,8 +128,8 @@ pub struct Lidar {
 enum Scans {
     /// `[sensors.lidar] schedule`: a log's scans, and the one being taken.
     Log(Arc<ScanSchedule>, usize),
-    /// `[sensors.lidar] model`: another unit's revolutions.
-    Unit(UnitScans),
+    /// `[sensors.lidar] model`: another unit's revolutions (boxed: a lidar holds one).
+    Unit(Box<UnitScans>),
 }
 
 impl Scans {
@@ -211,12 +211,12 @@ impl Lidar {
             unit: config.model,
             scans: (config.model != LidarModel::Xv11).then(|| {
                 (
-                    Scans::Unit(UnitScans::new(
+                    Scans::Unit(Box::new(UnitScans::new(
                         config.model,
                         config.rpm,
                         config.rpm_wobble,
                         seed,
-                    )),
+                    ))),
                     0,
                 )
             }),

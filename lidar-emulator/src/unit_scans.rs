@@ -142,7 +142,7 @@ mod tests {
         let mut scans = UnitScans::new(model, spec.rev_hz * 60.0, 0.0, 3);
         (0..n)
             .map(|_| {
-                let r = (scans.current().clone(), scans.current_hz());
+                let r = (*scans.current(), scans.current_hz());
                 scans.advance();
                 r
             })

@@ -374,7 +374,7 @@ mod tests {
         let input = dir.path().join("nope.bin");
         let csv = dir.path().join("good.csv");
         std::fs::write(&csv, "keep me").expect("write csv");
-        let err = run(&input, Some(&csv), true, &mut Vec::new()).expect_err("missing input");
+        let err = run_xv11(&input, Some(&csv), true, &mut Vec::new()).expect_err("missing input");
         let message = format!("{err:#}");
         assert!(
             message.contains("nope.bin") && message.contains("cannot open"),
@@ -386,7 +386,7 @@ mod tests {
     #[test]
     fn directory_input_is_a_clean_error() {
         let dir = tempfile::tempdir().expect("temp dir");
-        let err = run(dir.path(), None, false, &mut Vec::new()).expect_err("directory");
+        let err = run_xv11(dir.path(), None, false, &mut Vec::new()).expect_err("directory");
         assert!(format!("{err:#}").contains("is a directory"));
     }
 
@@ -396,7 +396,7 @@ mod tests {
         let input = dir.path().join("capture.bin");
         std::fs::write(&input, sample_capture()).expect("write capture");
         let csv = dir.path().join("no-such-dir").join("out.csv");
-        let err = run(&input, Some(&csv), false, &mut Vec::new()).expect_err("bad csv dir");
+        let err = run_xv11(&input, Some(&csv), false, &mut Vec::new()).expect_err("bad csv dir");
         assert!(format!("{err:#}").contains("out.csv"), "{err:#}");
     }
 }

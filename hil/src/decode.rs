@@ -92,14 +92,7 @@ pub fn decode_stream<E>(
     let mut summary = PacketSummary::new();
     let mut assembler = RevolutionAssembler::new();
     let mut chunk = vec![0; CHUNK_LEN];
-    loop {
-        let len = match source.read(&mut chunk) {
-            Ok(0) => break,
-            Ok(len) => len,
-            Err(err) if err.kind() == ErrorKind::Interrupted => continue,
-            Err(err) if is_closed_pty(&err) => break,
-            Err(err) => return Err(DecodeError::Read(err)),
-        };
+    while let Some(len) = read_chunk(source, &mut chunk)? {
         for packet in decoder.feed(&chunk[..len]) {
             summary.add(&packet);
             if let Some(sink) = on_revolution.as_mut() {
@@ -115,6 +108,20 @@ pub fn decode_stream<E>(
         }
     }
     Ok(DecodeCounts::new(&decoder.finish(), &summary))
+}
+
+/// The next chunk of `source` into `chunk`: its length, or `None` at the stream's end (end of
+/// file, or a pty whose writer went away).
+fn read_chunk<E>(source: &mut dyn Read, chunk: &mut [u8]) -> Result<Option<usize>, DecodeError<E>> {
+    loop {
+        match source.read(chunk) {
+            Ok(0) => return Ok(None),
+            Ok(len) => return Ok(Some(len)),
+            Err(err) if err.kind() == ErrorKind::Interrupted => {}
+            Err(err) if is_closed_pty(&err) => return Ok(None),
+            Err(err) => return Err(DecodeError::Read(err)),
+        }
+    }
 }
 
 #[cfg(unix)]
@@ -223,14 +230,7 @@ pub fn decode_unit_stream<E>(
         rev_hz_median: 0.0,
     };
     let mut rev: Option<u64> = None;
-    loop {
-        let len = match source.read(&mut chunk) {
-            Ok(0) => break,
-            Ok(len) => len,
-            Err(err) if err.kind() == ErrorKind::Interrupted => continue,
-            Err(err) if is_closed_pty(&err) => break,
-            Err(err) => return Err(DecodeError::Read(err)),
-        };
+    while let Some(len) = read_chunk(source, &mut chunk)? {
         points.clear();
         decoder.feed(&chunk[..len], &mut points);
         for point in &points {

@@ -32,6 +32,7 @@
 //! assert_eq!(points[11].distance_mm, 1011);
 //! ```
 
+use crate::framing::SyncFramer;
 use crate::{DecodeStats, HostDecoder, Output, Point, Unit, UnitReading};
 
 /// Bytes in one packet.
@@ -255,10 +256,8 @@ impl Unit for Ld06Unit {
 /// than 180° from the previous point's (the LD06 marks none itself; `lds2d` splits scans so).
 #[derive(Debug, Clone)]
 pub struct Ld06Decoder {
-    window: [u8; PACKET_LEN],
-    len: usize,
+    framer: SyncFramer<PACKET_LEN>,
     previous_angle: Option<f64>,
-    stats: DecodeStats,
 }
 
 impl Default for Ld06Decoder {
@@ -272,69 +271,20 @@ impl Ld06Decoder {
     #[must_use]
     pub fn new() -> Self {
         Self {
-            window: [0; PACKET_LEN],
-            len: 0,
+            framer: SyncFramer::new(HEADER, |b| b == VER_LEN),
             previous_angle: None,
-            stats: DecodeStats::default(),
         }
     }
 
     /// Takes one byte; returns the packet it completes, if any.
     pub fn push(&mut self, byte: u8) -> Option<Packet> {
-        self.stats.bytes += 1;
-        match self.len {
-            0 => self.start_or_skip(byte),
-            1 if byte == VER_LEN => {
-                self.window[1] = byte;
-                self.len = 2;
-            }
-            1 => {
-                self.stats.skipped_bytes += 1;
-                self.len = 0;
-                self.start_or_skip(byte);
-            }
-            _ => {
-                self.window[self.len] = byte;
-                self.len += 1;
-                if self.len == PACKET_LEN {
-                    return self.check_window();
-                }
-            }
-        }
-        None
+        self.framer.push(byte, Packet::decode)
     }
 
     /// Bytes held for a packet not complete yet, 0..=46.
     #[must_use]
     pub fn pending_len(&self) -> usize {
-        self.len
-    }
-
-    fn start_or_skip(&mut self, byte: u8) {
-        if byte == HEADER {
-            self.window[0] = byte;
-            self.len = 1;
-        } else {
-            self.stats.skipped_bytes += 1;
-        }
-    }
-
-    fn check_window(&mut self) -> Option<Packet> {
-        if let Some(packet) = Packet::decode(&self.window) {
-            self.len = 0;
-            self.stats.packets += 1;
-            return Some(packet);
-        }
-        self.stats.bad_checksum += 1;
-        let next = (1..PACKET_LEN)
-            .find(|&at| {
-                self.window[at] == HEADER && self.window.get(at + 1).is_none_or(|&b| b == VER_LEN)
-            })
-            .unwrap_or(PACKET_LEN);
-        self.stats.skipped_bytes += next as u64;
-        self.window.copy_within(next.., 0);
-        self.len = PACKET_LEN - next;
-        None
+        self.framer.pending_len()
     }
 
     fn points(&mut self, packet: &Packet, out: &mut Vec<Point>) {
@@ -366,7 +316,7 @@ impl HostDecoder for Ld06Decoder {
     }
 
     fn stats(&self) -> DecodeStats {
-        self.stats
+        self.framer.stats
     }
 }
 

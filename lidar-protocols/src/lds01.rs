@@ -33,6 +33,7 @@
 //! assert_eq!((points[90].angle_deg, points[90].distance_mm), (90.0, 590));
 //! ```
 
+use crate::framing::SyncFramer;
 use crate::{DecodeStats, HostDecoder, Output, Point, Unit, UnitReading};
 
 /// Bytes in one packet.
@@ -296,9 +297,7 @@ impl Unit for Lds01Unit {
 /// (on a bad checksum only the start byte is dropped and the rest rescanned, as `lds2d` does).
 #[derive(Debug, Clone)]
 pub struct Lds01Decoder {
-    window: [u8; PACKET_LEN],
-    len: usize,
-    stats: DecodeStats,
+    framer: SyncFramer<PACKET_LEN>,
 }
 
 impl Default for Lds01Decoder {
@@ -312,69 +311,19 @@ impl Lds01Decoder {
     #[must_use]
     pub fn new() -> Self {
         Self {
-            window: [0; PACKET_LEN],
-            len: 0,
-            stats: DecodeStats::default(),
+            framer: SyncFramer::new(START_BYTE, is_index_byte),
         }
     }
 
     /// Takes one byte; returns the packet it completes, if any.
     pub fn push(&mut self, byte: u8) -> Option<Packet> {
-        self.stats.bytes += 1;
-        match self.len {
-            0 => self.start_or_skip(byte),
-            1 if is_index_byte(byte) => {
-                self.window[1] = byte;
-                self.len = 2;
-            }
-            1 => {
-                self.stats.skipped_bytes += 1;
-                self.len = 0;
-                self.start_or_skip(byte);
-            }
-            _ => {
-                self.window[self.len] = byte;
-                self.len += 1;
-                if self.len == PACKET_LEN {
-                    return self.check_window();
-                }
-            }
-        }
-        None
+        self.framer.push(byte, Packet::decode)
     }
 
     /// Bytes held for a packet not complete yet, 0..=41.
     #[must_use]
     pub fn pending_len(&self) -> usize {
-        self.len
-    }
-
-    fn start_or_skip(&mut self, byte: u8) {
-        if byte == START_BYTE {
-            self.window[0] = byte;
-            self.len = 1;
-        } else {
-            self.stats.skipped_bytes += 1;
-        }
-    }
-
-    fn check_window(&mut self) -> Option<Packet> {
-        if let Some(packet) = Packet::decode(&self.window) {
-            self.len = 0;
-            self.stats.packets += 1;
-            return Some(packet);
-        }
-        self.stats.bad_checksum += 1;
-        let next = (1..PACKET_LEN)
-            .find(|&at| {
-                self.window[at] == START_BYTE
-                    && self.window.get(at + 1).is_none_or(|&b| is_index_byte(b))
-            })
-            .unwrap_or(PACKET_LEN);
-        self.stats.skipped_bytes += next as u64;
-        self.window.copy_within(next.., 0);
-        self.len = PACKET_LEN - next;
-        None
+        self.framer.pending_len()
     }
 }
 
@@ -404,7 +353,7 @@ impl HostDecoder for Lds01Decoder {
     }
 
     fn stats(&self) -> DecodeStats {
-        self.stats
+        self.framer.stats
     }
 }
 

@@ -15,6 +15,7 @@
 //! [`ld06`] (LDROBOT LD06), [`ydlidar`] (YDLIDAR X4) and [`scip`] (Hokuyo URG-04LX, SCIP 2.0).
 #![warn(missing_docs)]
 
+mod framing;
 pub mod ld06;
 pub mod lds01;
 pub mod lds02rr;

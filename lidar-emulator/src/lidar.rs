@@ -343,6 +343,12 @@ impl Lidar {
             }
         }
         self.rev_rpm = self.rpm_of_revolution(self.rev);
+        if let Some((Scans::Unit(unit), _)) = &mut self.scans {
+            **unit = unit
+                .as_ref()
+                .clone()
+                .with_link(faults.spin_up_s, self.rpm_wobble);
+        }
         self
     }
 

@@ -3,8 +3,8 @@
 //! revolution to revolution (a fixed sample rate on a motor whose speed wanders).
 
 use hilsim_lidar_protocols::{Direction, LidarModel, Sampling, UnitSpec};
-use hilsim_sim::rng;
 use hilsim_sim::scan_schedule::Scan;
+use hilsim_sim::{rng, scenario};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -17,6 +17,9 @@ pub(crate) struct UnitScans {
     spec: &'static UnitSpec,
     rpm: f64,
     rpm_wobble: f64,
+    /// `[link] spin_up_s`: the motor spins up from [`scenario::SPIN_UP_FROM_RPM`] to `rpm`,
+    /// linearly in time, over this long (0: it starts at speed).
+    spin_up_s: f64,
     wobble_phase: f64,
     motor: rng::Rng,
     /// The revolution being taken.
@@ -27,6 +30,8 @@ pub(crate) struct UnitScans {
     /// in the unit's convention, degrees in [0, one sample's step).
     next_t_s: f64,
     next_angle_deg: f64,
+    /// Where the head is when sampling starts (free-running units).
+    first_angle_deg: f64,
 }
 
 impl UnitScans {
@@ -40,6 +45,7 @@ impl UnitScans {
             spec: model.spec(),
             rpm,
             rpm_wobble,
+            spin_up_s: 0.0,
             wobble_phase,
             motor,
             current: Scan {
@@ -53,13 +59,26 @@ impl UnitScans {
             current_hz: rpm / 60.0,
             next_t_s: 0.0,
             next_angle_deg: 0.0,
+            first_angle_deg: 0.0,
         };
         if matches!(scans.spec.sampling, Sampling::FreeRunning { .. }) {
             // The head is anywhere when sampling starts: the first revolution is partial.
-            scans.next_angle_deg = 360.0 * first_angle;
+            scans.first_angle_deg = 360.0 * first_angle;
+            scans.next_angle_deg = scans.first_angle_deg;
         }
         scans.current = scans.make(0);
         scans
+    }
+
+    /// The same revolutions with the motor spinning up over `spin_up_s` after power-on, and
+    /// turning with a wobble of `rpm_wobble` (the `[link]` table's), from the start again.
+    pub(crate) fn with_link(mut self, spin_up_s: f64, rpm_wobble: f64) -> Self {
+        self.spin_up_s = spin_up_s;
+        self.rpm_wobble = rpm_wobble;
+        self.next_t_s = 0.0;
+        self.next_angle_deg = self.first_angle_deg;
+        self.current = self.make(0);
+        self
     }
 
     /// The revolution being taken.
@@ -81,9 +100,16 @@ impl UnitScans {
     fn make(&mut self, rev: u64) -> Scan {
         let phase = std::f64::consts::TAU * rev as f64 / WOBBLE_PERIOD_REVS + self.wobble_phase;
         let jitter: f64 = StandardNormal.sample(&mut self.motor);
-        let rpm = (self.rpm * (1.0 + self.spec.rev_hz_jitter * jitter)
+        // Spinning up: each revolution at the speed of its start.
+        let speed = if self.next_t_s < self.spin_up_s && self.rpm > scenario::SPIN_UP_FROM_RPM {
+            let from = scenario::SPIN_UP_FROM_RPM;
+            from + (self.rpm - from) * self.next_t_s / self.spin_up_s
+        } else {
+            self.rpm
+        };
+        let rpm = (speed * (1.0 + self.spec.rev_hz_jitter * jitter)
             + self.rpm_wobble * phase.sin())
-        .max(self.rpm * 0.5);
+        .max(speed * 0.5);
         let hz = rpm / 60.0;
         self.current_hz = hz;
         // Angles in hilsim's frame grow counter-clockwise; a clockwise unit's grow the other way.
@@ -168,6 +194,34 @@ mod tests {
             assert!(b.step_deg < 0.0);
             assert!(b.first_deg <= 0.0 && b.first_deg > b.step_deg, "{b:?}");
         }
+    }
+
+    #[test]
+    fn a_spinning_up_motor_turns_slowly_first_and_takes_more_readings_a_revolution() {
+        let spec = LidarModel::Ld06.spec();
+        let mut scans =
+            UnitScans::new(LidarModel::Ld06, spec.rev_hz * 60.0, 0.0, 3).with_link(2.0, 0.0);
+        let mut first = Vec::new();
+        while scans.current().t_s < 3.0 {
+            first.push((
+                scans.current().t_s,
+                scans.current_hz(),
+                scans.current().beams,
+            ));
+            scans.advance();
+        }
+        // From 50 rpm (0.83 Hz) to 10 Hz within 2 s, each revolution at the speed of its start,
+        // then at speed (the jitter is a few tenths of a percent). The first revolution is
+        // partial; the first whole one, at about 3 Hz, takes some 1,400 samples, not 450.
+        assert!(first[0].1 < 0.84, "{first:?}");
+        assert!(first[1].1 < 4.0 && first[1].2 > 1_000, "{first:?}");
+        let (t_last, hz_last, beams_last) = *first.last().unwrap();
+        assert!(t_last > 2.0 && (hz_last - 10.0).abs() < 0.1, "{first:?}");
+        assert!((440..=460).contains(&beams_last));
+        assert!(
+            first.windows(2).all(|w| w[0].1 <= w[1].1 * 1.01),
+            "{first:?}"
+        );
     }
 
     #[test]

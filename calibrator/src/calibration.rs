@@ -110,7 +110,7 @@ pub struct Metrics {
     pub nmse_calibrated: f64,
     /// The lidar model alone: each raw reading inverted through the fitted lidar model. For
     /// EM the figures above measure the smoothed distance, which also fuses the commands, the
-    /// odometer and the sonar, and can look good while the lidar model is wrong (issue 16).
+    /// odometer and the sonar, and can look good while the lidar model is wrong.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lidar_model: Option<LidarModelMetrics>,
 }

@@ -1,6 +1,6 @@
 //! The assumptions each method makes of its data, tested on the data: a calibration that comes
 //! out of a recording its method does not fit is still printed, with the checks that failed
-//! (exit code 1), instead of passing as a confident result (issue 16).
+//! (exit code 1), instead of passing as a confident result.
 //!
 //! The thresholds are stated with each check. They are meant to separate a recording the
 //! method fits from one it does not, not to test the model at a significance level: every

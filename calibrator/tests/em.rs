@@ -1,4 +1,4 @@
-//! Issue 5: the ground-truth-less EM calibrator (Alhashimi, Varagnolo, Gustafsson, IEEE
+//! The ground-truth-less EM calibrator (Alhashimi, Varagnolo, Gustafsson, IEEE
 //! Sensors J. 2017) on the simulated straight-board experiment, with the actuation error its
 //! premise needs (the commands are known, the actual speed is not).
 

@@ -1,4 +1,4 @@
-//! Issue 5 fixtures: a smoke test of the simulated experiment the issue-5 tests share
+//! Fixtures: a smoke test of the simulated experiment the EM tests share
 //! (`fixtures/mod.rs`).
 
 mod fixtures;

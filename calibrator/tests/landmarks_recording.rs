@@ -1,4 +1,4 @@
-//! Issue 6: the landmark calibrator on simulated recordings, from the raw scans: the detector
+//! The landmark calibrator on simulated recordings, from the raw scans: the detector
 //! finds the cylinders and nothing else, the landmarks land where they are, and the calibration
 //! recovers the configured range model.
 

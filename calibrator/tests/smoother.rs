@@ -1,4 +1,4 @@
-//! Issue 5: the Kalman/RTS smoother under the EM calibrator, checked against brute force. On a
+//! The Kalman/RTS smoother under the EM calibrator, checked against brute force. On a
 //! small linear-Gaussian model every state and observation is jointly Gaussian, so the smoothed
 //! means, covariances and lag-one covariances are the Gaussian conditioning of the states on all
 //! observations, and the log-likelihood is the observations' joint Gaussian density.

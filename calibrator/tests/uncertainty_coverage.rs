@@ -1,4 +1,4 @@
-//! Issue 16: every method reports a standard error for each coefficient, and the 95 % interval
+//! Every method reports a standard error for each coefficient, and the 95 % interval
 //! `estimate ± 1.96 sd` covers the truth in 90–98 % of 200 seeded runs (for a calibrated
 //! interval the count is Binomial(200, 0.95): sd 1.5 %, so 90–98 % is ±3.3 sd — a miss means the
 //! sds are wrong, not bad luck; the seeds are fixed).

@@ -272,7 +272,7 @@ mod tests {
     }
 
     #[test]
-    fn issue_18_writers_at_once_create_dataset_toml_exactly_once_and_whole() {
+    fn writers_at_once_create_dataset_toml_exactly_once_and_whole() {
         const WRITERS: usize = 8;
         for round in 0..20 {
             let dir = tempfile::tempdir().unwrap();

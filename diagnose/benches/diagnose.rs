@@ -1,4 +1,4 @@
-//! `hilsim diagnose` benchmark (issue 7): diagnosing a 60 s recording of `diagnose-room` (a lidar
+//! `hilsim diagnose` benchmark: diagnosing a 60 s recording of `diagnose-room` (a lidar
 //! revolution every 0.2 s, 108,000 readings, sonar, encoders, truth) with every catalogued effect
 //! tried, on one core and on two; the baseline of the same run is recording those 60 s
 //! (`Emulation::run`, what `hilsim record` does). Goal: under 30 s on two cores.

@@ -1,4 +1,4 @@
-//! Issue 15: each of the catalogue's mount, timing and wheel-geometry entries, concealed in a
+//! Each of the catalogue's mount, timing and wheel-geometry entries, concealed in a
 //! recording `hilsim` makes with truth, is named with its parameters (and, without truth, the
 //! warm-up's constant term and a mount beside wheels' radii).
 //!

@@ -1,4 +1,4 @@
-//! Robot command port latency (issue 8), printed as figures and a ratio: the round trip of a
+//! Robot command port latency, printed as figures and a ratio: the round trip of a
 //! `GetMotors` request through the pty to its complete reply (up to the Ctrl-Z), while the
 //! simulation runs in real time and the lidar streams to a reader on the other port:
 //!

@@ -1,4 +1,4 @@
-//! Serial link benchmarks (issue 4), printed as figures and ratios:
+//! Serial link benchmarks, printed as figures and ratios:
 //!
 //! - realtime pacing over `HILSIM_BENCH_SECONDS` (default 60) of a 300 rpm stream read by a
 //!   client thread from the pty: revolutions per second against rpm/60, and the packet lateness

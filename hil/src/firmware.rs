@@ -551,9 +551,9 @@ mod tests {
         assert!(gone(pid) && gone(grandchild), "{pid} {grandchild}");
     }
 
-    /// Issue 18: a daemon that left the firmware's group (`setsid`) is reported and killed.
+    /// A daemon that left the firmware's group (`setsid`) is reported and killed.
     #[test]
-    fn issue_18_a_process_that_left_the_group_is_reported_and_killed() {
+    fn a_process_that_left_the_group_is_reported_and_killed() {
         // The pid is told only once the daemon has left (its own session, `sleep` exec'd):
         // on a loaded machine the firmware could otherwise exit first and its group be shut
         // down with the daemon still in it, which kills it as a member, not as an escapee.

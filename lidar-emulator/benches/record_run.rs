@@ -6,7 +6,7 @@
 //! than either time on a shared machine.
 //!
 //! `cargo bench -p hilsim-lidar-emulator --bench record_run` prints criterion's timing, then
-//! `record_run = N x real time` (goal >= 1000 x, issue 18) for a 60 s straight-board run and the
+//! `record_run = N x real time` (goal >= 1000 x) for a 60 s straight-board run and the
 //! same for every checked-in scenario (`scenarios/*.toml`).
 
 use std::hint::black_box;

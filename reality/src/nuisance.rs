@@ -1,5 +1,5 @@
 //! Small differences between any two simulators, or a simulator and a robot, that no catalogue
-//! effect is about (issue 14's list). A run draws its own: each is on with probability ½, at a
+//! effect is about. A run draws its own: each is on with probability ½, at a
 //! size drawn from a range a real setup shows.
 
 use crate::noise::Stream;
@@ -74,7 +74,7 @@ impl Default for Nuisances {
 
 impl Nuisances {
     /// A run's nuisances: each on with probability ½, its size uniform in the range given
-    /// (issue 14: "a few" mm, ms, packets).
+    /// ("a few" mm, ms, packets).
     #[must_use]
     pub fn draw(s: &mut Stream) -> Self {
         let mut n = Self::default();

@@ -1,6 +1,6 @@
 //! Numbers as CSV text, exactly as `Display` writes them (the shortest decimal that reads back
 //! as the same `f64`, in plain notation), faster: formatting was half the time of `hilsim
-//! record` (issue 18) and most of `hilsim import`'s (issue 17). The fixed decimals a recording
+//! record` and most of `hilsim import`'s. The fixed decimals a recording
 //! mostly holds (times to the microsecond, millimetres) are written from their integer digits;
 //! other numbers' shortest digits come from Żmij (`zmij`, by the author of `ryu` and `itoa`),
 //! with its notation and its rounding of exact ties changed to `Display`'s, so recordings keep

@@ -1,4 +1,4 @@
-//! Import and export speed (issue 17's goals: import ≥ 50 MB of bag a second on one core;
+//! Import and export speed (the goals: import ≥ 50 MB of bag a second on one core;
 //! export of a 60 s run under 1 s), each beside a baseline measured in the same run: the bare
 //! MCAP read of the same file (the records streamed, nothing decoded) for the import, and
 //! writing the recording's CSV files for the export.

@@ -1,4 +1,4 @@
-//! Bags as other ROS 2 libraries and robots write them (issue 17): wheel joints instead of
+//! Bags as other ROS 2 libraries and robots write them: wheel joints instead of
 //! Odometry, split bags, scans that turn clockwise or start off zero, NaN and inf readings,
 //! other frame names, `ros2idl` schemas, big-endian CDR and namespaced topics. Each bag is
 //! written here with the `mcap` crate, message by message, as such a writer lays it out.

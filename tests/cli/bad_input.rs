@@ -73,7 +73,7 @@ const CORPUS: &[(&str, usize, &str)] = &[
         1,
         "invalid type: integer `42`, expected a string",
     ),
-    // Issue 18: values with no physical sense are refused with the documented limit.
+    // Values with no physical sense are refused with the documented limit.
     (
         "issue-18-duration-a-billion-seconds.toml",
         2,

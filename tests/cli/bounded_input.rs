@@ -1,4 +1,4 @@
-//! Inputs that never end, or are garbage of any size (issue 18, item 2): each is refused with exit
+//! Inputs that never end, or are garbage of any size: each is refused with exit
 //! code 2 and one line naming the file (and the line, where there is one) after reading at most a
 //! bounded amount — never the whole of it.
 
@@ -31,7 +31,7 @@ fn quickly(dir: &Path, args: &[&str]) -> Output {
 }
 
 #[test]
-fn issue_18_a_lidar_csv_linked_to_dev_zero_is_refused_at_once() {
+fn a_lidar_csv_linked_to_dev_zero_is_refused_at_once() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path());
     let cal = hilsim(
@@ -56,7 +56,7 @@ fn issue_18_a_lidar_csv_linked_to_dev_zero_is_refused_at_once() {
 }
 
 #[test]
-fn issue_18_a_line_of_10_mb_without_a_newline_names_file_and_line() {
+fn a_line_of_10_mb_without_a_newline_names_file_and_line() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path());
     let path = tmp.path().join("rec/lidar.csv");
@@ -78,7 +78,7 @@ fn issue_18_a_line_of_10_mb_without_a_newline_names_file_and_line() {
 }
 
 #[test]
-fn issue_18_a_pipe_or_a_device_in_a_recording_is_refused_before_it_is_opened() {
+fn a_pipe_or_a_device_in_a_recording_is_refused_before_it_is_opened() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path());
     // Opening a pipe would wait for a writer that never comes: it must not be opened at all.
@@ -109,7 +109,7 @@ fn issue_18_a_pipe_or_a_device_in_a_recording_is_refused_before_it_is_opened() {
 }
 
 #[test]
-fn issue_18_a_meta_toml_over_1_mib_is_refused() {
+fn a_meta_toml_over_1_mib_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path());
     let path = tmp.path().join("rec/meta.toml");
@@ -127,7 +127,7 @@ fn issue_18_a_meta_toml_over_1_mib_is_refused() {
 }
 
 #[test]
-fn issue_18_a_scenario_linked_to_dev_zero_is_refused_after_1_mib() {
+fn a_scenario_linked_to_dev_zero_is_refused_after_1_mib() {
     let tmp = tempfile::tempdir().unwrap();
     symlink("/dev/zero", tmp.path().join("zero.toml")).unwrap();
     for args in [
@@ -148,7 +148,7 @@ fn issue_18_a_scenario_linked_to_dev_zero_is_refused_after_1_mib() {
 }
 
 #[test]
-fn issue_18_a_scenario_over_1_mib_or_from_an_endless_pipe_is_refused() {
+fn a_scenario_over_1_mib_or_from_an_endless_pipe_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let mut text = fs::read_to_string(repo_file("scenarios/straight-board.toml")).unwrap();
     text.push_str(&format!("# {}\n", "x".repeat(1 << 20)));

@@ -143,11 +143,11 @@ fn bad_recordings_exit_2_with_one_line_naming_the_file() {
     assert!(err.contains("cal.json"), "{err}");
 }
 
-/// Issue 16: stops of 1 s (five revolutions) in a recording without odometry: rest is found
+/// Stops of 1 s (five revolutions) in a recording without odometry: rest is found
 /// from the scans and every stop is used; the JSON notes say so. Asking for more revolutions
 /// than a stop holds leaves too few stops: exit 2, saying how many were needed.
 #[test]
-fn issue_16_one_second_stops_without_odometry_calibrate() {
+fn one_second_stops_without_odometry_calibrate() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = std::fs::read_to_string(repo_file("scenarios/landmarks-5.toml"))
         .unwrap()
@@ -219,12 +219,12 @@ fn issue_16_one_second_stops_without_odometry_calibrate() {
     assert!(notes.contains("the settling time given"), "{notes}");
 }
 
-/// Issue 16: EM's assumptions checked. On landmarks-5 (its lidar beam sweeps across cylinders
+/// EM's assumptions checked. On landmarks-5 (its lidar beam sweeps across cylinders
 /// and walls) and with a start distance 2.5 m off it used to print a confident garbage model
 /// with exit 0: now the result is still printed, with the failed checks, and the exit code is 1.
 /// The run it is made for passes every check.
 #[test]
-fn issue_16_em_checks_its_assumptions_and_a_failure_exits_1() {
+fn em_checks_its_assumptions_and_a_failure_exits_1() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path(), "straight-board.toml", "board");
     record(tmp.path(), "landmarks-5.toml", "landmarks");
@@ -330,10 +330,10 @@ fn issue_16_em_checks_its_assumptions_and_a_failure_exits_1() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
-/// Issue 16: the landmark method's and the ground-truth baseline's checks pass on the runs they
+/// The landmark method's and the ground-truth baseline's checks pass on the runs they
 /// are made for.
 #[test]
-fn issue_16_landmarks_and_groundtruth_pass_their_checks_on_their_runs() {
+fn landmarks_and_groundtruth_pass_their_checks_on_their_runs() {
     let tmp = tempfile::tempdir().unwrap();
     record(tmp.path(), "landmarks-5.toml", "landmarks");
     record(tmp.path(), "straight-board.toml", "board");
@@ -364,13 +364,13 @@ fn issue_16_landmarks_and_groundtruth_pass_their_checks_on_their_runs() {
     }
 }
 
-/// Issue 16: a prior on the sonar's scale (the speed of sound at a known temperature) makes the
+/// A prior on the sonar's scale (the speed of sound at a known temperature) makes the
 /// drive's speed error identifiable. Straight-board at seed 3 draws a speed error the commands
 /// do not know: without the prior EM's lidar model scores an MSE ratio of 5.3, with it 86 (the
 /// true model's is 87.5; `python3 docs/em-priors-check.py` measures 24 runs). Tolerances: at
 /// least 1.5× the ratio without the prior and 50 (0.57 of the true model's), as the issue asks.
 #[test]
-fn issue_16_a_prior_on_the_sonar_scale_recovers_the_lidar_model() {
+fn a_prior_on_the_sonar_scale_recovers_the_lidar_model() {
     let tmp = tempfile::tempdir().unwrap();
     let path = repo_file("scenarios/straight-board.toml");
     let o = hilsim(

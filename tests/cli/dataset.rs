@@ -437,7 +437,7 @@ fn truncate_lines(file: &Path) {
 }
 
 #[test]
-fn issue_18_a_truncated_run_is_made_again_on_resume() {
+fn a_truncated_run_is_made_again_on_resume() {
     let tmp = tempfile::tempdir().unwrap();
     let s = scenario(tmp.path(), 1.0);
     let args = ["dataset", &s, "--runs", "4", "--vary", VARY_X, "--out", "d"];
@@ -466,7 +466,7 @@ fn issue_18_a_truncated_run_is_made_again_on_resume() {
 }
 
 #[test]
-fn issue_18_merge_refuses_a_corrupt_shard_run_and_the_target_never_holds_it() {
+fn merge_refuses_a_corrupt_shard_run_and_the_target_never_holds_it() {
     let tmp = tempfile::tempdir().unwrap();
     let s = scenario(tmp.path(), 1.0);
     for i in 1..=2 {
@@ -497,7 +497,7 @@ fn issue_18_merge_refuses_a_corrupt_shard_run_and_the_target_never_holds_it() {
 }
 
 #[test]
-fn issue_18_shard_processes_started_at_once_on_a_fresh_directory_all_succeed() {
+fn shard_processes_started_at_once_on_a_fresh_directory_all_succeed() {
     // What a Slurm job array does: K processes, one per shard, on one fresh --out.
     const K: usize = 4;
     let tmp = tempfile::tempdir().unwrap();

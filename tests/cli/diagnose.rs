@@ -94,7 +94,7 @@ fn a_concealed_effect_is_named_in_the_interface_json() {
     }
     assert_eq!(j["mismatch"], true);
     assert_eq!(j["effect"], "sonar_speed_of_sound", "{j}");
-    // Issue 20: `--fail-on-mismatch` fails a CI job on it, the result still printed.
+    // `--fail-on-mismatch` fails a CI job on it, the result still printed.
     let failing = hilsim(
         tmp.path(),
         &[
@@ -236,7 +236,7 @@ fn without_truth_the_trajectory_is_estimated() {
     assert!(notes
         .iter()
         .any(|n| n.as_str().unwrap().contains("no truth.csv")));
-    // Issue 15: every sensor diagnosed, each against a reference independent of it.
+    // Every sensor diagnosed, each against a reference independent of it.
     let refs = &j["references"];
     assert_eq!(
         refs["odometer"], "lidar-estimated path (commands between scans)",
@@ -282,7 +282,7 @@ fn both_named_without_truth(only: &str, seed: u64) -> String {
     text
 }
 
-/// Issue 15: without truth a concealed motor lag (before: `none`, the drive was not diagnosed)
+/// Without truth a concealed motor lag (before: `none`, the drive was not diagnosed)
 /// is named in both trials, its time constant within 20 %, and no other effect is named.
 #[test]
 fn without_truth_a_motor_lag_is_named_from_the_drive() {
@@ -294,7 +294,7 @@ fn without_truth_a_motor_lag_is_named_from_the_drive() {
     );
 }
 
-/// Issue 15: without truth a lidar mount offset goes into the path estimated from the lidar
+/// Without truth a lidar mount offset goes into the path estimated from the lidar
 /// (before: the wheels' geometry and the speed of sound were named in its place); it is named
 /// through the sonar and the encoders in both trials, within 20 %.
 #[test]
@@ -302,7 +302,7 @@ fn without_truth_a_lidar_mount_offset_is_named_through_the_other_sensors() {
     both_named_without_truth("lidar_mount_offset", 1);
 }
 
-/// Issue 15: without truth a lidar delay goes into the path estimated from the lidar (the
+/// Without truth a lidar delay goes into the path estimated from the lidar (the
 /// matching puts each pose at its scan's late stamp); it is named through the sonar and the
 /// encoders, within 20 % (before: trial 1 of seed 3, a 65 ms lidar delay, came out a wheel slip
 /// of 66 ms with the speed of sound beside it). Trial 0 conceals a sonar delay.
@@ -436,7 +436,7 @@ fn the_self_test_prints_its_confusion_matrix_and_goals() {
     );
 }
 
-/// Issue 14: the self-test on the independent reality (a generator that shares no model code
+/// The self-test on the independent reality (a generator that shares no model code
 /// with the simulator, with random nuisances): a concealed speed of sound is named in both of
 /// its trials and a periodic range error outside the catalogue comes out unexplained, naming
 /// nothing. Fixed seed; the goals' exit code says every goal was met.

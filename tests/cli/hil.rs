@@ -158,7 +158,7 @@ fn the_example_firmware_stops_half_a_metre_from_the_board_and_misses_no_revoluti
     );
     assert!(text.contains("; 0 collision(s)"), "{text}");
     assert!(text.contains(", 0 error(s)"), "{text}");
-    // Issue 19: the scenario's assertions, checked under hil.
+    // The scenario's assertions, checked under hil.
     for line in [
         "PASS sim.final_x_m",
         "PASS hil.command_errors",
@@ -374,11 +374,11 @@ fn duration_makes_a_scenario_without_drive_program_or_duration_runnable() {
     );
 }
 
-/// Issue 18: a `hilsim hil` started where SIGINT, SIGTERM and SIGHUP are ignored (a script's
+/// A `hilsim hil` started where SIGINT, SIGTERM and SIGHUP are ignored (a script's
 /// background job, `nohup`) still gives its firmware the default dispositions, so the polite
 /// SIGTERM at the end works and the summary says so.
 #[test]
-fn issue_18_the_firmware_starts_with_default_signal_dispositions() {
+fn the_firmware_starts_with_default_signal_dispositions() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/hil-approach.toml");
     // The firmware reads the lidar (so the run has no fault), records its ignored signals and
@@ -407,10 +407,10 @@ fn issue_18_the_firmware_starts_with_default_signal_dispositions() {
     }
 }
 
-/// Issue 18: a daemon the firmware starts in a session of its own (out of reach of the group's
+/// A daemon the firmware starts in a session of its own (out of reach of the group's
 /// signals) is reported in the summary and does not outlive the run.
 #[test]
-fn issue_18_a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
+fn a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/hil-approach.toml");
     let firmware = r#"sh -c 'cat "$HILSIM_LIDAR_PORT" >/dev/null & setsid sleep 60 </dev/null >/dev/null 2>&1 & echo $! > daemon.pid; sleep 30'"#;
@@ -442,10 +442,10 @@ fn issue_18_a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
     assert!(gone(daemon));
 }
 
-/// Issue 19: a firmware that reads the lidar but never drives fails the scenario's `when =
+/// A firmware that reads the lidar but never drives fails the scenario's `when =
 /// "hil"` assertion on where the robot stops: exit 1, and the summary says which.
 #[test]
-fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
+fn a_failed_assertion_under_hil_exits_1_and_says_which() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/hil-approach.toml");
     let out = hilsim(
@@ -467,7 +467,7 @@ fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
         text.contains("1 of 5 assertion(s) failed: sim.final_x_m"),
         "{text}"
     );
-    // Issue 20: `--json` ends with one object saying the same.
+    // `--json` ends with one object saying the same.
     let out = hilsim(
         tmp.path(),
         &[
@@ -497,7 +497,7 @@ fn issue_19_a_failed_assertion_under_hil_exits_1_and_says_which() {
     assert!(j["firmware"]["status"].is_string(), "{j}");
 }
 
-/// Issue 19: both example firmwares, over a link that fails as the real capture does (spin-up
+/// Both example firmwares, over a link that fails as the real capture does (spin-up
 /// with every other packet missing below 210 rpm, corrupted packets, a disconnection), still
 /// stop half a metre from the board; the scenario's `when = "hil"` assertions hold and the
 /// summary counts the faults. The start is moved to 1.5 m to keep the test short.

@@ -1,5 +1,5 @@
 //! Counts, flags, pipes, links and recordings that once hung, panicked or answered wrongly
-//! (issue 18): each now ends in the documented exit code with one clear line, or none.
+//!: each now ends in the documented exit code with one clear line, or none.
 
 use std::fs;
 use std::process::{Command, Stdio};
@@ -11,7 +11,7 @@ const TINY: &str = "name = \"tiny\"\nduration_s = 0.5\n[robot]\nstart = { x = 0.
                     wheel_base_m = 0.23\n";
 
 #[test]
-fn issue_18_self_test_counts_are_checked_before_anything_is_allocated() {
+fn self_test_counts_are_checked_before_anything_is_allocated() {
     let tmp = tempfile::tempdir().unwrap();
     for n in ["18446744073709551615", "1000000000000", "100001"] {
         let err = assert_bad_input(&hilsim(tmp.path(), &["diagnose", "--self-test", n]));
@@ -23,7 +23,7 @@ fn issue_18_self_test_counts_are_checked_before_anything_is_allocated() {
 }
 
 #[test]
-fn issue_18_a_negative_start_distance_is_a_value_not_a_flag() {
+fn a_negative_start_distance_is_a_value_not_a_flag() {
     let tmp = tempfile::tempdir().unwrap();
     for command in ["calibrate", "smooth"] {
         let mut args = vec![command, "rec"];
@@ -42,7 +42,7 @@ fn issue_18_a_negative_start_distance_is_a_value_not_a_flag() {
 }
 
 #[test]
-fn issue_18_a_reader_that_goes_away_ends_the_run_quietly() {
+fn a_reader_that_goes_away_ends_the_run_quietly() {
     let tmp = tempfile::tempdir().unwrap();
     fs::write(tmp.path().join("tiny.toml"), TINY).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_hilsim"))
@@ -60,7 +60,7 @@ fn issue_18_a_reader_that_goes_away_ends_the_run_quietly() {
 }
 
 #[test]
-fn issue_18_scenario_test_enters_each_directory_once() {
+fn scenario_test_enters_each_directory_once() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("s");
     fs::create_dir(&dir).unwrap();
@@ -78,7 +78,7 @@ fn issue_18_scenario_test_enters_each_directory_once() {
 }
 
 #[test]
-fn issue_18_diagnose_with_no_sensor_in_common_is_refused() {
+fn diagnose_with_no_sensor_in_common_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = fs::read_to_string(repo_file("scenarios/straight-board.toml")).unwrap();
     fs::write(tmp.path().join("with.toml"), &scenario).unwrap();
@@ -99,7 +99,7 @@ fn issue_18_diagnose_with_no_sensor_in_common_is_refused() {
 }
 
 #[test]
-fn issue_18_an_endless_calibration_or_scenario_path_is_refused() {
+fn an_endless_calibration_or_scenario_path_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let err = assert_bad_input(&hilsim(
         tmp.path(),
@@ -118,7 +118,7 @@ fn issue_18_an_endless_calibration_or_scenario_path_is_refused() {
 }
 
 #[test]
-fn issue_18_dataset_counts_and_scenarios_are_bounded_before_work() {
+fn dataset_counts_and_scenarios_are_bounded_before_work() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/straight-board.toml");
     let err = assert_bad_input(&hilsim(
@@ -146,7 +146,7 @@ fn issue_18_dataset_counts_and_scenarios_are_bounded_before_work() {
 }
 
 #[test]
-fn issue_18_a_looping_link_in_a_recording_is_named_not_taken_for_a_missing_table() {
+fn a_looping_link_in_a_recording_is_named_not_taken_for_a_missing_table() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/straight-board.toml");
     let o = hilsim(

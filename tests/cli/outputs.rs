@@ -1,4 +1,4 @@
-//! Outputs never lose a user's data (issue 18): a directory output replaces only a previous
+//! Outputs never lose a user's data: a directory output replaces only a previous
 //! recording (or an empty directory), a file output follows links, writes through devices and
 //! never overwrites an input.
 
@@ -14,7 +14,7 @@ fn record(cwd: &Path, out: &str) -> std::process::Output {
 }
 
 #[test]
-fn issue_18_record_refuses_a_directory_that_is_not_a_recording() {
+fn record_refuses_a_directory_that_is_not_a_recording() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("x");
     fs::create_dir(&dir).unwrap();
@@ -29,7 +29,7 @@ fn issue_18_record_refuses_a_directory_that_is_not_a_recording() {
 }
 
 #[test]
-fn issue_18_record_and_run_refuse_a_file_at_the_output() {
+fn record_and_run_refuse_a_file_at_the_output() {
     let tmp = tempfile::tempdir().unwrap();
     fs::write(tmp.path().join("x"), "precious").unwrap();
     let err = assert_bad_input(&record(tmp.path(), "x"));
@@ -45,7 +45,7 @@ fn issue_18_record_and_run_refuse_a_file_at_the_output() {
 }
 
 #[test]
-fn issue_18_a_previous_recording_and_an_empty_directory_are_replaced() {
+fn a_previous_recording_and_an_empty_directory_are_replaced() {
     let tmp = tempfile::tempdir().unwrap();
     fs::create_dir(tmp.path().join("empty")).unwrap();
     for out in ["empty", "rec", "rec"] {
@@ -64,7 +64,7 @@ fn capture() -> std::path::PathBuf {
 }
 
 #[test]
-fn issue_18_decode_writes_through_a_device_and_never_replaces_it() {
+fn decode_writes_through_a_device_and_never_replaces_it() {
     let tmp = tempfile::tempdir().unwrap();
     let o = hilsim(
         tmp.path(),
@@ -76,7 +76,7 @@ fn issue_18_decode_writes_through_a_device_and_never_replaces_it() {
 }
 
 #[test]
-fn issue_18_decode_refuses_to_write_over_its_input_or_a_directory() {
+fn decode_refuses_to_write_over_its_input_or_a_directory() {
     let tmp = tempfile::tempdir().unwrap();
     let input = tmp.path().join("capture.bin");
     fs::copy(capture(), &input).unwrap();
@@ -127,7 +127,7 @@ fn a_csv_through_a_link_replaces_the_linked_previous_csv_and_keeps_the_link() {
 }
 
 #[test]
-fn issue_18_smooth_refuses_to_write_over_the_recording() {
+fn smooth_refuses_to_write_over_the_recording() {
     let tmp = tempfile::tempdir().unwrap();
     assert_eq!(record(tmp.path(), "rec").status.code(), Some(0));
     fs::write(tmp.path().join("cal.json"), "{}").unwrap();
@@ -156,7 +156,7 @@ fn dead_pid() -> u32 {
 }
 
 #[test]
-fn issue_18_what_a_killed_writer_left_is_tidied_and_an_orphaned_recording_restored() {
+fn what_a_killed_writer_left_is_tidied_and_an_orphaned_recording_restored() {
     let tmp = tempfile::tempdir().unwrap();
     let pid = dead_pid();
     // An unfinished new recording of a killed `record --out rec`.

@@ -107,10 +107,10 @@ fn a_failed_record_leaves_the_previous_recording_alone() {
     assert_eq!(entries.len(), 1);
 }
 
-/// Issue 18: `record` streams its samples to disk (flat memory); `run --out` writes the
+/// `record` streams its samples to disk (flat memory); `run --out` writes the
 /// recording it holds. The two give the same files, byte for byte.
 #[test]
-fn issue_18_record_streams_the_same_bytes_as_a_written_recording() {
+fn record_streams_the_same_bytes_as_a_written_recording() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = repo_file("scenarios/room-tour.toml");
     let scenario = scenario.to_str().unwrap();

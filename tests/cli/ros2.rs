@@ -1,4 +1,4 @@
-//! `hilsim import` and `hilsim export` (issue 17): a recording exported as ROS 2 messages and
+//! `hilsim import` and `hilsim export`: a recording exported as ROS 2 messages and
 //! imported again is the recording, and bad bags are one-line errors.
 
 use std::fs;

@@ -38,7 +38,7 @@ fn a_failing_scenario_fails_the_whole_test_with_exit_1() {
     assert!(text.contains("PASS room-tour"), "{text}");
     assert!(text.ends_with("1 passed, 1 failed\n"), "{text}");
 
-    // Issue 20: the same as one JSON object, and as JUnit XML for CI systems.
+    // The same as one JSON object, and as JUnit XML for CI systems.
     let out = hilsim(
         tmp.path(),
         &["scenario", "test", ".", "--json", "--junit", "junit.xml"],
@@ -74,7 +74,7 @@ fn a_failing_scenario_fails_the_whole_test_with_exit_1() {
     );
 }
 
-/// Issue 20: `run --json` prints results.json's object instead of the summary.
+/// `run --json` prints results.json's object instead of the summary.
 #[test]
 fn run_json_prints_the_results_object() {
     let tmp = tempfile::tempdir().unwrap();

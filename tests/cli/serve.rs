@@ -255,11 +255,11 @@ fn decode_counts_the_real_capture_and_writes_csv() {
     assert!(err.contains("nothing.bin"), "{err}");
 }
 
-/// Issue 19: `--fast --wait-for-client` streams nothing until the client opens the port, and a
+/// `--fast --wait-for-client` streams nothing until the client opens the port, and a
 /// client that reads, however slowly (here 2 KB every 20 ms, far behind the simulation), loses
 /// no revolution: it gets every one of the run's, equal to the recording's.
 #[test]
-fn issue_19_a_late_slow_client_of_a_fast_stream_gets_every_revolution() {
+fn a_late_slow_client_of_a_fast_stream_gets_every_revolution() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("short.toml"), SHORT).unwrap();
     let expected = recorded_revolutions(tmp.path(), "4");
@@ -306,10 +306,10 @@ fn issue_19_a_late_slow_client_of_a_fast_stream_gets_every_revolution() {
     assert!(status.success());
 }
 
-/// Issue 19: a client of a fast stream that stops reading for a second loses whole
+/// A client of a fast stream that stops reading for a second loses whole
 /// revolutions, and the summary counts them: every revolution is either sent or dropped.
 #[test]
-fn issue_19_what_a_stalled_client_loses_is_counted() {
+fn what_a_stalled_client_loses_is_counted() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("short.toml"), SHORT).unwrap();
     let mut server = serve(tmp.path(), &["short.toml", "--fast", "--wait-for-client"]);
@@ -333,12 +333,12 @@ fn issue_19_what_a_stalled_client_loses_is_counted() {
     assert_eq!(sent + dropped, 15, "{text}");
 }
 
-/// Issue 19: a scenario's `[link]` faults reach a client of `serve`, seeded: the same run gives
+/// A scenario's `[link]` faults reach a client of `serve`, seeded: the same run gives
 /// the same bytes. The motor spins up from 50 rpm (the rpm field follows), packets fail their
 /// checksum at the rate asked (5 %: 0.05 × ~1,100 packets ≈ 55, binomial sd 7) and the summary
 /// counts them as the decoder does.
 #[test]
-fn issue_19_link_faults_reach_the_client_and_are_counted() {
+fn link_faults_reach_the_client_and_are_counted() {
     let tmp = tempfile::tempdir().unwrap();
     let faulty = format!("{SHORT}\n[link]\nspin_up_s = 1.0\ncorrupt_packet_rate = 0.05\n");
     std::fs::write(tmp.path().join("faulty.toml"), faulty).unwrap();

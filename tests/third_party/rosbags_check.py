@@ -1,4 +1,4 @@
-"""Third-party ROS libraries against `hilsim import` and `hilsim export` (issue 17).
+"""Third-party ROS libraries against `hilsim import` and `hilsim export`.
 
     rosbags_check.py write BAGDIR [VARIANT]  write a ROS 2 bag with rosbags (MCAP storage;
                                              VARIANT: rosbag2 compression, file or message,

@@ -12,7 +12,7 @@ use hilsim_sim::Scenario;
 /// The paper's speeds (Sec. VI).
 pub const SPEEDS: [f64; 3] = [0.1, 0.2, 0.3];
 /// The actuation error of the runs "with actuation error": a fixed speed-scale error of sd 2 %
-/// and a wander of sd 1 % with a 10 s correlation time (issue 5's example values).
+/// and a wander of sd 1 % with a 10 s correlation time.
 pub const ACTUATION: (f64, f64) = (0.02, 0.01);
 /// The paper's Sec. V test windows: 12 samples.
 pub const WINDOW: usize = 12;

@@ -1,4 +1,4 @@
-//! The EM paper's experiment (Sec. VI) as scenarios, shared by the issue-5 tests, the `em`
+//! The EM paper's experiment (Sec. VI) as scenarios, shared by the EM tests, the `em`
 //! benchmark and the `reproduce_em` example: the simulated sensors' true models, one run's
 //! scenario text (for `hilsim_sim::Scenario::from_toml`; the calibrator itself never runs the
 //! physics), and a recording drawn straight from the models without the physics.

@@ -90,7 +90,7 @@ impl Drawn {
 /// The name of the outside-the-catalogue effect the independent reality conceals.
 pub const OUTSIDE: &str = "lidar_periodic_range";
 
-/// Share of the independent reality's trials that conceal two catalogued effects (issue 14).
+/// Share of the independent reality's trials that conceal two catalogued effects.
 const TWO_EFFECTS: f64 = 0.2;
 
 /// The catalogue effect `effect` with `values` as the independent reality takes it.

@@ -1,4 +1,4 @@
-//! The self-test's score over its trials: the confusion matrix and the goals of issues 7 and 14.
+//! The self-test's score over its trials: the confusion matrix and its goals.
 
 use super::draw::OUTSIDE;
 use super::plan::Reality;
@@ -13,7 +13,7 @@ pub const GOAL_FALSE_ALARMS: f64 = 0.05;
 pub const GOAL_PARAM_ERROR: f64 = 0.20;
 /// Held-out RMSE after the fix over the noise floor that counts as explained.
 pub const GOAL_HELDOUT_RATIO: f64 = 1.2;
-/// Share of concealed effects outside the catalogue that must come out unexplained (issue 14).
+/// Share of concealed effects outside the catalogue that must come out unexplained.
 pub const GOAL_OUTSIDE: f64 = 0.90;
 
 /// The score of a set of trials.
@@ -75,9 +75,9 @@ fn share(a: usize, b: usize) -> f64 {
 
 impl Score {
     /// The score of `outcomes` of a self-test on `reality`. A false alarm is, on hilsim's
-    /// reality, a verdict other than `none` on a recording without an effect (issue 7); on the
+    /// reality, a verdict other than `none` on a recording without an effect; on the
     /// independent one, whose nuisances are real mismatches, a trial that names an effect that
-    /// was not concealed (issue 14), over all trials.
+    /// was not concealed, over all trials.
     #[must_use]
     pub fn of(outcomes: &[Outcome], reality: Reality) -> Self {
         // Confusion matrix of the trials with one concealed class: rows the truth, columns the

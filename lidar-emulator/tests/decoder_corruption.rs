@@ -1,4 +1,4 @@
-//! Issue 4: the XV-11 decoder must resynchronise after any corruption (flipped, inserted or
+//! The XV-11 decoder must resynchronise after any corruption (flipped, inserted or
 //! deleted bytes) without ever accepting a damaged packet or losing an intact one it could see.
 //!
 //! A stream of distinct packets (a sequence number in reading 0's strength) is damaged by random

@@ -1,4 +1,4 @@
-//! Issue 4: the XV-11 decoder must read what a real unit sends, gaps and damage included; it is
+//! The XV-11 decoder must read what a real unit sends, gaps and damage included; it is
 //! checked on a real capture against a deliberately naive scan written independently here.
 
 use std::collections::BTreeMap;

@@ -1,4 +1,4 @@
-//! Issue 6: the landmark estimators on the paper's pure-maths model (Sec. 4.1): the bearing
+//! The landmark estimators on the paper's pure-maths model (Sec. 4.1): the bearing
 //! intersection is unbiased, order selection finds the quadratic, the inversion round-trips, and
 //! the refinement beyond the paper improves the calibration.
 

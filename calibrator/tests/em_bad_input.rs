@@ -1,4 +1,4 @@
-//! Issue 5: bad input to the EM calibrator, the ground-truth baseline and the smoother gives
+//! Bad input to the EM calibrator, the ground-truth baseline and the smoother gives
 //! the right `CalibrationError` with a message a user can act on, never a panic or a NaN.
 
 mod fixtures;

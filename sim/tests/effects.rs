@@ -1,4 +1,4 @@
-//! Issue 7: every catalogued effect is optional physics a scenario switches on in `[effects]`,
+//! Every catalogued effect is optional physics a scenario switches on in `[effects]`,
 //! off by default (the nominal simulation is exactly what the scenario declares), checked on load
 //! with the line of the offending key; motor lag is the simulation's own.
 
@@ -43,7 +43,7 @@ fn every_effect_table_loads_with_its_defaults() {
     );
     let s = load(&text).unwrap();
     assert_eq!(s.effects.active().len(), 13);
-    // Issue 15's tables: each key defaults to no change.
+    // The mount, timing and wheel tables: each key defaults to no change.
     assert_eq!(s.effects.lidar_mount_offset.unwrap().x_m, 0.0);
     assert_eq!(s.effects.sensor_latency.unwrap().sonar_s, 0.0);
     assert_eq!(s.effects.odometer_wheel_radius.unwrap().left_scale, 1.0);

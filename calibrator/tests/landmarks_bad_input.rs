@@ -1,4 +1,4 @@
-//! Issue 6: bad input to the landmark calibrator gives a clear error or a named warning, never
+//! Bad input to the landmark calibrator gives a clear error or a named warning, never
 //! a NaN: too few stops, no landmark, a landmark seen from one stop, colinear bearings, missing
 //! or disordered data, nonsense options.
 

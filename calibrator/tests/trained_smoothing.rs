@@ -1,4 +1,4 @@
-//! Issue 5: reusing a trained calibration (the EM paper's Sec. V): one smoother pass over a new
+//! Reusing a trained calibration (the EM paper's Sec. V): one smoother pass over a new
 //! recording gives calibrated distances without re-running EM.
 
 mod fixtures;

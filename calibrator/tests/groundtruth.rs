@@ -1,4 +1,4 @@
-//! Issue 5: the ground-truth baseline (ML fit against the true distances, order by AIC, as in
+//! The ground-truth baseline (ML fit against the true distances, order by AIC, as in
 //! Alhashimi et al., ICINCO 2016) recovers the lidar model and picks the true order.
 
 mod fixtures;

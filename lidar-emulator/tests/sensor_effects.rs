@@ -1,4 +1,4 @@
-//! Issue 7: each catalogued sensor effect, switched on in a scenario's `[effects]`, changes the
+//! Each catalogued sensor effect, switched on in a scenario's `[effects]`, changes the
 //! readings exactly as its physics says, and with every effect off the sensors are the nominal
 //! ones bit for bit.
 //!

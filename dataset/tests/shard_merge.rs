@@ -1,4 +1,4 @@
-//! Issue 9: K machines must be able to split a dataset with `--shard I/K` and no coordination,
+//! K machines must be able to split a dataset with `--shard I/K` and no coordination,
 //! and merging their directories (or their shared directory in place) must give the unsharded
 //! dataset byte for byte; a merge of different datasets, or of a run changed after it was made,
 //! must be refused.

@@ -1,4 +1,4 @@
-//! Issue 9: the manifest must say, for every run, its seed, its varied values, what its
+//! The manifest must say, for every run, its seed, its varied values, what its
 //! recording holds and a content hash anyone can recompute from the files with standard tools.
 
 mod common;

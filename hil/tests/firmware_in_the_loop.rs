@@ -1,4 +1,4 @@
-//! Issue 8, firmware in the loop: a client on the two ptys (this test, standing in for a
+//! Firmware in the loop: a client on the two ptys (this test, standing in for a
 //! firmware) drives the simulated robot with `SetMotor` and reads its encoders, sonar and
 //! lidar through the command port, in real time, while the lidar streams on the other port.
 

@@ -1,4 +1,4 @@
-//! Issue 3: the lidar must see the world where it is: beams hit cylinders and walls at the analytic
+//! The lidar must see the world where it is: beams hit cylinders and walls at the analytic
 //! distance, never the robot's own body, each reading from the pose at its own instant, through
 //! the configured mount.
 //!

@@ -1,4 +1,4 @@
-//! Issue 17: a lidar other than the XV-11 — readings 0.5° apart (720 a revolution) or 1,080 a
+//! A lidar other than the XV-11 — readings 0.5° apart (720 a revolution) or 1,080 a
 //! revolution — calibrates with every method (EM, ground truth, landmarks), smooths, and the
 //! landmark detector finds the cylinders. Before, a reading's angle was a whole degree and a
 //! stop's scan had 360 beams.

@@ -1,4 +1,4 @@
-//! Issue 7: the predictive distributions `hilsim diagnose` compares data with are the emulator's
+//! The predictive distributions `hilsim diagnose` compares data with are the emulator's
 //! own: the predicted mean and spread of a reading match those of many emulated readings, on a
 //! surface met obliquely (where the direction noise adds spread) and at an edge (where it splits
 //! the readings between two surfaces).

@@ -1,4 +1,4 @@
-//! Issue 9: a dataset must be the same whatever the number of threads, an interrupted one must
+//! A dataset must be the same whatever the number of threads, an interrupted one must
 //! resume to exactly the dataset an uninterrupted call makes (half-written runs and a stale
 //! manifest left behind), a directory of another dataset must be refused, and a run that fails
 //! must be recorded while the others go on.
@@ -129,7 +129,7 @@ fn a_run_damaged_by_hand_is_named_not_silently_replaced() {
     let dir = tmp.path().join("d");
     let d = small_room(3, &[]);
     d.generate(&dir, &Options::default(), &mut ()).unwrap();
-    // No manifest vouches for the run (one that does is made again: issue 18).
+    // No manifest vouches for the run (one that does is made again).
     fs::remove_file(dir.join("manifest.csv")).unwrap();
     fs::remove_file(dir.join("run-000001/meta.toml")).unwrap();
     let err = d.generate(&dir, &Options::default(), &mut ()).unwrap_err();

@@ -1,4 +1,4 @@
-//! Issue 3: a run must be a pure function of (scenario, seed): the same seed gives the same
+//! A run must be a pure function of (scenario, seed): the same seed gives the same
 //! samples in process and on disk, each sensor draws from its own stream (adding a sonar leaves
 //! the lidar's samples alone), and another seed gives other noise.
 

@@ -1,4 +1,4 @@
-//! Issue 8, firmware faults: a firmware that crashes, hangs, floods the command port or never
+//! Firmware faults: a firmware that crashes, hangs, floods the command port or never
 //! reads the lidar ends the run with that fault, its stderr tail kept, and nothing of it is
 //! left behind: no process of its group, no descriptor of the harness.
 //!

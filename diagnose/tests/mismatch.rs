@@ -1,4 +1,4 @@
-//! Issue 7: the diagnosis names a concealed effect, says "none" when there is none, answers
+//! The diagnosis names a concealed effect, says "none" when there is none, answers
 //! "unexplained" when the mismatch is not in its catalogue, and refuses recordings that are not
 //! runs of the scenario — here against an analytic stand-in for the simulator (a robot driving
 //! along a corridor, a lidar of 36 beams), so the statistics are tested on their own.

@@ -1,4 +1,4 @@
-//! Issue 18, item 6: dataset integrity. Resuming must not re-bless a run whose files no longer
+//! Dataset integrity. Resuming must not re-bless a run whose files no longer
 //! match the content hash its manifest recorded (it is made again, to the same hash); merging
 //! must refuse such a run without ever bringing it into the target, however often it is asked;
 //! shards started at the same instant on a fresh directory (a Slurm job array) must all succeed.
@@ -53,7 +53,7 @@ fn recorded_sha(path: &Path, r: u64) -> String {
 }
 
 #[test]
-fn issue_18_a_truncated_run_is_remade_on_resume_to_its_original_hash() {
+fn a_truncated_run_is_remade_on_resume_to_its_original_hash() {
     let tmp = tempfile::tempdir().unwrap();
     let d = small_room(6, VARIES);
     let dir = tmp.path().join("d");
@@ -120,7 +120,7 @@ fn issue_18_a_truncated_run_is_remade_on_resume_to_its_original_hash() {
 }
 
 #[test]
-fn issue_18_a_run_no_manifest_vouches_for_is_still_trusted_or_named() {
+fn a_run_no_manifest_vouches_for_is_still_trusted_or_named() {
     // Runs made after the last manifest write of an interrupted call are trusted (they were
     // renamed into place whole); one that does not even scan as a run is named, not replaced.
     let tmp = tempfile::tempdir().unwrap();
@@ -144,7 +144,7 @@ fn issue_18_a_run_no_manifest_vouches_for_is_still_trusted_or_named() {
 }
 
 #[test]
-fn issue_18_merge_refuses_a_corrupt_shard_run_and_never_brings_it_in() {
+fn merge_refuses_a_corrupt_shard_run_and_never_brings_it_in() {
     let tmp = tempfile::tempdir().unwrap();
     let d = small_room(7, VARIES);
     let whole = tmp.path().join("whole");
@@ -198,7 +198,7 @@ fn issue_18_merge_refuses_a_corrupt_shard_run_and_never_brings_it_in() {
 }
 
 #[test]
-fn issue_18_merge_in_place_refuses_a_corrupt_run_every_time_and_writes_nothing() {
+fn merge_in_place_refuses_a_corrupt_run_every_time_and_writes_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let d = small_room(6, &[]);
     let shared = tmp.path().join("shared");
@@ -220,7 +220,7 @@ fn issue_18_merge_in_place_refuses_a_corrupt_run_every_time_and_writes_nothing()
 }
 
 #[test]
-fn issue_18_shards_started_at_once_on_a_fresh_directory_all_succeed() {
+fn shards_started_at_once_on_a_fresh_directory_all_succeed() {
     const K: u64 = 4;
     let tmp = tempfile::tempdir().unwrap();
     let d = small_room(9, VARIES);
@@ -253,7 +253,7 @@ fn issue_18_shards_started_at_once_on_a_fresh_directory_all_succeed() {
 }
 
 #[test]
-fn issue_18_another_writers_dataset_toml_in_progress_is_left_alone() {
+fn another_writers_dataset_toml_in_progress_is_left_alone() {
     // What a shard started a moment earlier leaves while it creates dataset.toml: its
     // temporary. The old code removed it (and that shard then failed: `dataset.toml: No such
     // file or directory`); now it is another writer's, left alone until the merge.

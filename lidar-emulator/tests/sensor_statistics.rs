@@ -1,4 +1,4 @@
-//! Issue 3: the sensors' noise must be the configured model: the lidar's bias polynomial and
+//! The sensors' noise must be the configured model: the lidar's bias polynomial and
 //! β₂d² spread recovered by fits over 10⁵ readings, the sonar's cone, the odometer's slip and
 //! ticks.
 //!

@@ -1,4 +1,4 @@
-//! Issue 9: run r of a dataset must be a function of (S, r) alone, and each varied value of
+//! Run r of a dataset must be a function of (S, r) alone, and each varied value of
 //! (S, r, KEY) alone, drawn uniformly in its range; a `--vary` that cannot work is refused
 //! before any run, naming the key.
 

@@ -1,4 +1,4 @@
-//! Issue 15: the commonest real mismatches as `[effects]`: a lidar mounted rotated or
+//! The commonest real mismatches as `[effects]`: a lidar mounted rotated or
 //! off-centre, sensors whose timestamps lag, wheels whose radii are not nominal, an effective
 //! wheel base that is not the nominal one. Each changes the recording exactly as its physics
 //! says, and `meta.toml` keeps what the scenario declares.

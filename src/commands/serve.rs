@@ -3,6 +3,7 @@
 
 use std::io::{IsTerminal, Write};
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use hilsim_hil::faults::WireFaults;
@@ -42,7 +43,11 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         .unwrap_or_default();
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
-    let stop = AtomicBool::new(false);
+    // Ctrl-C (or SIGTERM, SIGHUP) ends the stream and still prints what was sent; a second
+    // one ends the process at once.
+    let stop = Arc::new(AtomicBool::new(false));
+    hilsim_hil::hil_run::stop_on_signals(Arc::clone(&stop))
+        .context("cannot set up signal handling")?;
     // Validation has checked the table: its faults resolve.
     let link_faults = scenario.link.faults().unwrap_or_default();
     let wire_faults = || WireFaults::new(&link_faults, scenario.seed);
@@ -94,6 +99,7 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
                 "p99": s.lateness_quantile(0.99).map(|d| d.as_secs_f64() * 1e3),
             },
             "link_faults": report.link_faults,
+            "interrupted": report.interrupted,
         });
         writeln!(out, "{json}")?;
         return Ok(());
@@ -105,6 +111,9 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     )?;
     if let Some(lateness) = s.lateness_summary() {
         write!(out, "; {lateness}")?;
+    }
+    if report.interrupted {
+        write!(out, " (interrupted)")?;
     }
     writeln!(out)?;
     if let Some(faults) = &report.link_faults {

@@ -425,3 +425,27 @@ fn serve_refuses_a_link_wobble_as_large_as_the_rpm() {
     );
     assert!(err.contains("smaller than the rpm"), "{err}");
 }
+
+/// Ctrl-C ends a stream that would otherwise run on, and `serve` still says what it sent, marks
+/// the run interrupted and exits 0.
+#[test]
+fn ctrl_c_ends_serve_with_its_summary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let long = SHORT.replace("duration_s = 3.0", "duration_s = 600.0");
+    std::fs::write(tmp.path().join("long.toml"), long).unwrap();
+    let mut server = serve(tmp.path(), &["long.toml", "--realtime"]);
+    std::thread::sleep(Duration::from_millis(700));
+    let killed = Command::new("kill")
+        .args(["-INT", &server.child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = server.child.wait().unwrap();
+    let mut rest = String::new();
+    server.stdout.read_to_string(&mut rest).unwrap();
+    assert_eq!(status.code(), Some(0), "{rest}");
+    assert!(
+        rest.contains("revolutions sent") && rest.trim_end().ends_with("(interrupted)"),
+        "{rest}"
+    );
+}

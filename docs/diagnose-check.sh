@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces the figures of docs/diagnose.md's Limits section:
+# Checks the diagnosis on every checked-in scenario and each catalogued effect (docs/diagnose.md):
 #   bash docs/diagnose-check.sh effects   # each effect concealed in diagnose-room (seed 77),
 #                                         # diagnosed with truth.csv and without it
 #   bash docs/diagnose-check.sh nominal   # faithful runs of every checked-in scenario (its own

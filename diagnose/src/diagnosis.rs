@@ -247,10 +247,9 @@ pub fn diagnose_with_progress(
 /// Share of the normal score of a sensor's main structure (its strongest counting test under
 /// the nominal model) at or above which its named effects are taken to leave it standing: the
 /// score of a χ² statistic grows as its cube root, so 0.95 of the score is 86 % of the
-/// statistic. Measured: a periodic range error outside the catalogue keeps 0.98–0.995 of its
-/// main structure's score under the lidar effects that each mimic a part of it; the foreign
-/// recordings' concealed incidence and warm-up, beside structure of the other simulator's own,
-/// keep 0.88 and 0.80 (`docs/diagnose.md`).
+/// statistic. A periodic range error outside the catalogue keeps nearly all (0.98 and more) of
+/// its main structure's score under the lidar effects that each mimic a part of it, while a
+/// real effect beside another simulator's own structure leaves much less (0.8–0.9) standing.
 const MAX_MAIN_LEFT: f64 = 0.95;
 /// Share of the main structure's size (metres) the named effects may leave.
 const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
@@ -693,9 +692,8 @@ fn misaligned_evidence(sensor: Sensor, wild: f64) -> Evidence {
 /// each was estimated under, and the refit against that estimate): the root of the refit's
 /// change `h(s) = refit(s) − s` by the secant through the last two rounds — by regula falsi
 /// within the last pair that brackets it, once one does. Plain iteration `s ← refit(s)`
-/// converges only as fast as the scan matching gives the effect back (measured on independent
-/// motion-skew trials: a fifth to a third of the remaining gap a round, 0.048 → 0.160 s in four
-/// rounds where the truth is 0.2 s); `None` (iterate) until two rounds differ.
+/// converges only as fast as the scan matching gives the effect back (for motion skew, a fifth
+/// to a third of the remaining gap a round); `None` (iterate) until two rounds differ.
 fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
     let h = |(s, refit): (f64, f64)| (s, refit - s);
     let (b, hb) = h(*rounds.last()?);
@@ -725,9 +723,9 @@ fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
 /// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
 /// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
 /// fit has only the sonar's ranges and a crab of the heading against the direction of travel
-/// (`cos ψ` of each step), which mimic a wheel's radius: measured on the other simulator's
-/// straight runs in front of a board (`board-b`, `board-d`, no turns), a "mount" of 6.3° and
-/// 0.1 m was fitted and named. A quarter turn with a 1 cm offset is 16 mm of travel.
+/// (`cos ψ` of each step), which mimic a wheel's radius: on a straight run in front of a board a
+/// "mount" of degrees and decimetres fits. A quarter turn with a 1 cm offset is 16 mm of
+/// travel.
 const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 
 /// Against a path estimated from the lidar, a lidar mount offset goes into the path: scan
@@ -819,9 +817,8 @@ fn through_path(
     // are judged again along the path it puts back, and dropped if it took their place) …
     let alone = fitted_on(&Hypothesis::nominal())
         .filter(|(gain, best)| *gain > explained + options.min_gain && earns(best));
-    // … or, beside them, gain on top of what they explain: measured, a mount of −2.4° beside
-    // wheels' radii of 0.97 and 0.98 gained less alone than the radii's 4,100 nats, and was
-    // lost (self-test trial 70, independent reality, without truth).
+    // … or, beside them, gain on top of what they explain: a mount of a few degrees beside
+    // wheels' radii a few percent off gains less alone than the radii do, and would be lost.
     let found = match alone {
         Some(found) => Some(found),
         None if !beside.is_empty() => fitted_on(&hypothesis_of(&beside))
@@ -856,9 +853,9 @@ fn through_path(
 /// Against an estimated trajectory a lidar effect was partly absorbed into the scan matching
 /// (fitted with the nominal model): the trajectory is estimated again under the named lidar
 /// effects' fitted model and each is refitted against it in turn, strongest first, the others
-/// held at their fits (a second effect's part stays in the path otherwise: measured, a warm-up
-/// beside a concealed motion skew left its settling in the path, which the encoders showed as
-/// a wheel radius and a delay). Returns the named effects and, when one was refitted, the
+/// held at their fits (a second effect's part stays in the path otherwise: a warm-up beside a
+/// motion skew leaves its settling in the path, which the encoders show as a wheel radius and a
+/// delay). Returns the named effects and, when one was refitted, the
 /// trajectory the last rests on (`candidates` and the lidar's `data` then follow it).
 fn realign_lidar(
     ctx: &Context<'_>,
@@ -1052,9 +1049,9 @@ mod tests {
 
     #[test]
     fn the_realignment_reaches_a_slowly_given_back_effect_within_its_rounds() {
-        // Motion skew of 0.2 s seen from 0.048 s, given back a fifth to a third a round (the
-        // measured independent trials 3 and 19): plain iteration is still 20 % short after
-        // six rounds; the secant settles within 2 % of the truth.
+        // Motion skew of 0.2 s seen from 0.048 s, given back a fifth to a third a round, as the
+        // scan matching gives it back: plain iteration is still 20 % short after six rounds; the
+        // secant settles within 2 % of the truth.
         let share = |s: f64| 0.2 + 0.6 * s;
         let settled = rounds_to_settle(0.2, 0.048, share).expect("settles");
         assert!((settled - 0.2).abs() < 0.02 * 0.2, "{settled}");

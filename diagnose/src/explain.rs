@@ -81,9 +81,7 @@ fn total_ll(ctx: &Context<'_>, data: &SensorData, h: &Hypothesis, rows: &[usize]
 /// are then the readings' least-squares-like match, which that error does not bias but only
 /// makes less certain (so it enters the scoring, [`total_ll`]); conditioned on the readings
 /// before, the likelihood is flat along what the shared error could also explain, and a mount
-/// fitted through the encoders by it was measured to land far off (independent trial 14 of
-/// `--self-test 100 --seed 1 --reality independent --without-truth`: −5.9° and −33 mm for
-/// −1.23° and −15 mm).
+/// fitted through the encoders by it lands far off (several times its size).
 fn fit_ll(ctx: &Context<'_>, data: &SensorData, h: &Hypothesis, rows: &[usize]) -> f64 {
     summed_ll(data, rows, &ctx.predict_unconditioned(data, h, rows))
 }

@@ -44,10 +44,9 @@ pub struct Options {
 /// How well the timing of a path estimated from the lidar is known, seconds. Each revolution's
 /// correction is held at the revolution's middle and the dead reckoning follows the commands
 /// between them, so the path lags or leads the robot by a few milliseconds wherever the
-/// robot's response to its commands or a lidar effect bends it. Measured
-/// (`--self-test 100 --seed 1 --reality independent --without-truth`): beside a concealed motor
-/// lag, incidence or speed of sound the encoders' delay fits 7.7–12.2 ms (trials 44, 56, 63,
-/// 75), in faithful trials 0.5–5.4 ms (`--only none --seed 5`); the self-test's concealed
+/// robot's response to its commands or a lidar effect bends it: beside a motor lag, an incidence
+/// or a speed of sound the encoders' delay fits up to about 12 ms, in faithful runs a few
+/// milliseconds (`--self-test 100 --only none --without-truth`); the self-test's concealed
 /// delays are 20–80 ms.
 pub const ESTIMATED_PATH_TIMING_S: f64 = 0.015;
 
@@ -55,10 +54,8 @@ pub const ESTIMATED_PATH_TIMING_S: f64 = 0.015;
 /// metres, whether the mount is fitted in the lidar or through the sonar and the encoders. The
 /// path takes up most of a mount, and it is bent systematically by a lidar effect the matching
 /// does not model (an incidence, a reflectivity walk, motion skew), which a mount of a few
-/// millimetres mimics: measured (`--self-test 100 --seed 1 --reality independent
-/// --without-truth`) 2–8 mm "mounts" beside a concealed incidence, skew, reflectivity or sonar
-/// delay (trials 19, 26, 37, 44, 50, 67, 74, 84, 91), the yaw then 0.02–2.7° and meaningless.
-/// The self-test conceals 1–3 cm in each of x and y.
+/// millimetres mimics: 2–8 mm "mounts", with a meaningless yaw, fit beside an incidence, a motion
+/// skew, a reflectivity walk or a sonar delay. The self-test conceals 1–3 cm in each of x and y.
 pub const ESTIMATED_MOUNT_MIN_M: f64 = 0.01;
 
 impl Default for Options {

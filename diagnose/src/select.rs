@@ -55,10 +55,9 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
 /// whose τ it barely outlasts, as `a_warmup_of_the_constant_term_is_named_not_a_mount_offset`
 /// conceals τ = 15 s in 17 s). A drift that outlasts the
 /// run is a constant range error over it, which the warm-up's `(c + k d²) e^{−t/τ}` mimics at
-/// τ far beyond the run and a unit's warm-up is not: measured (`--self-test 100 --seed 1
-/// --reality independent --without-truth`, trials 47 and 67) a "warm-up" of τ ≈ 990 s with
-/// `k = −0.00055 /m` beside a concealed reflectivity, the other simulator's reflectivity taking
-/// another form than the catalogue's. The self-test conceals τ of 5–20 s in 60 s runs.
+/// τ far beyond the run and a unit's warm-up is not: without truth, a range error of another
+/// form than the catalogue's (a reflectivity walk written otherwise) is fitted as a "warm-up" of
+/// τ in the hundreds of seconds. The self-test conceals τ of 5–20 s in 60 s runs.
 const WARMUP_SETTLED_SHARE: f64 = 1.0;
 
 /// Whether `c`, a lidar warm-up, is seen to settle within the readings it was scored on
@@ -289,7 +288,7 @@ mod tests {
     }
 
     /// A warm-up whose time constant outlasts the 60 s it was seen over is a constant range
-    /// error there, not named (what trials 47 and 67 fitted beside a reflectivity: τ ≈ 990 s);
+    /// error there, not named (as fitted beside a reflectivity of another form: τ ≈ 990 s);
     /// one that settles within it is.
     #[test]
     fn a_warmup_that_does_not_settle_within_the_run_is_not_named() {

@@ -3,7 +3,7 @@
 //! ([`CommandPort::feed`]); replies come out into a buffer; what a reply says about the robot
 //! comes from a [`Robot`], so nothing here reads a clock or a port.
 //!
-//! The subset (README "Firmware in the loop" is the user's copy):
+//! The subset (`docs/hil.md` is the user's copy):
 //! - a request is one line ending in `\n`, `\r\n` or `\r`; empty lines are ignored; commands
 //!   and parameter names are case-insensitive; a line longer than [`MAX_LINE`] bytes is
 //!   refused;

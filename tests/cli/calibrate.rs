@@ -368,7 +368,8 @@ fn landmarks_and_groundtruth_pass_their_checks_on_their_runs() {
 /// drive's speed error identifiable. Straight-board at seed 3 draws a speed error the commands
 /// do not know: without the prior EM's lidar model scores an MSE ratio of 5.3, with it 86 (the
 /// true model's is 87.5; `python3 docs/em-priors-check.py` measures 24 runs). Tolerances: at
-/// least 1.5× the ratio without the prior and 50 (0.57 of the true model's), as the issue asks.
+/// least 1.5× the ratio without the prior and 50 (0.57 of the true model's): the prior must
+/// recover most of what the speed error costs.
 #[test]
 fn a_prior_on_the_sonar_scale_recovers_the_lidar_model() {
     let tmp = tempfile::tempdir().unwrap();

@@ -304,8 +304,8 @@ fn without_truth_a_lidar_mount_offset_is_named_through_the_other_sensors() {
 
 /// Without truth a lidar delay goes into the path estimated from the lidar (the
 /// matching puts each pose at its scan's late stamp); it is named through the sonar and the
-/// encoders, within 20 % (before: trial 1 of seed 3, a 65 ms lidar delay, came out a wheel slip
-/// of 66 ms with the speed of sound beside it). Trial 0 conceals a sonar delay.
+/// encoders, within 20 %, not as a wheel slip of its size with a speed of sound beside it. At
+/// seed 3 the self-test's second trial conceals a lidar delay (its first, a sonar delay).
 #[test]
 fn without_truth_a_lidar_delay_is_named_through_the_other_sensors() {
     both_named_without_truth("sensor_latency", 3);

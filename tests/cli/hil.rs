@@ -27,7 +27,7 @@ fn short_approach(dir: &Path) -> PathBuf {
 
 /// The example firmware, built once per test run (the `hilsim` package cannot depend on a
 /// binary-only package, so the test asks cargo for it; a no-op when it is up to date).
-fn example_firmware() -> &'static Path {
+pub(super) fn example_firmware() -> &'static Path {
     static BUILT: OnceLock<PathBuf> = OnceLock::new();
     BUILT.get_or_init(|| {
         let bin_dir = Path::new(env!("CARGO_BIN_EXE_hilsim")).parent().unwrap();

@@ -14,6 +14,7 @@ mod import_ros1;
 mod lidar_models;
 mod limits;
 mod outputs;
+mod readme;
 mod record;
 mod report;
 mod ros2;

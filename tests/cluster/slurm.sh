@@ -1,5 +1,5 @@
 #!/bin/bash
-# A real cluster: the README's Slurm job-array example ("Datasets", Sharding) run on a
+# A real cluster: the Slurm job-array example of docs/datasets.md (Sharding) run on a
 # single-node Slurm cluster, and the merged dataset compared byte for byte with the unsharded one.
 #
 # Usage, as root:  tests/cluster/slurm.sh [HILSIM]     (HILSIM: default the release binary, built
@@ -195,7 +195,7 @@ job_states() {
     scontrol -o show job "$1" | sed -E 's/.*JobState=([A-Z_]+).* ExitCode=([0-9:]+).*/\1 \2/'
 }
 
-# 3. The README's example: a job array, one task per shard, into one fresh shared directory;
+# 3. The example of docs/datasets.md: a job array, one task per shard, into one fresh shared directory;
 # then the merge, submitted to run after the array.
 DATA=$T/sharded
 cat >"$T/dataset.sbatch" <<EOF

@@ -360,9 +360,8 @@ impl Effect {
     /// pose (it weighs the near readings most, and the pose shifts away from them), and the
     /// realignment gives it back (`realign_lidar` in the diagnosis settles each term apart, by
     /// rounds of estimating the path under it, and keeps the one the lidar's held-out readings
-    /// favour). Held at zero there until session 10, a warm-up drawn in that term was
-    /// fitted in its quadratic term (median error 44 %) and its early position error named as a
-    /// wheel radius or slip; a drift that does not settle within the run, which the term freed
+    /// favour). Held at zero, a warm-up drawn in that term would be fitted in its quadratic
+    /// term and its early position error named as a wheel radius or slip; a drift that does not settle within the run, which the term freed
     /// took up beside a concealed reflectivity, is not named (`select::earns_place`).
     ///
     /// The incidence's two terms, a diverging beam's `κ d tan θ` and a collimated one's

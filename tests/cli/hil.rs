@@ -443,7 +443,8 @@ fn a_daemon_that_escaped_the_firmware_is_reported_and_killed() {
 }
 
 /// A firmware that reads the lidar but never drives fails the scenario's `when =
-/// "hil"` assertion on where the robot stops: exit 1, and the summary says which.
+/// "hil"` assertion on where the robot stops, and, as `cat` exits 1 when its port closes at the
+/// run's end, the one on its exit code: exit 1, and the summary says which.
 #[test]
 fn a_failed_assertion_under_hil_exits_1_and_says_which() {
     let tmp = tempfile::tempdir().unwrap();
@@ -464,7 +465,7 @@ fn a_failed_assertion_under_hil_exits_1_and_says_which() {
     assert!(text.contains("FAIL sim.final_x_m = 2.5"), "{text}");
     assert!(text.contains("PASS hil.fault = 0"), "{text}");
     assert!(
-        text.contains("1 of 5 assertion(s) failed: sim.final_x_m"),
+        text.contains("2 of 6 assertion(s) failed: sim.final_x_m, hil.firmware_exit_code"),
         "{text}"
     );
     // `--json` ends with one object saying the same.
@@ -493,7 +494,7 @@ fn a_failed_assertion_under_hil_exits_1_and_says_which() {
         .filter(|e| e["passed"] == false)
         .map(|e| e["metric"].as_str().unwrap())
         .collect();
-    assert_eq!(failed, ["sim.final_x_m"]);
+    assert_eq!(failed, ["sim.final_x_m", "hil.firmware_exit_code"]);
     assert!(j["firmware"]["status"].is_string(), "{j}");
 }
 

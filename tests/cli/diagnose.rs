@@ -282,8 +282,8 @@ fn both_named_without_truth(only: &str, seed: u64) -> String {
     text
 }
 
-/// Without truth a concealed motor lag (before: `none`, the drive was not diagnosed)
-/// is named in both trials, its time constant within 20 %, and no other effect is named.
+/// Without truth a concealed motor lag (the drive judged against a path that follows the
+/// encoders) is named in both trials, its time constant within 20 %, and no other effect is named.
 #[test]
 fn without_truth_a_motor_lag_is_named_from_the_drive() {
     let text = both_named_without_truth("drive_motor_lag", 1);
@@ -295,7 +295,7 @@ fn without_truth_a_motor_lag_is_named_from_the_drive() {
 }
 
 /// Without truth a lidar mount offset goes into the path estimated from the lidar
-/// (before: the wheels' geometry and the speed of sound were named in its place); it is named
+/// (where the wheels' geometry and the speed of sound would take its place); it is named
 /// through the sonar and the encoders in both trials, within 20 %.
 #[test]
 fn without_truth_a_lidar_mount_offset_is_named_through_the_other_sensors() {

@@ -5,6 +5,9 @@
 //! other numbers' shortest digits come from Żmij (`zmij`, by the author of `ryu` and `itoa`),
 //! with its notation and its rounding of exact ties changed to `Display`'s, so recordings keep
 //! their bytes.
+//!
+//! The way back from a float32 (a ROS message's field) to the decimal it was written as,
+//! [`decimal_of_f32`], lives here too: an imported range is then written as it was sent.
 
 /// Where CSV text goes: a `String` (a whole table) or a byte buffer (a streamed table's).
 pub(crate) trait Text {
@@ -429,9 +432,176 @@ pub(crate) fn push_int(out: &mut impl Text, n: impl Into<u64>) {
     out.push_short(|bytes| write_unsigned(bytes, n));
 }
 
+/// A float32 field as the decimal it was written as: the shortest decimal that reads back as
+/// that float32 (`1.234`, not `1.2339999675750732`), so that millimetre ranges stay millimetres
+/// and a recording exported and imported keeps its numbers.
+#[must_use]
+pub fn decimal_of_f32(x: f32) -> f64 {
+    if !x.is_finite() {
+        return f64::from(x);
+    }
+    if let Some((digits, scale)) = short_decimal_of_f32(x) {
+        let decimal = digits as f64 / POWERS_OF_TEN[scale as usize];
+        return if x < 0.0 { -decimal } else { decimal };
+    }
+    let mut buffer = zmij::Buffer::new();
+    buffer
+        .format_finite(x)
+        .parse()
+        .unwrap_or_else(|_| f64::from(x))
+}
+
+/// `x`'s decimal, as its digits and the power of ten they are divided by, when it has at most
+/// 6 significant digits (millimetre ranges, `0.5`, `12.25`), found without formatting; `None`
+/// otherwise (and outside 1e-10..1e6).
+///
+/// Two different decimals of at most 6 significant digits (`f32::DIGITS`) are never read as
+/// the same normal `f32`, so one that reads as `x` is the only one as short: the shortest, the
+/// one [`decimal_of_f32`] gives. The 6-digit decimals are 10⁻ˢ apart, 10 to 100 times the
+/// float32's step, so only the one closest to `x` can read as `x`: n·10⁻ˢ for n the whole
+/// number closest to |x|·10ˢ, with s such that n has 6 digits.
+pub fn short_decimal_of_f32(x: f32) -> Option<(u64, u32)> {
+    let magnitude = f64::from(x).abs();
+    if !(1e-10..1e6).contains(&magnitude) {
+        return None;
+    }
+    let bits = x.abs().to_bits();
+    let e = i32::try_from(bits >> 23).unwrap_or(0) - 127;
+    // Within half a step of `x` towards either neighbour, a decimal reads as `x`; the margin
+    // of one part in 10⁶ is far above the f64 rounding of the products (10⁻¹⁶), so that no
+    // double rounding decides. The step is 2^(e−23), and half that below a power of two.
+    let step = f64::from_bits(u64::try_from(e - 23 + 1023).unwrap_or(0) << 52);
+    let half_step = if bits & 0x007F_FFFF == 0 {
+        0.25 * step
+    } else {
+        0.5 * step
+    } * (1.0 - 1e-6);
+    // Millimetres first (most lidars' and sonars' ranges): n·10⁻³ with n < 10⁶ has at most
+    // 6 significant digits, so if it reads as `x` it is the one such decimal.
+    let millimetres = magnitude * 1e3;
+    let n = round_half_away(millimetres);
+    if n < 1e6 && (n - millimetres).abs() < half_step * 1e3 {
+        return Some((n as u64, 3));
+    }
+    let s = POWERS_OF_TEN.iter().position(|p| magnitude * p >= 1e5)?;
+    let power = POWERS_OF_TEN[s];
+    let scaled = round_half_away(magnitude * power);
+    // n ≥ 10⁵ by the choice of s: n ≤ 10⁶ has at most 6 significant digits. (A power one
+    // off at a boundary makes 7 digits, or a decimal that misses `x`: `None` either way.)
+    if scaled > 1e6 {
+        return None;
+    }
+    // The f64 closest to n·10⁻ˢ (n and 10ˢ are exact: one rounding), what parsing the
+    // decimal gives.
+    let decimal = scaled / power;
+    // n ≤ 10⁶ and s ≤ 15: both exact in their integer types.
+    ((decimal - magnitude).abs() < half_step).then_some((scaled as u64, s as u32))
+}
+
+/// 10⁰ to 10¹⁵, each exact in an `f64`.
+const POWERS_OF_TEN: [f64; 16] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+];
+
+/// `f64::round` (half away from zero) without its call into the C library, which the
+/// baseline x86-64 target has no instruction for: it was a tenth of an import's time.
+#[must_use]
+pub fn round_half_away(x: f64) -> f64 {
+    // 2⁵²: from here on every f64 is whole (and NaN, ±inf pass through).
+    if x.is_nan() || x.abs() >= 4_503_599_627_370_496.0 {
+        return x;
+    }
+    // |x| < 2⁵²: the cast truncates exactly, and `x - whole` is exact.
+    let whole = x as i64 as f64;
+    let fraction = x - whole;
+    if fraction >= 0.5 {
+        whole + 1.0
+    } else if fraction <= -0.5 {
+        whole - 1.0
+    } else {
+        // Keeps the sign of a zero, as `round` does.
+        whole.copysign(x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn float32_fields_keep_their_decimals() {
+        assert_eq!(decimal_of_f32(1.234), 1.234);
+        assert_eq!(decimal_of_f32(0.5), 0.5);
+        assert_eq!(decimal_of_f32(6.0), 6.0);
+    }
+
+    /// The short path gives what formatting the float32's shortest decimal and reading it does,
+    /// for every float32 between 1e-11 and 1e7 in steps of a prime number of bit patterns.
+    #[test]
+    fn short_decimals_are_the_shortest() {
+        let slow = |x: f32| -> f64 { zmij::Buffer::new().format_finite(x).parse().unwrap() };
+        let (low, high) = (1e-11f32.to_bits(), 1e7f32.to_bits());
+        let mut short = 0;
+        for bits in (low..high).step_by(997) {
+            for x in [f32::from_bits(bits), -f32::from_bits(bits)] {
+                assert_eq!(decimal_of_f32(x), slow(x), "{x:e}");
+                short += usize::from(short_decimal_of_f32(x).is_some());
+            }
+        }
+        for text in [
+            "1.234", "0.001", "65.535", "12.3456", "0.000123", "1000", "0.5", "99999.9", "10",
+            "123456", "1e-9",
+        ] {
+            let x: f32 = text.parse().unwrap();
+            let expected: f64 = text.parse().unwrap();
+            for x in [x, -x] {
+                let (digits, scale) = short_decimal_of_f32(x).unwrap();
+                assert_eq!(digits as f64 / 10f64.powi(scale as i32), expected, "{text}");
+                assert_eq!(decimal_of_f32(x), expected.copysign(f64::from(x)), "{text}");
+            }
+        }
+        assert_eq!(short_decimal_of_f32(1.234_567_8), None);
+        assert!(short > 0);
+        // Every millimetre range to 100 m (the fast path of an import) is short.
+        for mm in 1..100_000u32 {
+            let x = mm as f32 / 1000.0;
+            let (digits, scale) = short_decimal_of_f32(x).unwrap();
+            assert_eq!(
+                digits as f64 / 10f64.powi(scale as i32),
+                f64::from(mm) / 1e3
+            );
+        }
+    }
+
+    #[test]
+    fn rounding_is_round() {
+        let mut x = 1e-3f64;
+        for _ in 0..2000 {
+            for v in [
+                x,
+                -x,
+                x + 0.5,
+                -x - 0.5,
+                x.floor() + 0.5,
+                -(x.floor() + 0.5),
+            ] {
+                assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+            }
+            x *= 1.037;
+        }
+        for v in [
+            0.0,
+            -0.0,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4.5e15 + 0.5,
+        ] {
+            assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+        }
+        for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300] {
+            assert_eq!(round_half_away(v).to_bits(), v.round().to_bits(), "{v:e}");
+        }
+    }
+
     use proptest::prelude::*;
 
     /// As a whole table's `String` and a streamed table's bytes write it (the two must agree).

@@ -40,11 +40,12 @@ pub use atomic::{
     write_file_atomically, write_owned_file_atomically, AtomicFile, FileKind, OutputTarget,
 };
 pub use background::BackgroundStream;
+pub use decimal::{decimal_of_f32, round_half_away, short_decimal_of_f32};
 pub use error::{Error, ErrorKind};
 pub use input::{read_small_text, MAX_META_BYTES};
 pub use meta::{Meta, Mount, RobotMeta, SonarMount, SourceMeta, WorldMeta, FORMAT};
 pub use names::{Method, Sensor};
-pub use pose::{wrap_angle, Pose};
+pub use pose::{body_travel, wrap_angle, DeadReckoning, Pose};
 pub use printable::{printable, printable_cut, MAX_NAME_CHARS};
 pub use rows::{RecordingDir, Rows};
 pub use samples::{

@@ -41,13 +41,28 @@ impl Pose {
     /// (exact for a constant-curvature arc to second order in the turn).
     #[must_use]
     pub fn drive(&self, left_m: f64, right_m: f64, wheel_base_m: f64) -> Self {
-        let forward = (left_m + right_m) / 2.0;
-        let turn = (right_m - left_m) / wheel_base_m;
+        let (forward, turn) = body_travel(left_m, right_m, wheel_base_m);
         let mid = self.yaw + turn / 2.0;
         Self::new(
             self.x + forward * mid.cos(),
             self.y + forward * mid.sin(),
             self.yaw + turn,
+        )
+    }
+
+    /// The wheel travel (left, right) that drives this pose to `next` ([`Pose::drive`]'s
+    /// inverse): the turn is the heading's change the shorter way, the forward travel the
+    /// displacement along the heading halfway through the turn, and the wheels, `wheel_base_m`
+    /// apart, travel the forward travel ∓ half the turn times the wheel base. Exact for a
+    /// step that [`Pose::drive`] can make (a sideways displacement is dropped).
+    #[must_use]
+    pub fn wheel_travel_to(&self, next: &Pose, wheel_base_m: f64) -> (f64, f64) {
+        let turn = wrap_angle(next.yaw - self.yaw);
+        let heading = self.yaw + 0.5 * turn;
+        let forward = (next.x - self.x) * heading.cos() + (next.y - self.y) * heading.sin();
+        (
+            forward - 0.5 * turn * wheel_base_m,
+            forward + 0.5 * turn * wheel_base_m,
         )
     }
 
@@ -93,6 +108,51 @@ impl Pose {
     }
 }
 
+/// How a differential drive's body moves when its wheels, `wheel_base_m` apart, travel
+/// `left_m` and `right_m`: forward by their mean (metres) and turning by their difference over
+/// the wheel base (radians, counter-clockwise).
+#[must_use]
+pub fn body_travel(left_m: f64, right_m: f64, wheel_base_m: f64) -> (f64, f64) {
+    ((left_m + right_m) / 2.0, (right_m - left_m) / wheel_base_m)
+}
+
+/// A pose dead-reckoned from a differential drive's cumulative wheel travel (what its encoders
+/// count): each reading's travel since the one before moves the pose by [`Pose::drive`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DeadReckoning {
+    /// The last reading's (left, right) travel, metres.
+    last_m: Option<(f64, f64)>,
+    pose: Pose,
+}
+
+impl DeadReckoning {
+    /// Dead reckoning from `start`: the first reading is where the wheels' count starts.
+    #[must_use]
+    pub fn new(start: Pose) -> Self {
+        Self {
+            last_m: None,
+            pose: start,
+        }
+    }
+
+    /// Takes a reading of the wheels' cumulative travel and drives the pose by the travel
+    /// since the last; returns the body's forward travel (metres) and turn (radians) over
+    /// that step ([`body_travel`]), `None` at the first reading.
+    pub fn step(&mut self, left_m: f64, right_m: f64, wheel_base_m: f64) -> Option<(f64, f64)> {
+        let last = self.last_m.replace((left_m, right_m));
+        let (left0, right0) = last?;
+        let (dl, dr) = (left_m - left0, right_m - right0);
+        self.pose = self.pose.drive(dl, dr, wheel_base_m);
+        Some(body_travel(dl, dr, wheel_base_m))
+    }
+
+    /// The pose at the last reading.
+    #[must_use]
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+}
+
 /// Wraps an angle into (-π, π].
 #[must_use]
 pub fn wrap_angle(a: f64) -> f64 {
@@ -123,6 +183,56 @@ mod tests {
             "{pose:?}"
         );
         assert!((pose.yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    }
+
+    /// Driving by the wheel travel [`Pose::wheel_travel_to`] finds gives that travel back,
+    /// for straight steps, turns on the spot and arcs either way, across the ±π seam.
+    #[test]
+    fn wheel_travel_inverts_driving() {
+        let base = 0.23;
+        for start in [
+            Pose::new(0.0, 0.0, 0.0),
+            Pose::new(1.5, -2.0, 3.1),
+            Pose::new(-0.3, 0.7, -3.0),
+        ] {
+            for (left, right) in [
+                (0.1, 0.1),
+                (-0.05, 0.05),
+                (0.02, 0.13),
+                (0.3, -0.01),
+                (-0.2, -0.25),
+                (0.0, 0.0),
+            ] {
+                let next = start.drive(left, right, base);
+                let (l, r) = start.wheel_travel_to(&next, base);
+                assert!(
+                    (l - left).abs() < 1e-12 && (r - right).abs() < 1e-12,
+                    "{start:?} {left} {right}: {l} {r}"
+                );
+                let again = start.drive(l, r, base);
+                assert!((again.x - next.x).abs() < 1e-12 && (again.y - next.y).abs() < 1e-12);
+                assert!(wrap_angle(again.yaw - next.yaw).abs() < 1e-12);
+            }
+        }
+    }
+
+    /// Dead reckoning a run of encoder readings lands where driving each step does, and the
+    /// steps it gives back are the body's travel.
+    #[test]
+    fn dead_reckoning_accumulates_drives() {
+        let base = 0.2;
+        let readings = [(1.0, 2.0), (1.1, 2.12), (1.25, 2.2), (1.25, 2.3)];
+        let mut reckoning = DeadReckoning::new(Pose::new(0.5, 0.0, 1.0));
+        assert_eq!(reckoning.step(1.0, 2.0, base), None);
+        assert_eq!(reckoning.pose(), Pose::new(0.5, 0.0, 1.0));
+        let mut pose = Pose::new(0.5, 0.0, 1.0);
+        for w in readings.windows(2) {
+            let (dl, dr) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
+            pose = pose.drive(dl, dr, base);
+            let step = reckoning.step(w[1].0, w[1].1, base);
+            assert_eq!(step, Some(body_travel(dl, dr, base)));
+            assert_eq!(reckoning.pose(), pose);
+        }
     }
 
     #[test]

@@ -44,9 +44,9 @@ pub use export::{
     export, export_dir, export_with, ExportOptions, ExportReport, World, MAX_SCAN_READINGS,
     START_NS,
 };
+pub use hilsim_recording::decimal_of_f32;
 pub use import::{
-    angle_deg, decimal_of_f32, import, read_file, Converter, Encoding, Fault, ImportOptions,
-    ImportReport,
+    angle_deg, import, read_file, Converter, Encoding, Fault, ImportOptions, ImportReport,
 };
 pub use tf::Source as TfSource;
 pub use topics::{Kind, Role};

@@ -9,7 +9,7 @@ use hilsim_recording::{
     CommandSample, LidarSample, OdometrySample, SampleSink, SonarSample, TruthSample,
 };
 
-use super::START_NS;
+use super::options::START_NS;
 use crate::Error;
 
 /// What the messages need from whole tables before the first is written: the scans' and the

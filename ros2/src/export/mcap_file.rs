@@ -9,7 +9,7 @@ use std::path::Path;
 use mcap::records::MessageHeader;
 use mcap::write::NoSeek;
 
-use super::ExportReport;
+use super::options::ExportReport;
 use crate::cdr::encode;
 use crate::definitions::schema_text;
 use crate::Error;

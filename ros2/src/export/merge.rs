@@ -4,7 +4,7 @@
 
 use hilsim_recording::{CommandSample, LidarSample, OdometrySample, SonarSample, TruthSample};
 
-use super::Stream;
+use super::source::Stream;
 use crate::Error;
 
 /// The most readings one `/scan` message holds: a longer revolution (rows of one `rev`) is sent

@@ -3,7 +3,7 @@
 
 use hilsim_recording::LidarSample;
 
-use super::{stamp_ns, World, START_NS};
+use super::options::{stamp_ns, World, START_NS};
 use crate::msgs::{
     ColorRgba, Header, LaserScan, Marker, MarkerArray, Pose, Quaternion, Time, Transform,
     TransformStamped, Twist, Vector3,

@@ -5,7 +5,7 @@ use hilsim_recording::{DeadReckoning, OdometrySample};
 
 use super::merge::Head;
 use super::messages::{pose, twist};
-use super::Stream;
+use super::source::Stream;
 use crate::msgs::{Pose, Twist};
 use crate::Error;
 

@@ -15,7 +15,8 @@ use super::mcap_file::Bag;
 use super::merge::{Merge, Next};
 use super::messages::{header, laser_scan, laser_scan_ranges, markers, pose, transform, twist};
 use super::odometry::{Odometer, OdometryPath};
-use super::{stamp_ns, ExportOptions, Source, START_NS};
+use super::options::{stamp_ns, ExportOptions, START_NS};
+use super::source::Source;
 use crate::import::{ODOMETRY_START_KEYS, START_KEY, START_METADATA};
 use crate::msgs::{Odometry, PoseStamped, Range, TfMessage, TwistStamped};
 use crate::Error;
@@ -131,7 +132,7 @@ impl<'a, 'o> RowWriter<'a, 'o> {
         meta: &Meta,
         extent: &Extent,
         options: &ExportOptions<'o>,
-        odometry: super::Stream<'a, OdometrySample>,
+        odometry: super::source::Stream<'a, OdometrySample>,
     ) -> Result<Self, Error> {
         let wheel_base = meta.robot.wheel_base_m;
         let sonar_fov = meta

@@ -7,43 +7,16 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use hilsim_recording::{printable, SampleSink};
-use serde::de::DeserializeOwned;
 
 use super::clocks::{earliest_time, ros1_earliest_time};
-use super::{Converter, Fault, ODOMETRY_START_KEYS, START_KEY, START_METADATA};
+use super::clocks::{ODOMETRY_START_KEYS, START_KEY, START_METADATA};
+use super::wire::Encoding;
+use super::{Converter, Fault};
 use crate::bag::{self, Item};
-use crate::cdr::decode_whole;
-use crate::ros1::{self, FromRos1};
+use crate::ros1;
 use crate::tf;
 use crate::topics::{self, Chosen, Kind, Role, TopicTypes};
 use crate::Error;
-
-/// How a message's bytes are laid out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Encoding {
-    /// ROS 2: CDR after a 4-byte encapsulation header.
-    #[default]
-    Cdr,
-    /// ROS 1: packed little-endian, `std_msgs/Header` with its `seq`.
-    Ros1,
-}
-
-/// A message type read in either serialisation.
-pub(super) trait Wire: DeserializeOwned + FromRos1 {}
-impl<T: DeserializeOwned + FromRos1> Wire for T {}
-
-/// Decodes a whole message of `encoding` (at most `appended` bytes of fields a newer ROS 2
-/// distribution adds are allowed after it).
-pub(super) fn decode_as<T: Wire>(
-    encoding: Encoding,
-    data: &[u8],
-    appended: usize,
-) -> Result<T, String> {
-    match encoding {
-        Encoding::Cdr => decode_whole(data, appended),
-        Encoding::Ros1 => ros1::decode_whole(data),
-    }
-}
 
 /// A bag's container: a ROS 2 bag's files (MCAP or SQLite3) and their channels, or a ROS 1
 /// bag's one file and its connections.

@@ -8,14 +8,23 @@ use std::path::Path;
 
 use hilsim_recording::round_half_away;
 
-use super::bag_walk::{decode_as, Encoding};
-use super::{Converter, START_KEY, START_METADATA};
+use super::wire::{decode_as, Encoding};
+use super::Converter;
 use crate::bag::{self, Item};
 use crate::cdr::decode;
 use crate::msgs::{Header, TfMessage, Time};
 use crate::ros1;
 use crate::topics::{Chosen, Kind, Role};
 use crate::Error;
+
+/// The metadata record an exported file starts with: its `start_ns` is the recording's t = 0,
+/// so that importing an export gives back the recording's times even when no message is at 0.
+pub(crate) const START_METADATA: &str = "hilsim";
+/// The key of the recording's t = 0 (nanoseconds, as the messages' stamps).
+pub(crate) const START_KEY: &str = "start_ns";
+/// The keys of the wheel travel at the first odometry row (an `Odometry` pose starts from
+/// nothing; a recording's encoders may not).
+pub(crate) const ODOMETRY_START_KEYS: [&str; 2] = ["odometry_left_m", "odometry_right_m"];
 
 /// Above this difference between a stamp and its log time the two come from different clocks
 /// (simulated time against the recorder's wall clock): unstamped messages (`Twist`) are then

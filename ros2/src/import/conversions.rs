@@ -7,18 +7,20 @@ use std::collections::BTreeMap;
 
 use hilsim_recording::{decimal_of_f32, CommandSample, SampleSink, SonarSample, TruthSample};
 
-use super::bag_walk::{decode_as, Encoding, Wire};
 use super::clocks::TableClock;
 use super::mounts::sonar_half_angle_deg;
 use super::odometry::OdometryState;
 use super::scan::ScanAngles;
-use super::ODOM_FRAME;
+use super::wire::{decode_as, Encoding, Wire};
 use crate::msgs::{
     JointState, LaserScan, Odometry, Pose, PoseStamped, Range, TfMessage, Twist, TwistStamped,
 };
 use crate::tf;
 use crate::topics::{self, Chosen, Kind, Role};
 use crate::Error;
+
+/// The frame odometry is in (REP 105); a namespaced one (`robot1/odom`) counts too.
+pub(super) const ODOM_FRAME: &str = "odom";
 
 /// Unstamped commands held until the first stamped message says which clock they are on.
 const MAX_PENDING_COMMANDS: usize = 1 << 20;

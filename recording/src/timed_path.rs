@@ -27,19 +27,23 @@ pub struct TimedPath {
     poses: Vec<Pose>,
 }
 
-/// What a lookup gives at the ends of a path's span and beyond them.
+/// What a lookup gives at the ends of a path's span and beyond them. The users of a path
+/// differ here, and their outputs depend on the difference: interpolating at a sample's own
+/// instant (u = 0) wraps its heading and can turn a −0 into a 0, which a recorded pose is not.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ends {
     /// The nearest end's pose as recorded beyond the span and at its last instant; at its first
     /// instant interpolated (from the first sample, as at every later sample's instant). An
-    /// instant that is not a number: the first pose.
+    /// instant that is not a number: the first pose. (tf2's lookup between stamped transforms;
+    /// the report's paths, a scenario's recorded path.)
     Held,
-    /// The nearest end's pose as recorded beyond the span and at both its ends; the path never
-    /// has two samples at one time. An instant that is not a number: a pose of NaN.
+    /// The nearest end's pose as recorded beyond the span and at both its ends. An instant that
+    /// is not a number: a pose of NaN. (The diagnosis's trajectory.)
     HeldAtBothEnds,
     /// Nothing beyond the span (nor at an instant that is not a number); within it, the ends
     /// included, always interpolated between two samples (of two at one time, from the later;
-    /// two at the span's end, the earlier at its instant).
+    /// two at the span's end, the earlier at its instant). (The odometry calibration's dead
+    /// reckoning, which must not guess beyond its encoders' readings.)
     Within,
 }
 

@@ -149,7 +149,8 @@ impl Calibration {
                 .get("method")
                 .map_or_else(|| "none".to_string(), shown);
             return Err(invalid(format!(
-                "{origin}: `method` must be em, landmarks, groundtruth or odometry, found {found}"
+                "{origin}: `method` must be {}, found {found}",
+                method_names()
             )));
         };
         let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
@@ -289,6 +290,16 @@ fn parse_json(text: &str, origin: &str) -> Result<serde_json::Value, Calibration
             CalibrationError::Invalid(format!("{origin}:{}: {what}{err}", err.line()))
         })?;
     Ok(value)
+}
+
+/// Every method's name, for a message: `em, landmarks, groundtruth or odometry`.
+fn method_names() -> String {
+    let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
 }
 
 /// A JSON value for a message: terminal-safe and short.
@@ -474,7 +485,10 @@ mod tests {
         assert!(!err.contains('\u{1b}'), "{err}");
         assert!(!err.contains("Some("), "{err}");
         let err = error(r#"{"sensors": {}}"#);
-        assert!(err.ends_with("found none"), "{err}");
+        assert!(
+            err.ends_with("`method` must be em, landmarks, groundtruth or odometry, found none"),
+            "{err}"
+        );
         let err = error("[1, 2]");
         assert!(err.contains("expected a JSON object"), "{err}");
     }

@@ -19,6 +19,7 @@ pub mod groundtruth;
 pub mod kalman_smoother;
 pub mod landmarks;
 pub mod odometry;
+pub mod random_walk_smoother;
 pub mod scan_match;
 pub mod smoothing;
 pub mod stats;

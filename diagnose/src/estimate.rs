@@ -16,6 +16,7 @@
 //! still show. The estimate's own uncertainty is reported, and the drive's and the encoders'
 //! residuals are widened by it.
 
+use hilsim_calibrator::random_walk_smoother::{self, Step};
 use hilsim_recording::{LidarSample, Recording, TruthSample};
 use nalgebra::Matrix3;
 
@@ -526,29 +527,15 @@ fn smooth_corrections(
     let mut out = knots.to_vec();
     let mut out_var = variances.to_vec();
     for c in 0..3 {
-        // Forward filter: predicted (m⁻, p⁻) and filtered (m, p) at each knot.
-        let mut pred = Vec::with_capacity(n);
-        let mut filt: Vec<(f64, f64)> = Vec::with_capacity(n);
-        for k in 0..n {
-            let (mp, pp) = match filt.last() {
-                Some(&(m, p)) => (m, p + q[k][c]),
-                // The first revolution: a diffuse prior.
-                None => (0.0, 1e6),
-            };
-            pred.push((mp, pp));
-            let (y, r) = (knots[k].1[c], variances[k][c].max(1e-12));
-            let gain = pp / (pp + r);
-            filt.push((mp + gain * (y - mp), (1.0 - gain) * pp));
-        }
-        // Backward pass.
-        let mut smooth = filt.clone();
-        for k in (0..n - 1).rev() {
-            let g = filt[k].1 / pred[k + 1].1;
-            smooth[k] = (
-                filt[k].0 + g * (smooth[k + 1].0 - pred[k + 1].0),
-                filt[k].1 + g * g * (smooth[k + 1].1 - pred[k + 1].1),
-            );
-        }
+        let steps: Vec<Step> = (0..n)
+            .map(|k| Step {
+                process_variance: q[k][c],
+                observed: knots[k].1[c],
+                observation_variance: variances[k][c].max(1e-12),
+            })
+            .collect();
+        // The first revolution: a diffuse prior.
+        let smooth = random_walk_smoother::smooth((0.0, 1e6), &steps);
         for k in 0..n {
             out[k].1[c] = smooth[k].0;
             out_var[k][c] = smooth[k].1.max(0.0);

@@ -1,14 +1,14 @@
 //! The robot's trajectory: poses at increasing times, interpolated linearly between them (the
 //! heading along the shorter arc), as the simulator interpolates within a physics step.
 
-use hilsim_recording::{Mount, Pose, TruthSample};
+use hilsim_recording::{Ends, Mount, Place, Pose, TimedPath, TruthSample};
 
 use crate::error::MismatchError;
 
 /// Wraps an angle into (−π, π] (the one definition, `hilsim_recording::pose`).
 pub use hilsim_recording::pose::wrap_angle as wrap;
 
-/// Poses at increasing times.
+/// Poses at increasing times, held at both ends ([`Ends::HeldAtBothEnds`]).
 ///
 /// ```
 /// use hilsim_diagnose::Trajectory;
@@ -24,8 +24,7 @@ pub use hilsim_recording::pose::wrap_angle as wrap;
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
-    t: Vec<f64>,
-    poses: Vec<Pose>,
+    path: TimedPath,
 }
 
 impl Trajectory {
@@ -37,8 +36,7 @@ impl Trajectory {
         if samples.is_empty() {
             return Err(MismatchError::Input("the trajectory has no poses".into()));
         }
-        let mut t = Vec::with_capacity(samples.len());
-        let mut poses = Vec::with_capacity(samples.len());
+        let mut path = TimedPath::with_capacity(samples.len());
         for s in samples {
             if ![s.t_s, s.x_m, s.y_m, s.yaw_rad]
                 .iter()
@@ -49,7 +47,7 @@ impl Trajectory {
                     s.t_s
                 )));
             }
-            if let Some(&last) = t.last() {
+            if let Some(&last) = path.times().last() {
                 if s.t_s < last {
                     return Err(MismatchError::Input(format!(
                         "the trajectory's time goes backwards at {} s",
@@ -60,23 +58,24 @@ impl Trajectory {
                     continue;
                 }
             }
-            t.push(s.t_s);
-            poses.push(Pose {
-                x: s.x_m,
-                y: s.y_m,
-                yaw: s.yaw_rad,
-            });
+            path.push(
+                s.t_s,
+                Pose {
+                    x: s.x_m,
+                    y: s.y_m,
+                    yaw: s.yaw_rad,
+                },
+            );
         }
-        Ok(Self { t, poses })
+        Ok(Self { path })
     }
 
     /// Its samples, as [`Trajectory::new`] takes them.
     #[must_use]
     pub fn samples(&self) -> Vec<TruthSample> {
-        self.t
+        self.path
             .iter()
-            .zip(&self.poses)
-            .map(|(&t_s, p)| TruthSample {
+            .map(|(t_s, p)| TruthSample {
                 t_s,
                 x_m: p.x,
                 y_m: p.y,
@@ -91,24 +90,22 @@ impl Trajectory {
     /// real mount, `pose ⊕ declared ⊕ real⁻¹`.
     #[must_use]
     pub fn under_mount(&self, declared: &Mount, real: &Mount) -> Self {
-        let poses = self
-            .poses
+        let path = self
+            .path
             .iter()
-            .map(|p| {
-                let lidar = declared.in_world(p);
+            .map(|(t, p)| {
+                let lidar = declared.in_world(&p);
                 let yaw = lidar.yaw - real.yaw_rad();
                 let (sin, cos) = yaw.sin_cos();
-                Pose {
+                let robot = Pose {
                     x: lidar.x - (cos * real.x_m - sin * real.y_m),
                     y: lidar.y - (sin * real.x_m + cos * real.y_m),
                     yaw: wrap(yaw),
-                }
+                };
+                (t, robot)
             })
             .collect();
-        Self {
-            t: self.t.clone(),
-            poses,
-        }
+        Self { path }
     }
 
     /// The robot's path when this one was found by matching scans whose stamps ran `delay_s`
@@ -116,8 +113,7 @@ impl Trajectory {
     #[must_use]
     pub fn delayed(&self, delay_s: f64) -> Self {
         Self {
-            t: self.t.iter().map(|t| t - delay_s).collect(),
-            poses: self.poses.clone(),
+            path: self.path.iter().map(|(t, p)| (t - delay_s, p)).collect(),
         }
     }
 
@@ -127,7 +123,7 @@ impl Trajectory {
     pub fn heading_span_rad(&self) -> f64 {
         let mut heading = 0.0;
         let (mut lo, mut hi) = (0.0f64, 0.0f64);
-        for w in self.poses.windows(2) {
+        for w in self.poses().windows(2) {
             heading += wrap(w[1].yaw - w[0].yaw);
             lo = lo.min(heading);
             hi = hi.max(heading);
@@ -138,60 +134,45 @@ impl Trajectory {
     /// The sample times.
     #[must_use]
     pub fn times(&self) -> &[f64] {
-        &self.t
+        self.path.times()
     }
 
     /// The sample poses.
     #[must_use]
     pub fn poses(&self) -> &[Pose] {
-        &self.poses
+        self.path.poses()
     }
 
     /// The last sample's time.
     #[must_use]
     pub fn end_s(&self) -> f64 {
-        self.t[self.t.len() - 1]
+        self.times()[self.path.len() - 1]
     }
 
     /// The index of the interval holding `t`: samples `k` and `k + 1` bracket it (clamped).
     #[must_use]
     pub fn interval(&self, t: f64) -> usize {
-        let n = self.t.len();
-        if n < 2 {
-            return 0;
-        }
-        self.t.partition_point(|&s| s <= t).clamp(1, n - 1) - 1
+        self.path.interval(t)
     }
 
     /// The pose at `t`, interpolated (held constant beyond the ends).
     #[must_use]
     pub fn pose_at(&self, t: f64) -> Pose {
-        let n = self.t.len();
-        if n == 1 || t <= self.t[0] {
-            return self.poses[0];
-        }
-        if t >= self.t[n - 1] {
-            return self.poses[n - 1];
-        }
-        let k = self.interval(t);
-        let (p, q) = (self.poses[k], self.poses[k + 1]);
-        let u = (t - self.t[k]) / (self.t[k + 1] - self.t[k]);
-        Pose {
-            x: p.x + (q.x - p.x) * u,
-            y: p.y + (q.y - p.y) * u,
-            yaw: wrap(p.yaw + wrap(q.yaw - p.yaw) * u),
-        }
+        self.path
+            .pose_with(t, Ends::HeldAtBothEnds)
+            .unwrap_or_default()
     }
 
     /// Forward speed (m/s) and turn rate (rad/s) over the interval holding `t`.
     #[must_use]
     pub fn twist_at(&self, t: f64) -> (f64, f64) {
-        if self.t.len() < 2 {
+        let (times, poses) = (self.times(), self.poses());
+        if times.len() < 2 {
             return (0.0, 0.0);
         }
         let k = self.interval(t);
-        let (p, q) = (self.poses[k], self.poses[k + 1]);
-        let dt = self.t[k + 1] - self.t[k];
+        let (p, q) = (poses[k], poses[k + 1]);
+        let dt = times[k + 1] - times[k];
         let dyaw = wrap(q.yaw - p.yaw);
         let mid = p.yaw + dyaw / 2.0;
         let forward = (q.x - p.x) * mid.cos() + (q.y - p.y) * mid.sin();
@@ -203,11 +184,12 @@ impl Trajectory {
     /// each interval and its turn split onto the wheels (the simulator's definition).
     #[must_use]
     pub fn wheel_travel(&self, wheel_base_m: f64) -> Vec<[f64; 2]> {
-        let mut out = Vec::with_capacity(self.t.len());
+        let poses = self.poses();
+        let mut out = Vec::with_capacity(poses.len());
         let mut w = [0.0; 2];
         out.push(w);
-        for k in 1..self.t.len() {
-            let (p, q) = (self.poses[k - 1], self.poses[k]);
+        for k in 1..poses.len() {
+            let (p, q) = (poses[k - 1], poses[k]);
             let dyaw = wrap(q.yaw - p.yaw);
             let mid = p.yaw + dyaw / 2.0;
             let forward = (q.x - p.x) * mid.cos() + (q.y - p.y) * mid.sin();
@@ -218,22 +200,17 @@ impl Trajectory {
         out
     }
 
-    /// `travel` (one value per sample) interpolated at `t`.
+    /// `travel` (one value per sample) interpolated at `t`, as [`Trajectory::pose_at`].
     #[must_use]
     pub fn interpolate(&self, travel: &[[f64; 2]], t: f64) -> [f64; 2] {
-        let n = self.t.len();
-        if n == 1 || t <= self.t[0] {
-            return travel[0];
+        match self.path.locate(t, Ends::HeldAtBothEnds) {
+            Some(Place::Between(k, u)) => [
+                travel[k][0] + (travel[k + 1][0] - travel[k][0]) * u,
+                travel[k][1] + (travel[k + 1][1] - travel[k][1]) * u,
+            ],
+            Some(Place::At(k)) => travel[k],
+            None => travel[0],
         }
-        if t >= self.t[n - 1] {
-            return travel[n - 1];
-        }
-        let k = self.interval(t);
-        let u = (t - self.t[k]) / (self.t[k + 1] - self.t[k]);
-        [
-            travel[k][0] + (travel[k + 1][0] - travel[k][0]) * u,
-            travel[k][1] + (travel[k + 1][1] - travel[k][1]) * u,
-        ]
     }
 }
 

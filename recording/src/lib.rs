@@ -32,6 +32,7 @@ mod rows;
 mod samples;
 mod stream;
 mod thin;
+mod timed_path;
 mod write;
 
 pub use atomic::{
@@ -53,6 +54,7 @@ pub use samples::{
 };
 pub use stream::{RecordingStream, SampleSink, Tables};
 pub use thin::{ThinnedSink, Thinning, MAX_ROWS_HELD};
+pub use timed_path::{Ends, Place, TimedPath};
 
 /// A whole recording: the metadata and one table per sensor.
 ///

@@ -2,7 +2,7 @@
 //! paths, and a few lidar revolutions in the world frame, raw and calibrated.
 
 use hilsim_calibrator::{groundtruth::invert, Sensor};
-use hilsim_recording::{LidarSample, Pose};
+use hilsim_recording::{LidarSample, Pose, TimedPath};
 use hilsim_sim::occupancy::{Cell, OccupancyMap};
 use hilsim_sim::Scenario;
 
@@ -31,10 +31,11 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
     let scenario = view.inputs.scenario;
     let paths: Vec<(f64, f64)> = view
         .truth
+        .poses()
         .iter()
-        .chain(&view.odometry)
-        .chain(&view.calibrated_odometry)
-        .map(|(_, p)| (p.x, p.y))
+        .chain(view.odometry.poses())
+        .chain(view.calibrated_odometry.poses())
+        .map(|p| (p.x, p.y))
         .collect();
     let revs = chosen_revolutions(view);
     let scans: Vec<Scan> = revs.iter().map(|&rev| scan(view, rev)).collect();
@@ -76,10 +77,10 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
             ));
         }
     }
-    let line = |path: &[(f64, Pose)]| -> Vec<(f64, f64)> {
-        thin(path, PATH_POINTS)
+    let line = |path: &TimedPath| -> Vec<(f64, f64)> {
+        thin(path.poses(), PATH_POINTS)
             .iter()
-            .map(|(_, p)| (p.x, p.y))
+            .map(|p| (p.x, p.y))
             .collect()
     };
     if !view.odometry.is_empty() {

@@ -3,11 +3,8 @@
 //! from the true path) and the calibrated ranges.
 
 use hilsim_calibrator::{Calibration, Sensor};
-use hilsim_recording::{LidarSample, Pose, Recording};
+use hilsim_recording::{LidarSample, Pose, Recording, TimedPath};
 use hilsim_sim::{Scenario, World};
-
-/// A path: poses in time order.
-pub type Path = Vec<(f64, Pose)>;
 
 /// The inputs of a report.
 #[derive(Debug, Clone, Copy)]
@@ -61,13 +58,13 @@ pub struct View<'a> {
     /// The inputs.
     pub inputs: Inputs<'a>,
     /// The true path (truth.csv), empty without one.
-    pub truth: Path,
+    pub truth: TimedPath,
     /// The path dead-reckoned from the odometry, from the true start (else the scenario's
     /// start, else the origin); empty without odometry.
-    pub odometry: Path,
+    pub odometry: TimedPath,
     /// The same dead-reckoned with an odometry calibration's wheels (the first calibration
     /// that has them); empty without one.
-    pub calibrated_odometry: Path,
+    pub calibrated_odometry: TimedPath,
     /// What a reading's world position is computed from: "truth", "odometry" or "none".
     pub reference: &'static str,
     /// Each valid lidar reading with its true distance.
@@ -86,12 +83,7 @@ impl<'a> View<'a> {
     #[must_use]
     pub fn new(inputs: Inputs<'a>) -> Self {
         let rec = inputs.recording;
-        let truth: Path = rec
-            .truth
-            .iter()
-            .flatten()
-            .map(|s| (s.t_s, Pose::new(s.x_m, s.y_m, s.yaw_rad)))
-            .collect();
+        let truth = TimedPath::from_truth(rec.truth.as_deref().unwrap_or_default());
         let start = truth.first().map(|p| p.1).or_else(|| {
             inputs.scenario.map(|s| {
                 let p = &s.robot.start;
@@ -105,7 +97,7 @@ impl<'a> View<'a> {
             .iter()
             .find_map(|c| c.odometry.as_ref())
             .and_then(|o| Wheels::calibrated(rec, o))
-            .map_or_else(Vec::new, |wheels| dead_reckoning(rec, origin, wheels));
+            .map_or_else(TimedPath::new, |wheels| dead_reckoning(rec, origin, wheels));
         let reference = if !truth.is_empty() {
             "truth"
         } else if !odometry.is_empty() {
@@ -205,7 +197,7 @@ impl<'a> View<'a> {
         } else {
             &self.truth
         };
-        pose_at(path, t)
+        path.pose_at(t)
     }
 
     /// The first calibration with a model of `sensor`.
@@ -245,29 +237,18 @@ pub fn beam_rad(s: &LidarSample) -> f64 {
     s.angle_deg.to_radians()
 }
 
-/// The pose at `t` on `path`, interpolated (held at the ends); `None` for an empty path.
-#[must_use]
-pub fn pose_at(path: &[(f64, Pose)], t: f64) -> Option<Pose> {
-    let i = path.partition_point(|(ti, _)| *ti <= t);
-    match (i.checked_sub(1).and_then(|j| path.get(j)), path.get(i)) {
-        (Some((t0, p0)), Some((t1, p1))) if t1 > t0 => Some(p0.lerp(p1, (t - t0) / (t1 - t0))),
-        (Some((_, p)), _) | (None, Some((_, p))) => Some(*p),
-        (None, None) => None,
-    }
-}
-
 /// The distance along a beam at `beam_rad` in the frame of a sensor mounted at `mount`, from
 /// the true pose at `t`, to the first obstacle of `world` (NaN when either is unknown or
 /// nothing is hit within `max_m`).
 fn cast(
     world: Option<&World>,
-    truth: &[(f64, Pose)],
+    truth: &TimedPath,
     mount: Pose,
     t: f64,
     beam_rad: f64,
     max_m: f64,
 ) -> f64 {
-    let (Some(world), Some(pose)) = (world, pose_at(truth, t)) else {
+    let (Some(world), Some(pose)) = (world, truth.pose_at(t)) else {
         return f64::NAN;
     };
     let sensor = pose.compose(mount.x, mount.y, mount.yaw);
@@ -312,15 +293,15 @@ impl Wheels {
 }
 
 /// The odometry dead-reckoned from `start` ([`Pose::drive`] between readings).
-fn dead_reckoning(rec: &Recording, start: Pose, wheels: Wheels) -> Path {
+fn dead_reckoning(rec: &Recording, start: Pose, wheels: Wheels) -> TimedPath {
     let Some(odometry) = rec.odometry.as_deref() else {
-        return Vec::new();
+        return TimedPath::new();
     };
     let Wheels {
         scale: [left, right],
         base_m: base,
     } = wheels;
-    let mut path = Vec::with_capacity(odometry.len());
+    let mut path = TimedPath::with_capacity(odometry.len());
     let mut pose = start;
     let mut last: Option<(f64, f64)> = None;
     for o in odometry {
@@ -328,7 +309,7 @@ fn dead_reckoning(rec: &Recording, start: Pose, wheels: Wheels) -> Path {
             pose = pose.drive((o.left_m - l) * left, (o.right_m - r) * right, base);
         }
         last = Some((o.left_m, o.right_m));
-        path.push((o.t_s, pose));
+        path.push(o.t_s, pose);
     }
     path
 }

@@ -8,7 +8,8 @@
 
 use std::path::Path;
 
-use hilsim_recording::pose::{wrap_angle, Pose};
+use hilsim_recording::pose::Pose;
+use hilsim_recording::TimedPath;
 
 use crate::numeric_csv::read_rows;
 use crate::scenario::ScenarioError;
@@ -22,8 +23,7 @@ pub const MAX_PATH_ROWS: usize = 1_728_000;
 /// A recorded path: poses at increasing times.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordedPath {
-    times_s: Vec<f64>,
-    poses: Vec<Pose>,
+    path: TimedPath,
 }
 
 impl RecordedPath {
@@ -33,13 +33,12 @@ impl RecordedPath {
     /// No pose, a time not after the one before, or a pose that is not finite.
     pub fn new(points: impl IntoIterator<Item = (f64, Pose)>) -> Result<Self, String> {
         let mut path = Self {
-            times_s: Vec::new(),
-            poses: Vec::new(),
+            path: TimedPath::new(),
         };
         for (t, pose) in points {
             path.push(t, pose)?;
         }
-        if path.times_s.is_empty() {
+        if path.is_empty() {
             return Err("no pose".to_string());
         }
         Ok(path)
@@ -52,15 +51,14 @@ impl RecordedPath {
         {
             return Err("a pose or time that is not a finite number".to_string());
         }
-        if let Some(&last) = self.times_s.last() {
+        if let Some(&last) = self.path.times().last() {
             if t_s <= last {
                 return Err(format!(
                     "t_s {t_s} is not after the row before ({last}); a path's times increase"
                 ));
             }
         }
-        self.times_s.push(t_s);
-        self.poses.push(pose);
+        self.path.push(t_s, pose);
         Ok(())
     }
 
@@ -70,13 +68,12 @@ impl RecordedPath {
     /// The file cannot be read or is not a path: the error names the file and the line.
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
         let mut recorded = Self {
-            times_s: Vec::new(),
-            poses: Vec::new(),
+            path: TimedPath::new(),
         };
         read_rows(path, PATH_HEADER, MAX_PATH_ROWS, |[t, x, y, yaw_deg]| {
             recorded.push(t, Pose::new(x, y, yaw_deg.to_radians()))
         })?;
-        if recorded.times_s.is_empty() {
+        if recorded.is_empty() {
             return Err(ScenarioError {
                 file: path.to_path_buf(),
                 line: None,
@@ -92,7 +89,7 @@ impl RecordedPath {
     pub fn to_csv(&self) -> String {
         let mut text = PATH_HEADER.join(",");
         text.push('\n');
-        for (t, p) in self.times_s.iter().zip(&self.poses) {
+        for (t, p) in self.iter() {
             text.push_str(&format!(
                 "{t:.6},{:.6},{:.6},{:.6}\n",
                 p.x,
@@ -106,56 +103,42 @@ impl RecordedPath {
     /// The first recorded time, seconds.
     #[must_use]
     pub fn start_s(&self) -> f64 {
-        self.times_s.first().copied().unwrap_or(0.0)
+        self.path.times().first().copied().unwrap_or(0.0)
     }
 
     /// The last recorded time, seconds.
     #[must_use]
     pub fn end_s(&self) -> f64 {
-        self.times_s.last().copied().unwrap_or(0.0)
+        self.path.times().last().copied().unwrap_or(0.0)
     }
 
     /// The first pose.
     #[must_use]
     pub fn first(&self) -> Pose {
-        self.poses.first().copied().unwrap_or_default()
+        self.path.first().map(|(_, p)| p).unwrap_or_default()
     }
 
     /// The number of recorded poses.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.poses.len()
+        self.path.len()
     }
 
     /// Whether the path has no pose (never, for a loaded one).
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.poses.is_empty()
+        self.path.is_empty()
     }
 
     /// The recorded `(t_s, pose)` pairs.
     pub fn iter(&self) -> impl Iterator<Item = (f64, Pose)> + '_ {
-        self.times_s.iter().copied().zip(self.poses.iter().copied())
+        self.path.iter()
     }
 
-    /// The pose at `t_s`.
+    /// The pose at `t_s` (held at the ends, [`hilsim_recording::Ends::Held`]).
     #[must_use]
     pub fn pose_at(&self, t_s: f64) -> Pose {
-        let after = self.times_s.partition_point(|&t| t <= t_s);
-        match (after.checked_sub(1), self.poses.get(after)) {
-            (None, _) => self.first(),
-            (Some(k), None) => self.poses[k],
-            (Some(k), Some(next)) => {
-                let (t0, t1) = (self.times_s[k], self.times_s[after]);
-                let p = self.poses[k];
-                let u = (t_s - t0) / (t1 - t0);
-                Pose::new(
-                    p.x + (next.x - p.x) * u,
-                    p.y + (next.y - p.y) * u,
-                    p.yaw + wrap_angle(next.yaw - p.yaw) * u,
-                )
-            }
-        }
+        self.path.pose_at(t_s).unwrap_or_default()
     }
 }
 

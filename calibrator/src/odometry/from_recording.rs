@@ -1,7 +1,7 @@
 //! A recording's drive as tuples: the lidar's revolutions matched scan to scan, the encoders'
 //! travel over the same intervals, then the estimate of [`calibrate_intervals`].
 
-use hilsim_recording::{LidarSample, OdometrySample, Pose, Recording};
+use hilsim_recording::{Ends, LidarSample, OdometrySample, Place, Pose, Recording, TimedPath};
 use rayon::prelude::*;
 
 use super::estimate::calibrate_intervals;
@@ -432,42 +432,24 @@ struct Revolution {
 /// scan matcher's guesses and the de-skewing within a revolution.
 struct Path<'a> {
     odometry: &'a [OdometrySample],
-    poses: Vec<Pose>,
+    poses: TimedPath,
 }
 
 impl<'a> Path<'a> {
     fn new(odometry: &'a [OdometrySample], wheel_base_m: f64) -> Self {
-        let mut poses = Vec::with_capacity(odometry.len());
+        let mut poses = TimedPath::with_capacity(odometry.len());
         let mut pose = Pose::default();
         let mut last = (odometry[0].left_m, odometry[0].right_m);
         for o in odometry {
             pose = pose.drive(o.left_m - last.0, o.right_m - last.1, wheel_base_m);
             last = (o.left_m, o.right_m);
-            poses.push(pose);
+            poses.push(o.t_s, pose);
         }
         Self { odometry, poses }
     }
 
-    /// The index `i` and fraction `u` with `t` between rows `i` and `i + 1`; `None` outside
-    /// the odometry's span.
-    fn locate(&self, t: f64) -> Option<(usize, f64)> {
-        let o = self.odometry;
-        if !(t >= o[0].t_s && t <= o[o.len() - 1].t_s) {
-            return None;
-        }
-        let i = o.partition_point(|s| s.t_s <= t).clamp(1, o.len() - 1) - 1;
-        let span = o[i + 1].t_s - o[i].t_s;
-        let u = if span > 0.0 {
-            (t - o[i].t_s) / span
-        } else {
-            0.0
-        };
-        Some((i, u.clamp(0.0, 1.0)))
-    }
-
     fn pose_at(&self, t: f64) -> Option<Pose> {
-        let (i, u) = self.locate(t)?;
-        Some(self.poses[i].lerp(&self.poses[i + 1], u))
+        self.poses.pose_with(t, Ends::Within)
     }
 
     /// The wheels' turns from `from` to `to`, step by step between the encoders' readings,
@@ -497,13 +479,17 @@ impl<'a> Path<'a> {
         Some(turns)
     }
 
+    /// The wheels' travel at `t`, interpolated as the pose is; `None` outside the odometry's
+    /// span.
     fn travel_at(&self, t: f64) -> Option<(f64, f64)> {
-        let (i, u) = self.locate(t)?;
-        let (a, b) = (self.odometry[i], self.odometry[i + 1]);
-        Some((
-            a.left_m + (b.left_m - a.left_m) * u,
-            a.right_m + (b.right_m - a.right_m) * u,
-        ))
+        let o = self.odometry;
+        Some(match self.poses.locate(t, Ends::Within)? {
+            Place::Between(i, u) => (
+                o[i].left_m + (o[i + 1].left_m - o[i].left_m) * u,
+                o[i].right_m + (o[i + 1].right_m - o[i].right_m) * u,
+            ),
+            Place::At(i) => (o[i].left_m, o[i].right_m),
+        })
     }
 }
 

@@ -1,6 +1,8 @@
 //! The catalogue of metric names that `[[expect]]` assertions may name. The binary computes them
 //! after a run; a name outside this list is rejected when the scenario is loaded.
 
+use hilsim_recording::Method;
+
 /// Every metric name with what it measures. Keep `scenarios/README.md` in step.
 pub const METRICS: &[(&str, &str)] = &[
     ("sim.duration_s", "simulated time, seconds"),
@@ -141,12 +143,9 @@ pub fn is_hil(name: &str) -> bool {
 #[must_use]
 pub fn is_calibration(name: &str) -> bool {
     name.split_once('.').is_some_and(|(method, rest)| {
-        METHODS.contains(&method) && CALIBRATION_METRICS.iter().any(|(n, _)| *n == rest)
+        Method::from_name(method).is_some() && CALIBRATION_METRICS.iter().any(|(n, _)| *n == rest)
     })
 }
-
-/// The calibration methods a calibration metric may be prefixed with.
-pub const METHODS: &[&str] = &["em", "landmarks", "groundtruth", "odometry"];
 
 /// Whether `name` is in the catalogue.
 #[must_use]

@@ -12,12 +12,14 @@ pub mod colours;
 mod errors;
 pub mod map;
 mod page;
+mod report_dir;
 pub mod svg;
 mod table;
 mod timelines;
 pub mod view;
 
 pub use map::Overlay;
+pub use report_dir::{check_report_dir, write_report_files, ReportDirError};
 pub use page::{is_report, map_svg, render, render_with, GENERATOR};
 pub use view::Inputs;
 

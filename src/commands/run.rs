@@ -18,7 +18,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     );
     // Every output is checked before the run, so that a refused one costs nothing.
     if let Some(dir) = &args.report {
-        super::report_dir::check_report_dir(dir, &[])?;
+        hilsim_report::check_report_dir(dir, &[])?;
     }
     if let Some(dir) = &args.out {
         hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
@@ -104,7 +104,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             calibrations: &report.calibrations,
             truth_estimated: false,
         });
-        super::report_dir::write_report_page(dir, &html)?;
+        hilsim_report::write_report_files(dir, &[("index.html".into(), html)])?;
         if !args.json {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
         }
@@ -119,11 +119,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
     }
     drop(scratch);
-    Ok(if report.passed() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(super::exit_code(report.passed()))
 }
 
 /// A temporary directory beside `mcap` (the same file system, removed when dropped) for the

@@ -569,11 +569,8 @@ pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> Strin
             _,
             _,
         ) => {
-            let subs: Vec<&str> = cmd
-                .get_subcommands()
-                .map(clap::Command::get_name)
-                .filter(|name| *name != "help")
-                .collect();
+            let subs: Vec<&str> = cmd.get_subcommands().map(clap::Command::get_name).collect();
+            let subs: Vec<&str> = subs.into_iter().filter(|name| *name != "help").collect();
             format!("missing a command (one of: {})", subs.join(", "))
         }
         (ErrorKind::ArgumentConflict, Some(arg), _) => match text(ContextKind::PriorArg) {
@@ -581,21 +578,21 @@ pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> Strin
             Some(prior) => format!("{arg} cannot be used with {prior}"),
             None => format!("{arg} cannot be used with the other arguments given"),
         },
-        // Anything else: clap's own wording, its lines joined, without the usage block.
-        _ => err
-            .render()
-            .to_string()
-            .lines()
-            .map(str::trim)
-            .filter(|l| {
-                !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
-            })
-            .map(|l| l.strip_prefix("error: ").unwrap_or(l))
-            .collect::<Vec<_>>()
-            .join(" ")
-            .replace('\n', " "),
+        _ => clap_wording(err),
     };
     format!("{what}; see {path} --help")
+}
+
+/// clap's own wording of `err`, its lines joined, without the usage block.
+fn clap_wording(err: &clap::Error) -> String {
+    let rendered = err.render().to_string();
+    let lines = rendered.lines().map(str::trim).filter(|l| {
+        !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+    });
+    let lines: Vec<&str> = lines
+        .map(|l| l.strip_prefix("error: ").unwrap_or(l))
+        .collect();
+    lines.join(" ").replace('\n', " ")
 }
 
 /// `hilsim` followed by the subcommands named in `args` (`hilsim dataset merge`), and the last

@@ -58,9 +58,8 @@ fn check(value: Option<f64>, ok: impl Fn(f64) -> bool, expected: &str) -> Result
     }
 }
 
-/// The calibrator's settings from the arguments, each checked before anything is read.
-fn settings(args: &CalibrateArgs) -> Result<Settings> {
-    let target = target_options(args.beam, args.start_distance)?;
+/// The numbers given, each in its range.
+fn check_ranges(args: &CalibrateArgs) -> Result<()> {
     let (max_interval, max_latency) = (odometry::MAX_INTERVAL_S, odometry::MAX_LIDAR_LATENCY_S);
     check(
         args.settle_s,
@@ -87,6 +86,13 @@ fn settings(args: &CalibrateArgs) -> Result<Settings> {
         |s| s.abs() <= max_latency,
         &format!("--lidar-latency-s: expected seconds from -{max_latency} to {max_latency}"),
     )?;
+    Ok(())
+}
+
+/// The calibrator's settings from the arguments, each checked before anything is read.
+fn settings(args: &CalibrateArgs) -> Result<Settings> {
+    let target = target_options(args.beam, args.start_distance)?;
+    check_ranges(args)?;
     // Each method's own options: given to another, they would be silently ignored.
     let odometry_options = args.wheel_radius_m.is_some()
         || args.interval_s.is_some()
@@ -110,20 +116,7 @@ fn settings(args: &CalibrateArgs) -> Result<Settings> {
         .map(|p| p.parse())
         .collect::<Result<_, _>>()?;
     let priors = em::Priors::new(&priors)?;
-    let lidar_bias = match &args.lidar_model {
-        Some(path) => {
-            let model = hilsim_calibrator::Calibration::read(path)?;
-            let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
-                bail!(
-                    "{}: the {} method's calibration has no lidar model",
-                    path.display(),
-                    model.method.name()
-                );
-            };
-            Some(lidar.alpha.clone())
-        }
-        None => None,
-    };
+    let lidar_bias = args.lidar_model.as_deref().map(lidar_bias).transpose()?;
     let (stops, recording) = (
         StopOptions::default(),
         odometry::RecordingOptions::default(),
@@ -143,6 +136,19 @@ fn settings(args: &CalibrateArgs) -> Result<Settings> {
             lidar_bias,
         },
     })
+}
+
+/// The range bias of the lidar model in the calibration at `path` (`--lidar-model`).
+fn lidar_bias(path: &Path) -> Result<Vec<f64>> {
+    let model = Calibration::read(path)?;
+    let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
+        let method = model.method.name();
+        bail!(
+            "{}: the {method} method's calibration has no lidar model",
+            path.display()
+        );
+    };
+    Ok(lidar.alpha.clone())
 }
 
 /// The calibration of a recording directory, with a note for each key of its `meta.toml` the

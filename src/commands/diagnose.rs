@@ -83,8 +83,8 @@ fn options(args: &DiagnoseArgs) -> Result<Options> {
     })
 }
 
-/// `--self-test N`: the whole self-test, or with `--trial I` one trial's diagnosis.
-fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCode> {
+/// The self-test's nominal scenario and plan, checked before any trial is run.
+fn self_test_plan(args: &DiagnoseArgs, n: i128) -> Result<(Scenario, Plan)> {
     if n < 1 {
         bail!("--self-test: expected at least one trial, found {n}");
     }
@@ -121,10 +121,17 @@ fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCo
         reality,
         without_truth: args.without_truth,
     };
+    if let Some(i) = args.trial.filter(|i| *i >= n) {
+        bail!("--trial: expected a trial below --self-test {n}, found {i}");
+    }
+    Ok((scenario, plan))
+}
+
+/// `--self-test N`: the whole self-test, or with `--trial I` one trial's diagnosis.
+fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCode> {
+    let (scenario, plan) = self_test_plan(args, n)?;
+    let n = plan.trials;
     if let Some(i) = args.trial {
-        if i >= n {
-            bail!("--trial: expected a trial below --self-test {n}, found {i}");
-        }
         let run = self_test::one(&scenario, plan, i)?;
         if let Some(dir) = args.report.as_deref() {
             let rec_dir = dir.join("recording");

@@ -7,7 +7,8 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{write_file_atomically, RecordingStream};
-use hilsim_scenarios::{builtin, Via};
+use hilsim_scenarios::{builtin, Report, Via};
+use hilsim_sim::Scenario;
 
 use crate::cli::{self, RunArgs};
 
@@ -16,34 +17,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         || builtin::STRAIGHT_BOARD_ORIGIN.to_string(),
         |p| p.display().to_string(),
     );
-    // Every output is checked before the run, so that a refused one costs nothing.
-    if let Some(dir) = &args.report {
-        hilsim_report::check_report_dir(dir, &[])?;
-    }
-    if let Some(dir) = &args.out {
-        hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
-        hilsim_recording::tidy_after_killed_writers(dir)?;
-    }
-    if let Some(mcap) = &args.mcap {
-        super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
-    }
-    let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
-    let model = scenario
-        .sensors
-        .lidar
-        .as_ref()
-        .map(|l| l.model)
-        .unwrap_or_default();
-    if args.via == cli::Via::Serial && model != hilsim_sim::scenario::LidarModel::Xv11 {
-        bail!(
-            "{origin}: `--via serial` reads the Neato XV-11's wire, and the lidar is a {model}: \
-             `hilsim serve` streams its protocol"
-        );
-    }
-    let via = match args.via {
-        cli::Via::Memory => Via::Memory,
-        cli::Via::Serial => Via::Serial,
-    };
+    let (scenario, via) = validate(args, &origin)?;
     let world = super::export::world(&scenario);
     // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
     // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
@@ -59,40 +33,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
         Via::Serial => None,
     };
-    let (report, stream) = match &streamed_to {
-        Some(dir) => {
-            let emulation = Emulation::new(&scenario, scenario.seed)
-                .with_context(|| format!("{origin}: sensor model"))?;
-            let mut stream =
-                RecordingStream::create(dir, emulation.meta().clone(), emulation.tables())?;
-            drop(emulation);
-            let report = hilsim_scenarios::execute_into(scenario, &origin, via, &mut stream)?;
-            (report, Some(stream))
-        }
-        None => (hilsim_scenarios::execute(scenario, &origin, via)?, None),
-    };
-    if args.json {
-        out.write_all(report.results_json().as_bytes())?;
-    } else {
-        out.write_all(report.summary().as_bytes())?;
-    }
-    let results = report.results_json();
-    let add_results = |tmp: &Path| -> Result<()> {
-        write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
-        Ok(())
-    };
-    match (stream, &args.out) {
-        (Some(stream), Some(_)) => stream.finish_with(add_results)?,
-        (Some(stream), None) => stream.finish()?,
-        (None, Some(dir)) => hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
-            report.run.recording.write_files(tmp)?;
-            add_results(tmp)
-        })?,
-        (None, None) => {}
-    }
-    if let (Some(dir), false) = (&args.out, args.json) {
-        writeln!(out, "wrote {}", dir.display())?;
-    }
+    let report = execute(args, scenario, &origin, via, streamed_to.as_deref(), out)?;
     if let Some(dir) = &args.report {
         let title = format!("hilsim run: {}", report.scenario.name);
         let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
@@ -120,6 +61,86 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     drop(scratch);
     Ok(super::exit_code(report.passed()))
+}
+
+/// The scenario and the lidar's path, every output checked before the run, so that a refused
+/// one costs nothing.
+fn validate(args: &RunArgs, origin: &str) -> Result<(Scenario, Via)> {
+    if let Some(dir) = &args.report {
+        hilsim_report::check_report_dir(dir, &[])?;
+    }
+    if let Some(dir) = &args.out {
+        hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
+        hilsim_recording::tidy_after_killed_writers(dir)?;
+    }
+    if let Some(mcap) = &args.mcap {
+        super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
+    }
+    let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
+    let model = scenario
+        .sensors
+        .lidar
+        .as_ref()
+        .map(|l| l.model)
+        .unwrap_or_default();
+    if args.via == cli::Via::Serial && model != hilsim_sim::scenario::LidarModel::Xv11 {
+        bail!(
+            "{origin}: `--via serial` reads the Neato XV-11's wire, and the lidar is a {model}: \
+             `hilsim serve` streams its protocol"
+        );
+    }
+    let via = match args.via {
+        cli::Via::Memory => Via::Memory,
+        cli::Via::Serial => Via::Serial,
+    };
+    Ok((scenario, via))
+}
+
+/// Runs the scenario, streamed into `streamed_to` when given, prints the summary (or the
+/// results' JSON) and writes the recording with its `results.json` to `--out`.
+fn execute(
+    args: &RunArgs,
+    scenario: Scenario,
+    origin: &str,
+    via: Via,
+    streamed_to: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<Report> {
+    let (report, stream) = match streamed_to {
+        Some(dir) => {
+            let emulation = Emulation::new(&scenario, scenario.seed)
+                .with_context(|| format!("{origin}: sensor model"))?;
+            let mut stream =
+                RecordingStream::create(dir, emulation.meta().clone(), emulation.tables())?;
+            drop(emulation);
+            let report = hilsim_scenarios::execute_into(scenario, origin, via, &mut stream)?;
+            (report, Some(stream))
+        }
+        None => (hilsim_scenarios::execute(scenario, origin, via)?, None),
+    };
+    let results = report.results_json();
+    if args.json {
+        out.write_all(results.as_bytes())?;
+    } else {
+        out.write_all(report.summary().as_bytes())?;
+    }
+    let add_results = |tmp: &Path| -> Result<()> {
+        write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
+        Ok(())
+    };
+    match (stream, &args.out) {
+        (Some(stream), Some(_)) => stream.finish_with(add_results)?,
+        (Some(stream), None) => stream.finish()?,
+        (None, Some(dir)) => hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
+            report.run.recording.write_files(tmp)?;
+            add_results(tmp)
+        })?,
+        (None, None) => {}
+    }
+    if let (Some(dir), false) = (&args.out, args.json) {
+        writeln!(out, "wrote {}", dir.display())?;
+    }
+    Ok(report)
 }
 
 /// A temporary directory beside `mcap` (the same file system, removed when dropped) for the

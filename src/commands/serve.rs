@@ -46,14 +46,7 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         .context("cannot set up signal handling")?;
     let report = match &args.port {
         Some(path) => {
-            let baud = options.model.spec().baud;
-            let link =
-                DeviceLink::open_at(&path.to_string_lossy(), baud).map_err(|err| {
-                    match err.kind() {
-                        std::io::ErrorKind::InvalidInput => anyhow!("{}: {err}", path.display()),
-                        _ => anyhow!("{}: cannot open: {err}", path.display()),
-                    }
-                })?;
+            let link = open_device(path, options.model.spec().baud)?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
             run(emulation, link, options, &stop)?
@@ -77,6 +70,14 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         report.write_summary(out)?;
     }
     Ok(())
+}
+
+/// The serial device at `path`, opened 8N1 at `baud`.
+fn open_device(path: &std::path::Path, baud: u32) -> Result<DeviceLink> {
+    DeviceLink::open_at(&path.to_string_lossy(), baud).map_err(|err| match err.kind() {
+        std::io::ErrorKind::InvalidInput => anyhow!("{}: {err}", path.display()),
+        _ => anyhow!("{}: cannot open: {err}", path.display()),
+    })
 }
 
 /// Serves the stream, what is sent shown as a status line on a terminal (stderr; stdout keeps

@@ -10,7 +10,8 @@ use hilsim_twin::{build_world, compare, Declared, PoseSource, TwinFiles, WorldOp
 
 use crate::cli::WorldArgs;
 
-pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
+/// The world's options, the cell size checked.
+fn options(args: &WorldArgs) -> Result<WorldOptions> {
     if !(args.resolution_m.is_finite() && (0.005..=1.0).contains(&args.resolution_m)) {
         bail!(
             "--resolution-m {}: expected a cell size from 0.005 to 1 m; see hilsim world --help",
@@ -22,12 +23,16 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         "odometry" => PoseSource::Odometry,
         _ => PoseSource::Auto,
     };
-    let options = WorldOptions {
+    Ok(WorldOptions {
         map: args.map.clone(),
         resolution_m: args.resolution_m,
         poses,
         ..WorldOptions::default()
-    };
+    })
+}
+
+pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
+    let options = options(args)?;
     let calibration = args
         .calibration
         .as_deref()

@@ -21,8 +21,8 @@ pub mod kalman_smoother;
 pub mod landmarks;
 pub mod odometry;
 pub mod scan_match;
-pub mod smoothing;
 mod smoothed_table;
+pub mod smoothing;
 pub mod stats;
 pub mod target_samples;
 

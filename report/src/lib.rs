@@ -19,8 +19,8 @@ mod timelines;
 pub mod view;
 
 pub use map::Overlay;
-pub use report_dir::{check_report_dir, write_report_files, ReportDirError};
 pub use page::{is_report, map_svg, render, render_with, GENERATOR};
+pub use report_dir::{check_report_dir, write_report_files, ReportDirError};
 pub use view::Inputs;
 
 /// The most rows of one table a report draws from ([`hilsim_recording::MAX_ROWS_HELD`]).

@@ -16,5 +16,5 @@ mod test_results;
 pub use discover::{scenario_files, DiscoverError};
 pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};
-pub use test_results::{TestResults, JUNIT_XML};
 pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};
+pub use test_results::{TestResults, JUNIT_XML};

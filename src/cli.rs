@@ -36,24 +36,24 @@ pub enum Command {
     #[command(subcommand)]
     Scenario(ScenarioCommand),
     /// Generate many seeded, varied runs of a scenario: resumable, shardable.
-    Dataset(crate::commands::dataset::DatasetArgs),
+    Dataset(DatasetArgs),
     /// Run a firmware build in the loop with the lidar and robot command ports.
-    Hil(crate::commands::hil::HilArgs),
+    Hil(HilArgs),
     /// Compare a simulation with a real recording: locate the mismatch, name the physics the
     /// simulation left out, fit it and show the held-out improvement (or prove it blind with
     /// `--self-test N`).
-    Diagnose(crate::commands::diagnose::DiagnoseArgs),
+    Diagnose(DiagnoseArgs),
     /// Draw a recording as one self-contained HTML page: the world, the paths, the scans, each
     /// sensor's error against distance and the calibration.
     Report(ReportArgs),
     /// Turn a ROS 2 bag (MCAP or SQLite3, CDR), a ROS 1 bag (`.bag`), or a robot's log (CARMEN
     /// `.log`/`.clf`, CoreSLAM `.dat`), into a recording.
-    Import(crate::commands::import::ImportArgs),
+    Import(ImportArgs),
     /// Write a recording as ROS 2 messages in an MCAP file (Foxglove, RViz, `ros2 bag play`).
-    Export(crate::commands::export::ExportArgs),
+    Export(ExportArgs),
     /// Write a scenario that replays a recorded run in its world (the user's map, or one built
     /// from the run's scans): `hilsim record` on it makes the run's twin.
-    World(crate::commands::world::WorldArgs),
+    World(WorldArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -277,6 +277,247 @@ pub struct ReportArgs {
     pub out: PathBuf,
 }
 
+/// Compare a simulation with a real recording: locate the mismatch, name the physics left out,
+/// fit it, show the held-out improvement. Or prove it blind with `--self-test N`.
+#[derive(Debug, clap::Args)]
+pub struct DiagnoseArgs {
+    /// The scenario the recording is a run of (for `--self-test`: the nominal scenario, default
+    /// the built-in `scenarios/diagnose-room.toml`).
+    #[arg(long, value_name = "SCENARIO")]
+    pub sim: Option<PathBuf>,
+    /// The real recording (a directory in the recording format).
+    #[arg(long, value_name = "RECORDING", conflicts_with = "self_test")]
+    pub real: Option<PathBuf>,
+    /// Print the result as one JSON object (`interfaces.md`).
+    #[arg(long)]
+    pub json: bool,
+    /// Write the evidence as SVG plots and an HTML page (`index.html`) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Run N blind trials: each draws an effect (or none) and its parameters, records a "real"
+    /// run with it, diagnoses it against the nominal scenario and scores the answer.
+    // Wide enough for any count typed, so that the range check below says what is expected.
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub self_test: Option<i128>,
+    /// Seed of the self-test's draws (default 1).
+    #[arg(long, value_name = "S", requires = "self_test")]
+    pub seed: Option<u64>,
+    /// Self-test: strength of the drawn effects, a factor on the documented moderate ranges.
+    #[arg(
+        long,
+        value_name = "X",
+        requires = "self_test",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub strength: f64,
+    /// Self-test: conceal only this effect in every trial (a catalogue name, or `none`), to
+    /// study one class.
+    #[arg(long, value_name = "EFFECT", requires = "self_test")]
+    pub only: Option<String>,
+    /// Self-test: what makes the "real" recordings: `hilsim` (its own simulator with the drawn
+    /// effect switched on) or `independent` (a generator that shares no model code with it,
+    /// with random nuisances, two effects at once in a fifth of the trials and an effect
+    /// outside the catalogue).
+    #[arg(long, value_name = "REALITY", requires = "self_test", default_value = "hilsim",
+          value_parser = ["hilsim", "independent"])]
+    pub reality: String,
+    /// Self-test: run only trial I (of the N), print its whole diagnosis and, with `--report`,
+    /// write its report and its "real" recording (`DIR/recording`).
+    #[arg(long, value_name = "I", requires = "self_test")]
+    pub trial: Option<u64>,
+    /// Self-test: remove each "real" recording's `truth.csv` before diagnosing it, as a robot's
+    /// log without motion capture (the trajectory is then estimated from the lidar).
+    #[arg(long, requires = "self_test")]
+    pub without_truth: bool,
+    /// Exit 1 when the verdict is not `none` (a mismatch was found), for CI jobs; the result is
+    /// still printed.
+    #[arg(long, conflicts_with = "self_test")]
+    pub fail_on_mismatch: bool,
+    /// A sensor's practical floor: a mismatch smaller than this many millimetres (and than
+    /// `--floor-noise-share` of the declared noise) is not reported, however significant
+    /// (`SENSOR=MM`, SENSOR one of lidar, sonar, odometer, drive; repeatable; defaults in
+    /// docs/diagnose.md).
+    #[arg(long = "floor", value_name = "SENSOR=MM", conflicts_with = "self_test")]
+    pub floors: Vec<String>,
+    /// The share of the declared noise's standard deviation below which a mismatch is not
+    /// reported (default 0.25).
+    #[arg(long, value_name = "X", conflicts_with = "self_test")]
+    pub floor_noise_share: Option<f64>,
+    /// A calibration of the robot (`hilsim calibrate --json`): the simulation takes what it
+    /// found instead of the scenario's declared models (an odometry calibration's wheels and
+    /// lidar mount; an em, landmarks or groundtruth calibration's range bias and noise), so that
+    /// what is left is what the calibration did not explain.
+    #[arg(long, value_name = "FILE", conflicts_with = "self_test")]
+    pub calibration: Option<PathBuf>,
+}
+
+/// `hilsim dataset`.
+#[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct DatasetArgs {
+    #[command(subcommand)]
+    pub command: Option<DatasetCommand>,
+    /// Scenario file: the base of every run.
+    #[arg(required = true)]
+    pub scenario: Option<PathBuf>,
+    /// Number of runs N (runs 0 to N-1).
+    #[arg(long, required = true, value_name = "N")]
+    pub runs: Option<u64>,
+    /// The dataset directory: created, or resumed when it holds this dataset.
+    #[arg(long, required = true, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// The dataset's seed S (default: the scenario's `seed`); run r's seed derives from (S, r).
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "J")]
+    pub jobs: Option<usize>,
+    /// Make only shard I of K: the runs r with r mod K = I-1 (I counts from 1).
+    #[arg(long, value_name = "I/K", conflicts_with = "run")]
+    pub shard: Option<String>,
+    /// Make only run R (e.g. to make one run again on its own).
+    #[arg(long, value_name = "R")]
+    pub run: Option<u64>,
+    /// Draw this scenario number per run, uniformly in [LO, HI] (repeatable), e.g.
+    /// `robot.start.x=0.5..1.5`.
+    #[arg(long, value_name = "KEY=LO..HI")]
+    pub vary: Vec<String>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum DatasetCommand {
+    /// Merge dataset directories (the shards of one dataset) into one, and rebuild its manifest.
+    Merge(MergeArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// The merged dataset directory (new or empty, or one of the shards' own directory).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Dataset directories to bring into DIR (none: merge DIR's own shards in place).
+    pub sources: Vec<PathBuf>,
+    /// Worker threads for hashing and copying (default: one per core).
+    #[arg(long, value_name = "J")]
+    pub jobs: Option<usize>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct HilArgs {
+    /// Scenario file; its drive program is not run (the firmware drives).
+    pub scenario: PathBuf,
+    /// The firmware's command line, split into words as a shell would (no shell runs): it gets
+    /// HILSIM_LIDAR_PORT and HILSIM_ROBOT_PORT in its environment.
+    #[arg(long, value_name = "'CMD ARGS…'")]
+    pub firmware: String,
+    /// Write the run as a recording (truth included) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// The run's length in seconds, overriding the scenario's `duration_s`.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Seconds the firmware may go without a request before it counts as hung; also the time
+    /// it has to start reading the lidar.
+    #[arg(long, value_name = "S", default_value_t = 5.0)]
+    pub watchdog: f64,
+    /// Seed of every random stream (default: the scenario's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// End with one JSON object on its own line (how it ended, the metrics, the assertions, the
+    /// stream and the firmware) instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct ImportArgs {
+    /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files);
+    /// a ROS 1 bag (`.bag`, rosbag format 2.0; chunks uncompressed, bz2 or lz4); or a robot's
+    /// log: CARMEN (`.log`, `.clf`, either gzipped: `.gz`) or CoreSLAM (`.dat`). A bag's
+    /// `/tf_static` (else `/tf`) gives the lidar's mount unless --meta has one, and `/tf`'s odom →
+    /// base transforms the odometry when the bag has no odometry topic; each guess is a note.
+    pub bag: PathBuf,
+    /// The recording directory to write (replaced atomically when complete).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The robot's `meta.toml` (wheel base, sensor mounts, what is known of the world); its
+    /// `[lidar]` mount overrides the bag's TF. Default: a minimal one (the wheel base a guess),
+    /// said so.
+    #[arg(long, value_name = "FILE")]
+    pub meta: Option<PathBuf>,
+    /// The lidar's topic (sensor_msgs/LaserScan).
+    #[arg(long, value_name = "TOPIC")]
+    pub lidar: Option<String>,
+    /// The odometer's topic (nav_msgs/Odometry; sensor_msgs/JointState with --wheel-radius-m;
+    /// or tf2_msgs/TFMessage, its odom → base transforms).
+    #[arg(long, value_name = "TOPIC")]
+    pub odom: Option<String>,
+    /// The commands' topic (geometry_msgs/Twist or TwistStamped).
+    #[arg(long, value_name = "TOPIC")]
+    pub cmd: Option<String>,
+    /// The sonar's topic (sensor_msgs/Range).
+    #[arg(long, value_name = "TOPIC")]
+    pub sonar: Option<String>,
+    /// The true pose's topic (geometry_msgs/PoseStamped, or a motion capture's
+    /// nav_msgs/Odometry).
+    #[arg(long, value_name = "TOPIC")]
+    pub truth: Option<String>,
+    /// The wheels' radius, metres: wheel joint angles (JointState) times it are wheel travel.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub wheel_radius_m: Option<f64>,
+    /// The left and right wheels' joints in JointState (default: the joints named `…left…` and
+    /// `…right…`).
+    #[arg(long, value_name = "LEFT,RIGHT")]
+    pub wheel_joints: Option<String>,
+    /// What a CARMEN log's poses are: `truth` (a corrected log's: truth.csv) or `odometry`
+    /// (odometry.csv, as wheel travel); default truth. (`--log-poses` is the same.)
+    #[arg(long = "poses", alias = "log-poses", value_name = "KIND", value_parser = ["truth", "odometry"])]
+    pub log_poses: Option<String>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// A recording directory.
+    pub recording: PathBuf,
+    /// The MCAP file to write (replaced atomically when complete).
+    #[arg(long, value_name = "OUT")]
+    pub mcap: PathBuf,
+    /// The scenario the recording ran: its world is drawn as markers (`/world`).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: Option<PathBuf>,
+    /// A calibration (`hilsim calibrate --json`): the scans with each reading inverted through
+    /// its lidar model are sent too, as `/scan_calibrated`.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct WorldArgs {
+    /// The recording (as `hilsim import` writes one).
+    pub recording: PathBuf,
+    /// The scenario to write; its map (`STEM.map.yaml` and `.pgm`), path (`STEM.path.csv`) and
+    /// scan schedule (`STEM.scans.csv`) are written beside it.
+    #[arg(long, value_name = "SCENARIO.toml")]
+    pub out: PathBuf,
+    /// The user's map (map_server YAML and its image) instead of one built from the scans.
+    #[arg(long, value_name = "MAP.yaml")]
+    pub map: Option<PathBuf>,
+    /// The built map's cell size, metres.
+    #[arg(long, value_name = "M", default_value_t = hilsim_twin::WorldOptions::default().resolution_m)]
+    pub resolution_m: f64,
+    /// Where the robot's path comes from: `truth` (truth.csv), `odometry` (the wheels, corrected
+    /// by matching scans), or `auto` (truth when the recording has it).
+    #[arg(long, value_name = "SOURCE", default_value = "auto", value_parser = ["auto", "truth", "odometry"])]
+    pub poses: String,
+    /// A calibration of the robot (`hilsim calibrate --json`) whose models the scenario
+    /// declares: an em, landmarks or groundtruth calibration's lidar bias and noise; an odometry
+    /// calibration's wheel base and lidar mount. Without one the lidar is declared unbiased,
+    /// with the noise the log shows against its twin.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
+}
+
 /// A clap error as one line (`<what>; see hilsim <cmd> --help`), as every other error is, for
 /// scripts that read one line of stderr. Values the user typed are shown terminal-safe.
 pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> String {
@@ -328,11 +569,8 @@ pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> Strin
             _,
             _,
         ) => {
-            let subs: Vec<&str> = cmd
-                .get_subcommands()
-                .map(clap::Command::get_name)
-                .filter(|name| *name != "help")
-                .collect();
+            let subs: Vec<&str> = cmd.get_subcommands().map(clap::Command::get_name).collect();
+            let subs: Vec<&str> = subs.into_iter().filter(|name| *name != "help").collect();
             format!("missing a command (one of: {})", subs.join(", "))
         }
         (ErrorKind::ArgumentConflict, Some(arg), _) => match text(ContextKind::PriorArg) {
@@ -340,21 +578,21 @@ pub fn usage_error_line(err: &clap::Error, args: &[std::ffi::OsString]) -> Strin
             Some(prior) => format!("{arg} cannot be used with {prior}"),
             None => format!("{arg} cannot be used with the other arguments given"),
         },
-        // Anything else: clap's own wording, its lines joined, without the usage block.
-        _ => err
-            .render()
-            .to_string()
-            .lines()
-            .map(str::trim)
-            .filter(|l| {
-                !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
-            })
-            .map(|l| l.strip_prefix("error: ").unwrap_or(l))
-            .collect::<Vec<_>>()
-            .join(" ")
-            .replace('\n', " "),
+        _ => clap_wording(err),
     };
     format!("{what}; see {path} --help")
+}
+
+/// clap's own wording of `err`, its lines joined, without the usage block.
+fn clap_wording(err: &clap::Error) -> String {
+    let rendered = err.render().to_string();
+    let lines = rendered.lines().map(str::trim).filter(|l| {
+        !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+    });
+    let lines: Vec<&str> = lines
+        .map(|l| l.strip_prefix("error: ").unwrap_or(l))
+        .collect();
+    lines.join(" ").replace('\n', " ")
 }
 
 /// `hilsim` followed by the subcommands named in `args` (`hilsim dataset merge`), and the last

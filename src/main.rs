@@ -5,6 +5,7 @@
 
 mod cli;
 mod commands;
+mod progress;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -35,7 +36,9 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => commands::calibrate::calibrate(args, &mut out),
         Command::Smooth(args) => commands::calibrate::smooth(args, &mut out),
         Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
-        Command::Decode(args) => commands::decode::run(args, &mut out).map(|()| ExitCode::SUCCESS),
+        Command::Decode(args) => {
+            commands::decode::decode(args, &mut out).map(|()| ExitCode::SUCCESS)
+        }
         Command::Scenario(ScenarioCommand::Test(args)) => {
             commands::scenario_test::test(args, &mut out)
         }

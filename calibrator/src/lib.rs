@@ -11,6 +11,7 @@
 
 mod by_method;
 pub mod calibration;
+mod calibration_file;
 pub mod checks;
 mod describe;
 pub mod em;
@@ -21,6 +22,7 @@ pub mod landmarks;
 pub mod odometry;
 pub mod random_walk_smoother;
 pub mod scan_match;
+mod smoothed_table;
 pub mod smoothing;
 pub mod stats;
 pub mod target_samples;
@@ -30,4 +32,5 @@ pub use calibration::{
     Calibration, LidarModelMetrics, Method, Metrics, OdometryModel, Sensor, SensorModel,
 };
 pub use error::CalibrationError;
+pub use smoothed_table::{smoothed_csv, SMOOTHED_CSV};
 pub use target_samples::{SampleOptions, START_DISTANCE_RANGE_M};

@@ -34,6 +34,7 @@ mod params;
 mod progress;
 mod seed;
 mod shard;
+mod text;
 mod vary;
 
 pub use content::{scan_run, RunContent};

@@ -24,6 +24,7 @@ mod diagnosis;
 mod error;
 mod estimate;
 pub mod explain;
+mod floor;
 mod health;
 pub mod locate;
 mod optimize;
@@ -43,6 +44,7 @@ pub use catalogue::{DrawSource, Effect, ParamSpec, SelfTestRange, Sensor};
 pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
 pub use explain::CandidateFit;
+pub use floor::{ParseFloorError, SensorFloor};
 pub use hilsim_recording::Pose;
 pub use locate::{Evidence, Floors, TestKind};
 pub use outcome::{

@@ -7,6 +7,7 @@
 
 pub mod command_port;
 pub mod decode;
+mod decode_capture;
 mod device;
 pub mod escaped;
 pub mod faults;
@@ -18,12 +19,15 @@ pub mod motion;
 pub mod process;
 mod pty;
 pub mod serve;
+mod serve_model;
 mod streamer;
 mod unit_streamer;
 
+pub use decode_capture::{decode_capture, CaptureError, Decoded};
 pub use device::{DeviceLink, XV11_BAUD};
 pub use link::{MemoryLink, SerialLink};
 pub use pty::PtyLink;
+pub use serve_model::{serve_model, ServeOptions};
 pub use streamer::{
     Pacing, StreamStats, Streamer, BACKLOG_LIMIT, FAST_STALL_GRACE, LOSSLESS_TIMEOUT, STALL_DETECT,
 };

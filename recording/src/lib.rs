@@ -22,6 +22,7 @@ mod background;
 mod csv;
 mod decimal;
 mod error;
+mod farthest;
 mod input;
 mod meta;
 mod names;

@@ -12,6 +12,7 @@ pub mod colours;
 mod errors;
 pub mod map;
 mod page;
+mod report_dir;
 pub mod svg;
 mod table;
 mod timelines;
@@ -19,6 +20,7 @@ pub mod view;
 
 pub use map::Overlay;
 pub use page::{is_report, map_svg, render, render_with, GENERATOR};
+pub use report_dir::{check_report_dir, write_report_files, ReportDirError};
 pub use view::Inputs;
 
 /// The most rows of one table a report draws from ([`hilsim_recording::MAX_ROWS_HELD`]).

@@ -28,6 +28,7 @@ pub mod definitions;
 mod error;
 mod export;
 mod import;
+mod import_summary;
 pub mod msgs;
 pub mod ros1;
 mod tf;

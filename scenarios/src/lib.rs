@@ -7,10 +7,14 @@
 pub mod builtin;
 pub mod calibrated;
 mod discover;
+mod firmware_run;
 pub mod metrics;
 mod pipeline;
 mod summary;
+mod test_results;
 
 pub use discover::{scenario_files, DiscoverError};
+pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};
 pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};
+pub use test_results::{TestResults, JUNIT_XML};

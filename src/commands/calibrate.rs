@@ -2,140 +2,30 @@
 //! `hilsim calibrate --method odometry --tuples FILE` and
 //! `hilsim smooth RECORDING --calibration FILE [--csv OUT]` (the EM paper's Sec. V reuse).
 
-use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_calibrator::landmarks::StopOptions;
-use hilsim_calibrator::{em, Method, SampleOptions, Settings};
-use hilsim_calibrator::{odometry, smoothing};
-use hilsim_recording::{
-    check_output_file, write_file_atomically, FileKind, Meta, OutputTarget, Recording,
-};
+use hilsim_calibrator::{em, odometry, smoothing, Calibration, Method, SampleOptions, Settings};
+use hilsim_recording::{check_output_file, write_file_atomically, Meta, OutputTarget, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
 /// Prints the calibration; exit 1 when one of its checks failed (the result is still printed).
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let target = target_options(args.beam, args.start_distance)?;
-    if args
-        .settle_s
-        .is_some_and(|s| !(s.is_finite() && (0.0..=86_400.0).contains(&s)))
-    {
-        bail!("--settle-s: expected a settling time in seconds, from 0 to 86400");
-    }
-    if args
-        .min_revolutions
-        .is_some_and(|n| !(n.is_finite() && (1.0..=1e6).contains(&n)))
-    {
-        bail!("--min-revolutions: expected a number of revolutions from 1 to 1000000");
-    }
-    if args
-        .wheel_radius_m
-        .is_some_and(|r| !(r.is_finite() && r > 0.0 && r <= 10.0))
-    {
-        bail!("--wheel-radius-m: expected a radius in metres, more than 0 and at most 10");
-    }
-    let max_interval = hilsim_calibrator::odometry::MAX_INTERVAL_S;
-    if args
-        .interval_s
-        .is_some_and(|s| !(s.is_finite() && s > 0.0 && s <= max_interval))
-    {
-        bail!("--interval-s: expected seconds, more than 0 and at most {max_interval}");
-    }
-    let max_latency = odometry::MAX_LIDAR_LATENCY_S;
-    if args
-        .lidar_latency_s
-        .is_some_and(|s| !(s.is_finite() && s.abs() <= max_latency))
-    {
-        bail!("--lidar-latency-s: expected seconds from -{max_latency} to {max_latency}");
-    }
-    // Each method's own options: given to another, they would be silently ignored.
-    if (args.wheel_radius_m.is_some()
-        || args.interval_s.is_some()
-        || args.lidar_latency_s.is_some())
-        && (args.method != Method::Odometry || args.tuples.is_some())
-    {
-        bail!(
-            "--wheel-radius-m, --interval-s and --lidar-latency-s are for --method odometry on \
-             a recording"
-        );
-    }
-    if !args.priors.is_empty() && args.method != Method::Em {
-        bail!("--prior: priors are for --method em");
-    }
-    if (args.settle_s.is_some() || args.min_revolutions.is_some())
-        && args.method != Method::Landmarks
-    {
-        bail!("--settle-s and --min-revolutions are for --method landmarks");
-    }
-    let priors: Vec<em::Prior> = args
-        .priors
-        .iter()
-        .map(|p| p.parse())
-        .collect::<Result<_, _>>()?;
-    let settings = Settings {
-        target,
-        stops: StopOptions {
-            settle_s: args.settle_s,
-            min_revolutions: args
-                .min_revolutions
-                .unwrap_or(StopOptions::default().min_revolutions),
-            ..StopOptions::default()
-        },
-        priors: em::Priors::new(&priors)?,
-        odometry: odometry::RecordingOptions {
-            nominal_wheel_radius_m: args.wheel_radius_m,
-            interval_s: args
-                .interval_s
-                .unwrap_or(odometry::RecordingOptions::default().interval_s),
-            lidar_latency_s: args.lidar_latency_s,
-            lidar_bias: match &args.lidar_model {
-                Some(path) => {
-                    let model = super::read_calibration(path)?;
-                    let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
-                        bail!(
-                            "{}: the {} method's calibration has no lidar model",
-                            path.display(),
-                            model.method.name()
-                        );
-                    };
-                    Some(lidar.alpha.clone())
-                }
-                None => None,
-            },
-        },
-    };
+    let settings = settings(args)?;
     let method = args.method;
     let (calibration, input) = match (&args.recording, &args.tuples) {
-        (_, Some(tuples)) => {
-            if method != Method::Odometry {
-                bail!("--tuples: tuples are for --method odometry");
-            }
-            (calibrate_tuples(tuples)?, tuples.as_path())
+        (_, Some(tuples)) if method != Method::Odometry => {
+            bail!("--tuples: tuples are for --method odometry")
         }
-        (Some(recording), None) => {
-            let rec = Recording::read_dir(recording)?;
-            let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, &settings)
-                .with_context(|| format!("{}: {}", recording.display(), method.name()))?;
-            // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
-            let meta = recording.join("meta.toml");
-            if let Ok(text) = hilsim_recording::read_small_text(
-                &meta,
-                hilsim_recording::MAX_META_BYTES,
-                "meta.toml",
-            ) {
-                for key in Meta::unknown_keys(&text) {
-                    calibration.notes.push(format!(
-                        "meta.toml: `{}` is not a key of the recording format; ignored",
-                        hilsim_recording::printable(&key)
-                    ));
-                }
-            }
-            (calibration, recording.as_path())
-        }
+        (_, Some(tuples)) => (calibrate_tuples(tuples)?, tuples.as_path()),
+        (Some(recording), None) => (
+            calibrate_dir(recording, method, &settings)?,
+            recording.as_path(),
+        ),
         (None, None) => bail!("a recording or --tuples is needed"),
     };
     if args.json {
@@ -160,11 +50,132 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     Ok(ExitCode::from(1))
 }
 
+/// Refuses a `value` that `ok` does not accept, saying `expected`.
+fn check(value: Option<f64>, ok: impl Fn(f64) -> bool, expected: &str) -> Result<()> {
+    match value {
+        Some(v) if !(v.is_finite() && ok(v)) => bail!("{expected}"),
+        _ => Ok(()),
+    }
+}
+
+/// The numbers given, each in its range.
+fn check_ranges(args: &CalibrateArgs) -> Result<()> {
+    let (max_interval, max_latency) = (odometry::MAX_INTERVAL_S, odometry::MAX_LIDAR_LATENCY_S);
+    check(
+        args.settle_s,
+        |s| (0.0..=86_400.0).contains(&s),
+        "--settle-s: expected a settling time in seconds, from 0 to 86400",
+    )?;
+    check(
+        args.min_revolutions,
+        |n| (1.0..=1e6).contains(&n),
+        "--min-revolutions: expected a number of revolutions from 1 to 1000000",
+    )?;
+    check(
+        args.wheel_radius_m,
+        |r| r > 0.0 && r <= 10.0,
+        "--wheel-radius-m: expected a radius in metres, more than 0 and at most 10",
+    )?;
+    check(
+        args.interval_s,
+        |s| s > 0.0 && s <= max_interval,
+        &format!("--interval-s: expected seconds, more than 0 and at most {max_interval}"),
+    )?;
+    check(
+        args.lidar_latency_s,
+        |s| s.abs() <= max_latency,
+        &format!("--lidar-latency-s: expected seconds from -{max_latency} to {max_latency}"),
+    )?;
+    Ok(())
+}
+
+/// The calibrator's settings from the arguments, each checked before anything is read.
+fn settings(args: &CalibrateArgs) -> Result<Settings> {
+    let target = target_options(args.beam, args.start_distance)?;
+    check_ranges(args)?;
+    // Each method's own options: given to another, they would be silently ignored.
+    let odometry_options = args.wheel_radius_m.is_some()
+        || args.interval_s.is_some()
+        || args.lidar_latency_s.is_some();
+    if odometry_options && (args.method != Method::Odometry || args.tuples.is_some()) {
+        bail!(
+            "--wheel-radius-m, --interval-s and --lidar-latency-s are for --method odometry on \
+             a recording"
+        );
+    }
+    if !args.priors.is_empty() && args.method != Method::Em {
+        bail!("--prior: priors are for --method em");
+    }
+    let stop_options = args.settle_s.is_some() || args.min_revolutions.is_some();
+    if stop_options && args.method != Method::Landmarks {
+        bail!("--settle-s and --min-revolutions are for --method landmarks");
+    }
+    let priors: Vec<em::Prior> = args
+        .priors
+        .iter()
+        .map(|p| p.parse())
+        .collect::<Result<_, _>>()?;
+    let priors = em::Priors::new(&priors)?;
+    let lidar_bias = args.lidar_model.as_deref().map(lidar_bias).transpose()?;
+    let (stops, recording) = (
+        StopOptions::default(),
+        odometry::RecordingOptions::default(),
+    );
+    Ok(Settings {
+        target,
+        stops: StopOptions {
+            settle_s: args.settle_s,
+            min_revolutions: args.min_revolutions.unwrap_or(stops.min_revolutions),
+            ..stops
+        },
+        priors,
+        odometry: odometry::RecordingOptions {
+            nominal_wheel_radius_m: args.wheel_radius_m,
+            interval_s: args.interval_s.unwrap_or(recording.interval_s),
+            lidar_latency_s: args.lidar_latency_s,
+            lidar_bias,
+        },
+    })
+}
+
+/// The range bias of the lidar model in the calibration at `path` (`--lidar-model`).
+fn lidar_bias(path: &Path) -> Result<Vec<f64>> {
+    let model = Calibration::read(path)?;
+    let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
+        let method = model.method.name();
+        bail!(
+            "{}: the {method} method's calibration has no lidar model",
+            path.display()
+        );
+    };
+    Ok(lidar.alpha.clone())
+}
+
+/// The calibration of a recording directory, with a note for each key of its `meta.toml` the
+/// recording format does not have.
+fn calibrate_dir(dir: &Path, method: Method, settings: &Settings) -> Result<Calibration> {
+    let rec = Recording::read_dir(dir)?;
+    let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, settings)
+        .with_context(|| format!("{}: {}", dir.display(), method.name()))?;
+    // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
+    let meta = dir.join("meta.toml");
+    let max = hilsim_recording::MAX_META_BYTES;
+    if let Ok(text) = hilsim_recording::read_small_text(&meta, max, "meta.toml") {
+        for key in Meta::unknown_keys(&text) {
+            calibration.notes.push(format!(
+                "meta.toml: `{}` is not a key of the recording format; ignored",
+                hilsim_recording::printable(&key)
+            ));
+        }
+    }
+    Ok(calibration)
+}
+
 /// Most bytes of a tuples file: 128 MiB, a million tuples of the paper's format.
 const MAX_TUPLES_BYTES: u64 = 128 << 20;
 
 /// The odometry calibration of a tuples file.
-fn calibrate_tuples(path: &Path) -> Result<hilsim_calibrator::Calibration> {
+fn calibrate_tuples(path: &Path) -> Result<Calibration> {
     let text = hilsim_recording::read_small_text(path, MAX_TUPLES_BYTES, "tuples file")?;
     let origin = path.display().to_string();
     let (tuples, unsound) = odometry::parse_tuples(&text, &origin)?;
@@ -178,26 +189,14 @@ fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions
     }
     let range = hilsim_calibrator::START_DISTANCE_RANGE_M;
     if let Some(d) = start.filter(|d| !range.contains(d)) {
-        bail!(
-            "--start-distance: expected a distance from {} to {} m, found {d:?}",
-            range.start(),
-            range.end()
-        );
+        let (lo, hi) = (range.start(), range.end());
+        bail!("--start-distance: expected a distance from {lo} to {hi} m, found {d:?}");
     }
     Ok(SampleOptions {
         beam_deg,
         start_distance_m: start,
     })
 }
-
-/// The header of `smooth --csv`'s table.
-const SMOOTHED_CSV_HEADER: &str = "t_s,distance_m,sd_m\n";
-
-/// `smooth --csv`'s table, as a previous one is recognised.
-const SMOOTHED_CSV: FileKind = FileKind {
-    name: "a table of smoothed distances",
-    starts_with: SMOOTHED_CSV_HEADER.as_bytes(),
-};
 
 /// Writes the smoothed distances; exit 1 when the recording fails a check against the
 /// calibration (the distances are still written; the failed checks go to stderr).
@@ -207,13 +206,13 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
         let mut inputs = Recording::files_in(&args.recording);
         inputs.push(args.calibration.clone());
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-        check_output_file(csv, SMOOTHED_CSV, &inputs)?;
+        check_output_file(csv, hilsim_calibrator::SMOOTHED_CSV, &inputs)?;
     }
-    let trained = super::read_calibration(&args.calibration)?;
+    let trained = hilsim_calibrator::Calibration::read(&args.calibration)?;
     if trained.sensors.is_empty() {
         bail!(
-            "{}: the {} method's calibration holds no sensor model; smooth applies em's (lidar, sonar, \
-             odometer)",
+            "{}: the {} method's calibration holds no sensor model; smooth applies em's (lidar, \
+             sonar, odometer)",
             args.calibration.display(),
             trained.method.name()
         );
@@ -222,16 +221,7 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let (estimates, checks) =
         smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))
             .with_context(|| format!("{}: smoothing", args.recording.display()))?;
-    let mut csv = String::from(SMOOTHED_CSV_HEADER);
-    for e in &estimates {
-        let _ = writeln!(
-            csv,
-            "{},{},{}",
-            e.t_s,
-            e.distance_m,
-            e.variance_m2.max(0.0).sqrt()
-        );
-    }
+    let csv = hilsim_calibrator::smoothed_csv(&estimates);
     match &args.csv {
         Some(path) => {
             write_file_atomically(path, csv.as_bytes())?;
@@ -239,11 +229,10 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
             let on_stdout = OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout);
             let mut stderr = std::io::stderr();
             let out: &mut dyn Write = if on_stdout { &mut stderr } else { out };
+            let (n, recording) = (estimates.len(), args.recording.display());
             writeln!(
                 out,
-                "smoothed {} samples of {} into {}",
-                estimates.len(),
-                args.recording.display(),
+                "smoothed {n} samples of {recording} into {}",
                 path.display()
             )?;
         }

@@ -1,34 +1,16 @@
 //! `hilsim export RECORDING --mcap OUT [--scenario FILE] [--calibration FILE]`: a recording as
 //! ROS 2 messages in an MCAP file (and the `--mcap OUT` of `record` and `run`).
 
-use std::convert::Infallible;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use hilsim_calibrator::landmarks::Inverse;
 use hilsim_calibrator::Sensor;
-use hilsim_recording::{
-    check_output_file, CommandSample, LidarSample, OdometrySample, OutputTarget, Recording,
-    RecordingDir, SampleSink, SonarSample, TruthSample,
-};
+use hilsim_recording::{check_output_file, LidarSample, OutputTarget, Recording, RecordingDir};
 use hilsim_sim::Scenario;
 
-#[derive(Debug, clap::Args)]
-pub struct ExportArgs {
-    /// A recording directory.
-    pub recording: PathBuf,
-    /// The MCAP file to write (replaced atomically when complete).
-    #[arg(long, value_name = "OUT")]
-    pub mcap: PathBuf,
-    /// The scenario the recording ran: its world is drawn as markers (`/world`).
-    #[arg(long, value_name = "FILE")]
-    pub scenario: Option<PathBuf>,
-    /// A calibration (`hilsim calibrate --json`): the scans with each reading inverted through
-    /// its lidar model are sent too, as `/scan_calibrated`.
-    #[arg(long, value_name = "FILE")]
-    pub calibration: Option<PathBuf>,
-}
+use crate::cli::ExportArgs;
 
 pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
     let mut inputs = Recording::files_in(&args.recording);
@@ -42,7 +24,7 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
     let calibration = args
         .calibration
         .as_deref()
-        .map(super::read_calibration)
+        .map(hilsim_calibrator::Calibration::read)
         .transpose()?;
     let recording = RecordingDir::open(&args.recording)?;
     let inverse = match (&calibration, args.calibration.as_deref()) {
@@ -84,8 +66,7 @@ fn calibrated_ranges(
     path: &Path,
 ) -> Result<Inverse> {
     // The recording is checked (as a whole read would, its errors first) on the way.
-    let mut farthest = Farthest(1.0);
-    recording.check(&mut farthest)?;
+    let farthest = recording.farthest_lidar_range_m(1.0)?;
     let model = calibration.sensors.get(&Sensor::Lidar).with_context(|| {
         format!(
             "{}: no lidar model (the {} method's calibration; the calibrated scans need em's, \
@@ -95,31 +76,8 @@ fn calibrated_ranges(
         )
     })?;
     // Search up to past the farthest reading: a lidar model is fitted below 100 m.
-    Inverse::new(&model.alpha, [0.0, 2.0 * farthest.0 + 100.0])
+    Inverse::new(&model.alpha, [0.0, 2.0 * farthest + 100.0])
         .with_context(|| format!("{}: the lidar model", path.display()))
-}
-
-/// The farthest lidar reading, at least 1 m.
-struct Farthest(f64);
-
-impl SampleSink for Farthest {
-    type Error = Infallible;
-    fn lidar(&mut self, r: &LidarSample) -> Result<(), Infallible> {
-        self.0 = self.0.max(r.range_m);
-        Ok(())
-    }
-    fn command(&mut self, _: &CommandSample) -> Result<(), Infallible> {
-        Ok(())
-    }
-    fn odometry(&mut self, _: &OdometrySample) -> Result<(), Infallible> {
-        Ok(())
-    }
-    fn sonar(&mut self, _: &SonarSample) -> Result<(), Infallible> {
-        Ok(())
-    }
-    fn truth(&mut self, _: &TruthSample) -> Result<(), Infallible> {
-        Ok(())
-    }
 }
 
 /// Writes the recording directory `dir` as MCAP at `path`, reading it as streams.

@@ -1,86 +1,18 @@
 //! `hilsim import BAG --out DIR [--meta FILE] [--lidar T] [--odom T] [--cmd T] [--sonar T]
 //! [--truth T] [--wheel-radius-m R] [--wheel-joints LEFT,RIGHT]`: a ROS 2 bag (MCAP or SQLite3)
-//! or a ROS 1 bag (`.bag`) into a recording, the lidar's mount from its TF; `hilsim import LOG --out DIR [--poses truth|odometry]`: a real robot's
-//! log (CARMEN `.log`/`.clf`, gzipped or not; CoreSLAM `.dat`) into a recording.
+//! or a ROS 1 bag (`.bag`) into a recording, the lidar's mount from its TF; `hilsim import LOG
+//! --out DIR [--poses truth|odometry]`: a real robot's log (CARMEN `.log`/`.clf`, gzipped or
+//! not; CoreSLAM `.dat`) into a recording.
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use hilsim_recording::Meta;
+use hilsim_logs::{CarmenOptions, LogKind, Poses};
+use hilsim_recording::{check_input_outside, tidy_after_killed_writers, Meta};
 use hilsim_ros2::{ImportOptions, Role};
 
-#[derive(Debug, clap::Args)]
-pub struct ImportArgs {
-    /// A ROS 2 bag: an `.mcap` or `.db3` file, or a bag directory (`metadata.yaml` and its files);
-    /// a ROS 1 bag (`.bag`, rosbag format 2.0; chunks uncompressed, bz2 or lz4); or a robot's
-    /// log: CARMEN (`.log`, `.clf`, either gzipped: `.gz`) or CoreSLAM (`.dat`). A bag's
-    /// `/tf_static` (else `/tf`) gives the lidar's mount unless --meta has one, and `/tf`'s odom →
-    /// base transforms the odometry when the bag has no odometry topic; each guess is a note.
-    pub bag: PathBuf,
-    /// The recording directory to write (replaced atomically when complete).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// The robot's `meta.toml` (wheel base, sensor mounts, what is known of the world); its
-    /// `[lidar]` mount overrides the bag's TF. Default: a minimal one (the wheel base a guess),
-    /// said so.
-    #[arg(long, value_name = "FILE")]
-    pub meta: Option<PathBuf>,
-    /// The lidar's topic (sensor_msgs/LaserScan).
-    #[arg(long, value_name = "TOPIC")]
-    pub lidar: Option<String>,
-    /// The odometer's topic (nav_msgs/Odometry; sensor_msgs/JointState with --wheel-radius-m;
-    /// or tf2_msgs/TFMessage, its odom → base transforms).
-    #[arg(long, value_name = "TOPIC")]
-    pub odom: Option<String>,
-    /// The commands' topic (geometry_msgs/Twist or TwistStamped).
-    #[arg(long, value_name = "TOPIC")]
-    pub cmd: Option<String>,
-    /// The sonar's topic (sensor_msgs/Range).
-    #[arg(long, value_name = "TOPIC")]
-    pub sonar: Option<String>,
-    /// The true pose's topic (geometry_msgs/PoseStamped, or a motion capture's
-    /// nav_msgs/Odometry).
-    #[arg(long, value_name = "TOPIC")]
-    pub truth: Option<String>,
-    /// The wheels' radius, metres: wheel joint angles (JointState) times it are wheel travel.
-    #[arg(long, value_name = "M", allow_negative_numbers = true)]
-    pub wheel_radius_m: Option<f64>,
-    /// The left and right wheels' joints in JointState (default: the joints named `…left…` and
-    /// `…right…`).
-    #[arg(long, value_name = "LEFT,RIGHT")]
-    pub wheel_joints: Option<String>,
-    /// What a CARMEN log's poses are: `truth` (a corrected log's: truth.csv) or `odometry`
-    /// (odometry.csv, as wheel travel); default truth. (`--log-poses` is the same.)
-    #[arg(long = "poses", alias = "log-poses", value_name = "KIND", value_parser = ["truth", "odometry"])]
-    pub log_poses: Option<String>,
-}
-
-/// The kinds of robot log `import` reads besides ROS 2 bags, by the file's name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum LogKind {
-    Carmen,
-    CoreSlam,
-}
-
-fn log_kind(path: &std::path::Path) -> Option<LogKind> {
-    let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
-    let name = name.strip_suffix(".gz").unwrap_or(&name);
-    if name.ends_with(".log") || name.ends_with(".clf") {
-        Some(LogKind::Carmen)
-    } else if name.ends_with(".dat") {
-        Some(LogKind::CoreSlam)
-    } else if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
-    {
-        // A gzipped file of another name: CARMEN's logger is the one that writes them.
-        Some(LogKind::Carmen)
-    } else {
-        None
-    }
-}
+use crate::cli::ImportArgs;
 
 /// A robot's log into a recording.
 fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<()> {
@@ -103,52 +35,24 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<(
     if kind == LogKind::CoreSlam && args.log_poses.is_some() {
         bail!("--poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses");
     }
-    hilsim_recording::check_input_outside(&args.bag, &args.out)?;
-    let text = hilsim_logs::read_text(&args.bag)?;
-    let origin = args.bag.display().to_string();
-    let (rec, notes) = match kind {
-        LogKind::CoreSlam => (
-            hilsim_logs::read_coreslam(&text, &origin, &hilsim_logs::CoreSlamOptions::default())?,
-            Vec::new(),
-        ),
-        LogKind::Carmen => {
-            let options = hilsim_logs::CarmenOptions {
-                poses: match args.log_poses.as_deref() {
-                    Some("odometry") => hilsim_logs::Poses::Odometry,
-                    _ => hilsim_logs::Poses::Truth,
-                },
-                ..hilsim_logs::CarmenOptions::default()
-            };
-            hilsim_logs::read_carmen(&text, &origin, &options)?
-        }
+    let carmen = CarmenOptions {
+        poses: match args.log_poses.as_deref() {
+            Some("odometry") => Poses::Odometry,
+            _ => Poses::Truth,
+        },
+        ..CarmenOptions::default()
     };
-    drop(text);
-    hilsim_recording::tidy_after_killed_writers(&args.out)?;
-    rec.write_dir(&args.out)?;
-    let lidar = rec.lidar.as_deref().unwrap_or_default();
-    writeln!(
-        out,
-        "lidar     {} scans: {} rows",
-        lidar.last().map_or(0, |s| s.rev + 1),
-        lidar.len()
-    )?;
-    for (name, rows) in [
-        ("odometry", rec.odometry.as_ref().map(Vec::len)),
-        ("truth", rec.truth.as_ref().map(Vec::len)),
-    ] {
-        if let Some(rows) = rows {
-            writeln!(out, "{name:<9} {rows} rows")?;
-        }
-    }
-    for note in &notes {
-        writeln!(out, "note: {note}")?;
-    }
+    check_input_outside(&args.bag, &args.out)?;
+    let log = hilsim_logs::read_log(&args.bag, kind, &carmen)?;
+    tidy_after_killed_writers(&args.out)?;
+    log.recording.write_dir(&args.out)?;
+    log.write_summary(out)?;
     writeln!(out, "wrote {}", args.out.display())?;
     Ok(())
 }
 
 pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
-    if let Some(kind) = log_kind(&args.bag) {
+    if let Some(kind) = LogKind::of(&args.bag) {
         return import_log(args, kind, out);
     }
     if args.log_poses.is_some() {
@@ -177,18 +81,16 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
         },
     };
     let meta = args.meta.as_deref().map(Meta::read).transpose()?;
-    let mut topics = BTreeMap::new();
-    for (role, topic) in [
+    let topics: BTreeMap<Role, String> = [
         (Role::Lidar, &args.lidar),
         (Role::Odometry, &args.odom),
         (Role::Commands, &args.cmd),
         (Role::Sonar, &args.sonar),
         (Role::Truth, &args.truth),
-    ] {
-        if let Some(topic) = topic {
-            topics.insert(role, topic.clone());
-        }
-    }
+    ]
+    .into_iter()
+    .filter_map(|(role, topic)| Some((role, topic.clone()?)))
+    .collect();
     let options = ImportOptions {
         topics,
         meta,
@@ -196,21 +98,10 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
         wheel_joints,
     };
     // The bag is read while the recording is written: it must not be inside what is replaced.
-    hilsim_recording::check_input_outside(&args.bag, &args.out)?;
-    hilsim_recording::tidy_after_killed_writers(&args.out)?;
+    check_input_outside(&args.bag, &args.out)?;
+    tidy_after_killed_writers(&args.out)?;
     let report = hilsim_ros2::import(&args.bag, &args.out, &options)?;
-    for (role, (topic, kind)) in &report.chosen {
-        let rows = report.rows.get(role).copied().unwrap_or(0);
-        writeln!(
-            out,
-            "{role:<9} {} ({}): {rows} rows",
-            hilsim_recording::printable(topic),
-            kind.ros_name()
-        )?;
-    }
-    for note in &report.notes {
-        writeln!(out, "note: {note}")?;
-    }
+    report.write_summary(out)?;
     writeln!(out, "wrote {}", args.out.display())?;
     Ok(())
 }

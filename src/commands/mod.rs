@@ -1,7 +1,6 @@
 //! One module per subcommand; each validates its arguments before opening anything.
 
 pub mod calibrate;
-mod calibration_file;
 pub mod dataset;
 pub mod decode;
 pub mod diagnose;
@@ -10,12 +9,30 @@ pub mod hil;
 pub mod import;
 pub mod record;
 pub mod report;
-mod report_dir;
 pub mod run;
-mod scenario_file;
 pub mod scenario_test;
 pub mod serve;
 
-pub use calibration_file::{read_calibration, read_calibrations};
-pub use scenario_file::load_scenario;
 pub mod world;
+
+/// 0 when `passed`, else 1: a check or assertion failed (the result is still printed).
+pub fn exit_code(passed: bool) -> std::process::ExitCode {
+    if passed {
+        std::process::ExitCode::SUCCESS
+    } else {
+        std::process::ExitCode::from(1)
+    }
+}
+
+/// Loads a scenario file, or the built-in one, and applies a `--seed` override.
+pub fn load_scenario(
+    path: Option<&std::path::Path>,
+    seed: Option<u64>,
+) -> anyhow::Result<hilsim_sim::Scenario> {
+    let mut scenario = match path {
+        Some(path) => hilsim_sim::Scenario::load(path)?,
+        None => hilsim_scenarios::builtin::straight_board()?,
+    };
+    scenario.seed = seed.unwrap_or(scenario.seed);
+    Ok(scenario)
+}

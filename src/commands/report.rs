@@ -9,11 +9,10 @@ use hilsim_recording::RecordingDir;
 use hilsim_report::Inputs;
 use hilsim_sim::Scenario;
 
-use super::report_dir::{check_report_dir, write_report_page};
 use crate::cli::ReportArgs;
 
 pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    check_report_dir(&args.out, &[])?;
+    hilsim_report::check_report_dir(&args.out, &[])?;
     let scenario = args.scenario.as_deref().map(Scenario::load).transpose()?;
     // Read as streams, holding at most `MAX_ROWS` rows of a table whatever the recording's length.
     let (recording, thinning) =
@@ -24,7 +23,7 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .clone()
         .or_else(|| beside.is_file().then_some(beside));
     let calibrations = match &calibration_file {
-        Some(path) => super::read_calibrations(path)?,
+        Some(path) => hilsim_calibrator::Calibration::read_all(path)?,
         None => Vec::new(),
     };
     let name = args.recording.display().to_string();
@@ -37,7 +36,7 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
         calibrations: &calibrations,
         truth_estimated: false,
     });
-    write_report_page(&args.out, &html)?;
+    hilsim_report::write_report_files(&args.out, &[("index.html".into(), html)])?;
     writeln!(out, "report: {}", args.out.join("index.html").display())?;
     Ok(ExitCode::SUCCESS)
 }

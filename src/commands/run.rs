@@ -7,7 +7,8 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{write_file_atomically, RecordingStream};
-use hilsim_scenarios::{builtin, Via};
+use hilsim_scenarios::{builtin, Report, Via};
+use hilsim_sim::Scenario;
 
 use crate::cli::{self, RunArgs};
 
@@ -16,9 +17,57 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         || builtin::STRAIGHT_BOARD_ORIGIN.to_string(),
         |p| p.display().to_string(),
     );
-    // Every output is checked before the run, so that a refused one costs nothing.
+    let (scenario, via) = validate(args, &origin)?;
+    let world = super::export::world(&scenario);
+    // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
+    // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
+    // its length; through the serial path the run is held whole and written from memory.
+    let scratch = match (&args.out, &args.mcap, via) {
+        (None, Some(mcap), Via::Memory) => Some(scratch_dir(mcap)?),
+        _ => None,
+    };
+    let streamed_to: Option<PathBuf> = match via {
+        Via::Memory => args
+            .out
+            .clone()
+            .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
+        Via::Serial => None,
+    };
+    let report = execute(args, scenario, &origin, via, streamed_to.as_deref(), out)?;
     if let Some(dir) = &args.report {
-        super::report_dir::check_report_dir(dir, &[])?;
+        let title = format!("hilsim run: {}", report.scenario.name);
+        let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
+        let html = hilsim_report::render(hilsim_report::Inputs {
+            title: &title,
+            recording: &report.run.recording,
+            recording_name: &hilsim_report::drawn_name(&name, &report.thinning),
+            scenario: Some(&report.scenario),
+            calibrations: &report.calibrations,
+            truth_estimated: false,
+        });
+        hilsim_report::write_report_files(dir, &[("index.html".into(), html)])?;
+        if !args.json {
+            writeln!(out, "report: {}", dir.join("index.html").display())?;
+        }
+    }
+    if let Some(mcap) = &args.mcap {
+        match &streamed_to {
+            Some(dir) => super::export::write_mcap_of_dir(dir, Some(&world), mcap)?,
+            None => super::export::write_mcap(&report.run.recording, Some(&world), mcap)?,
+        }
+        if !args.json {
+            writeln!(out, "wrote {}", mcap.display())?;
+        }
+    }
+    drop(scratch);
+    Ok(super::exit_code(report.passed()))
+}
+
+/// The scenario and the lidar's path, every output checked before the run, so that a refused
+/// one costs nothing.
+fn validate(args: &RunArgs, origin: &str) -> Result<(Scenario, Via)> {
+    if let Some(dir) = &args.report {
+        hilsim_report::check_report_dir(dir, &[])?;
     }
     if let Some(dir) = &args.out {
         hilsim_recording::check_replaceable_recording(&hilsim_recording::resolve_output_dir(dir)?)?;
@@ -44,39 +93,37 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         cli::Via::Memory => Via::Memory,
         cli::Via::Serial => Via::Serial,
     };
-    let world = super::export::world(&scenario);
-    // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
-    // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
-    // its length; through the serial path the run is held whole and written from memory.
-    let scratch = match (&args.out, &args.mcap, via) {
-        (None, Some(mcap), Via::Memory) => Some(scratch_dir(mcap)?),
-        _ => None,
-    };
-    let streamed_to: Option<PathBuf> = match via {
-        Via::Memory => args
-            .out
-            .clone()
-            .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
-        Via::Serial => None,
-    };
-    let (report, stream) = match &streamed_to {
+    Ok((scenario, via))
+}
+
+/// Runs the scenario, streamed into `streamed_to` when given, prints the summary (or the
+/// results' JSON) and writes the recording with its `results.json` to `--out`.
+fn execute(
+    args: &RunArgs,
+    scenario: Scenario,
+    origin: &str,
+    via: Via,
+    streamed_to: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<Report> {
+    let (report, stream) = match streamed_to {
         Some(dir) => {
             let emulation = Emulation::new(&scenario, scenario.seed)
                 .with_context(|| format!("{origin}: sensor model"))?;
             let mut stream =
                 RecordingStream::create(dir, emulation.meta().clone(), emulation.tables())?;
             drop(emulation);
-            let report = hilsim_scenarios::execute_into(scenario, &origin, via, &mut stream)?;
+            let report = hilsim_scenarios::execute_into(scenario, origin, via, &mut stream)?;
             (report, Some(stream))
         }
-        None => (hilsim_scenarios::execute(scenario, &origin, via)?, None),
+        None => (hilsim_scenarios::execute(scenario, origin, via)?, None),
     };
+    let results = report.results_json();
     if args.json {
-        out.write_all(report.results_json().as_bytes())?;
+        out.write_all(results.as_bytes())?;
     } else {
         out.write_all(report.summary().as_bytes())?;
     }
-    let results = report.results_json();
     let add_results = |tmp: &Path| -> Result<()> {
         write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
         Ok(())
@@ -93,37 +140,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let (Some(dir), false) = (&args.out, args.json) {
         writeln!(out, "wrote {}", dir.display())?;
     }
-    if let Some(dir) = &args.report {
-        let title = format!("hilsim run: {}", report.scenario.name);
-        let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
-        let html = hilsim_report::render(hilsim_report::Inputs {
-            title: &title,
-            recording: &report.run.recording,
-            recording_name: &hilsim_report::drawn_name(&name, &report.thinning),
-            scenario: Some(&report.scenario),
-            calibrations: &report.calibrations,
-            truth_estimated: false,
-        });
-        super::report_dir::write_report_page(dir, &html)?;
-        if !args.json {
-            writeln!(out, "report: {}", dir.join("index.html").display())?;
-        }
-    }
-    if let Some(mcap) = &args.mcap {
-        match &streamed_to {
-            Some(dir) => super::export::write_mcap_of_dir(dir, Some(&world), mcap)?,
-            None => super::export::write_mcap(&report.run.recording, Some(&world), mcap)?,
-        }
-        if !args.json {
-            writeln!(out, "wrote {}", mcap.display())?;
-        }
-    }
-    drop(scratch);
-    Ok(if report.passed() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(report)
 }
 
 /// A temporary directory beside `mcap` (the same file system, removed when dropped) for the

@@ -6,6 +6,7 @@
 //! `hilsim world REC --out SCENARIO.toml` is [`build_world`], [`TwinWorld::write`] and
 //! [`compare`]; `hilsim record SCENARIO.toml` then makes the twin's recording.
 
+mod declare;
 mod error;
 mod fit;
 mod path;

@@ -4,6 +4,7 @@
 //! switched on (its own noise seed), diagnoses it against the nominal scenario without being
 //! told, and scores the answer. Trial `i` is a function of (S, i) alone.
 
+mod command;
 mod draw;
 mod plan;
 mod report;

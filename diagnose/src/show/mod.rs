@@ -6,11 +6,13 @@
 mod format;
 mod html;
 mod json;
+mod page;
 mod svg;
 mod text;
 
 pub use self::html::html;
 pub use self::json::to_json;
+pub use self::page::{report_files, MAP_FILE};
 pub use self::svg::svg;
 pub use self::text::summary;
 pub use crate::plot::PlotData;

@@ -14,12 +14,13 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
-use hilsim_calibrator::em::{self, experiment, EStep, EmOptions};
+use hilsim_calibrator::em::{self, EStep, EmOptions};
 use hilsim_calibrator::kalman_smoother::{
     Gaussian, Observation, Observations, RtsSmoother, StateSpaceModel, Transition,
 };
 use hilsim_calibrator::target_samples::{self, SampleOptions, TargetSamples};
 use hilsim_calibrator::{smoothing, Calibration, Sensor};
+use hilsim_fixtures::em_experiment;
 use nalgebra::{Matrix2, Vector2};
 use nalgebra::{Matrix3, Vector3};
 
@@ -303,7 +304,7 @@ fn export_for_pykalman(dir: &std::path::Path, model: &ExplicitModel, ns_per_step
 
 fn main() {
     let rec =
-        experiment::synthetic_recording(N, &mut hilsim_sim::rng::stream(1, "issue-5-synthetic"));
+        em_experiment::synthetic_recording(N, &mut hilsim_sim::rng::stream(1, "issue-5-synthetic"));
     let s = samples(&rec);
     // `EM_BENCH_PYKALMAN_DIR=DIR cargo bench -p hilsim-calibrator --bench em -- --list` (any
     // filter) exports the model for the pykalman comparison and times the Rust pass on it.

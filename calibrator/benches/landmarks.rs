@@ -18,8 +18,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput};
 use hilsim_calibrator::landmarks::estimate::EstimatorConfig;
-use hilsim_calibrator::landmarks::monte_carlo::{monte_carlo, Setup};
 use hilsim_calibrator::landmarks::{calibrate, Options};
+use hilsim_fixtures::landmark_study::{monte_carlo, Setup};
 
 use cpu_time::ProcessTime;
 

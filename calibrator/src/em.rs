@@ -34,7 +34,6 @@
 mod engine;
 mod estep;
 mod estimate;
-pub mod experiment;
 mod information;
 mod model;
 mod mstep;

@@ -2,11 +2,9 @@
 //! Sensors J. 2017) on the simulated straight-board experiment, with the actuation error its
 //! premise needs (the commands are known, the actual speed is not).
 
-mod fixtures;
-
-use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};
 use hilsim_calibrator::em::{self, EStep, EmOptions};
 use hilsim_calibrator::{Method, Sensor};
+use hilsim_fixtures::em_experiment::{Run, LIDAR_ALPHA, LIDAR_BETA2};
 use nalgebra::{Matrix3, Vector3};
 
 /// The straight-board run of these tests: 0.1 m/s from 0.5 m to 4 m (185 revolutions), a

@@ -1,13 +1,11 @@
 //! Bad input to the EM calibrator, the ground-truth baseline and the smoother gives
 //! the right `CalibrationError` with a message a user can act on, never a panic or a NaN.
 
-mod fixtures;
-
 use std::sync::OnceLock;
 
-use fixtures::{Record, Run};
 use hilsim_calibrator::em::{self, EmOptions};
 use hilsim_calibrator::{groundtruth, smoothing, CalibrationError, Sensor, SensorModel};
+use hilsim_fixtures::em_experiment::Run;
 use hilsim_recording::{CommandSample, Recording};
 
 /// A good recording (0.3 m/s: 13.7 s, 68 revolutions), simulated once for every test.

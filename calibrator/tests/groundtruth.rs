@@ -1,12 +1,10 @@
 //! The ground-truth baseline (ML fit against the true distances, order by AIC, as in
 //! Alhashimi et al., ICINCO 2016) recovers the lidar model and picks the true order.
 
-mod fixtures;
-
-use fixtures::{Record, Run, LIDAR_ALPHA, LIDAR_BETA2};
 use hilsim_calibrator::groundtruth::{self, fit_aic, fit_ml};
 use hilsim_calibrator::target_samples::{extract, SampleOptions};
 use hilsim_calibrator::{Method, Sensor};
+use hilsim_fixtures::em_experiment::{Run, LIDAR_ALPHA, LIDAR_BETA2};
 use nalgebra::{Matrix3, Vector3};
 use rand_distr::{Distribution, StandardNormal};
 

@@ -2,10 +2,10 @@
 //! a NaN: too few stops, no landmark, a landmark seen from one stop, colinear bearings, missing
 //! or disordered data, nonsense options.
 
-use hilsim_calibrator::landmarks::monte_carlo::PAPER_ALPHA;
 use hilsim_calibrator::landmarks::regression::horner;
 use hilsim_calibrator::landmarks::{calibrate, Options};
 use hilsim_calibrator::{Calibration, CalibrationError};
+use hilsim_fixtures::landmark_study::PAPER_ALPHA;
 use hilsim_recording::{CommandSample, LidarSample, Meta, Mount, Recording};
 
 /// A cylinder of radius 0.12 m, visible only during the stops listed (all when `None`).

@@ -3,12 +3,12 @@
 //! the refinement beyond the paper improves the calibration.
 
 use hilsim_calibrator::landmarks::estimate::{estimate, EstimatorConfig};
-use hilsim_calibrator::landmarks::monte_carlo::{
-    run_one, run_seed, simulate, Setup, Xoshiro256pp, PAPER_ALPHA,
-};
 use hilsim_calibrator::landmarks::positions::{intersect, second_order_bias, BearingLine, Weights};
 use hilsim_calibrator::landmarks::regression::horner;
 use hilsim_calibrator::landmarks::{Inverse, OrderSelection};
+use hilsim_fixtures::landmark_study::{
+    run_one, run_seed, simulate, Setup, Xoshiro256pp, PAPER_ALPHA,
+};
 use proptest::prelude::*;
 
 /// Three landmarks in fixed positions, so that the bias is that of one geometry.

@@ -4,9 +4,9 @@
 
 use std::sync::OnceLock;
 
-use hilsim_calibrator::landmarks::monte_carlo::PAPER_ALPHA;
 use hilsim_calibrator::landmarks::regression::horner;
 use hilsim_calibrator::landmarks::{analyse, Analysis, Nominal, Options};
+use hilsim_fixtures::landmark_study::PAPER_ALPHA;
 use hilsim_recording::Pose;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;

@@ -1,12 +1,10 @@
 //! Reusing a trained calibration (the EM paper's Sec. V): one smoother pass over a new
 //! recording gives calibrated distances without re-running EM.
 
-mod fixtures;
-
-use fixtures::{Record, Run};
 use hilsim_calibrator::em::{self, EStep, EmOptions};
 use hilsim_calibrator::target_samples::{distance_metrics, extract, SampleOptions};
 use hilsim_calibrator::{smoothing, Sensor};
+use hilsim_fixtures::em_experiment::Run;
 
 fn nmse(rec: &hilsim_recording::Recording, est: &[smoothing::Estimate]) -> (f64, f64) {
     let s = extract(

@@ -6,15 +6,16 @@
 //! The runs are drawn from each method's own model, without physics, so that the truth of every
 //! coefficient is known and 200 runs take seconds: ground truth from the paper's sensor model at
 //! known distances, EM from its state-space model (commanded motion with a speed error of
-//! `q |u|` per step), landmarks from the landmark paper's simulation study (`monte_carlo`).
+//! `q |u|` per step), landmarks from the landmark paper's simulation study
+//! (`hilsim_fixtures::landmark_study`).
 
 use hilsim_calibrator::em::{self, EmOptions};
 use hilsim_calibrator::groundtruth;
 use hilsim_calibrator::landmarks::estimate::estimate;
-use hilsim_calibrator::landmarks::monte_carlo::{simulate, Setup, Xoshiro256pp, PAPER_ALPHA};
 use hilsim_calibrator::landmarks::OrderSelection;
 use hilsim_calibrator::target_samples::TargetSamples;
 use hilsim_calibrator::Sensor;
+use hilsim_fixtures::landmark_study::{simulate, Setup, Xoshiro256pp, PAPER_ALPHA};
 use rand::RngCore;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;

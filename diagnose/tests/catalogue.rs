@@ -11,21 +11,12 @@
 use std::path::Path;
 
 use hilsim_diagnose::{diagnose, Diagnosis, Effect, Options, Sensor, SimPhysics};
+use hilsim_fixtures::rooms::ROOM_4X3;
 use hilsim_lidar_emulator::Emulation;
 use hilsim_sim::Scenario;
 
-const ROOM: &str = r#"
-name = "issue-15-room"
-seed = 5
-
-[world]
-walls = [
-    { from = [0.0, 0.0], to = [4.0, 0.0] },
-    { from = [4.0, 0.0], to = [4.0, 3.0] },
-    { from = [4.0, 3.0], to = [0.0, 3.0] },
-    { from = [0.0, 3.0], to = [0.0, 0.0] },
-]
-cylinders = [{ center = [2.8, 1.9], radius = 0.12 }]
+/// The room's furniture (added to [`ROOM_4X3`]'s `[world]`), robot, drive and sensors.
+const FURNISHED: &str = r#"cylinders = [{ center = [2.8, 1.9], radius = 0.12 }]
 boards = [{ center = [3.2, 0.7], length = 0.8, thickness = 0.02, yaw_deg = 60.0 }]
 
 [robot]
@@ -67,7 +58,8 @@ noise_m = 0.002
 "#;
 
 fn room() -> Scenario {
-    Scenario::from_toml(ROOM, Path::new("issue-15-room.toml")).expect("the test's scenario")
+    let text = format!("name = \"catalogue-room\"\nseed = 5\n\n{ROOM_4X3}{FURNISHED}");
+    Scenario::from_toml(&text, Path::new("catalogue-room.toml")).expect("the test's scenario")
 }
 
 /// The diagnosis of a run of `room()` with `effect` concealed at `params`, trying `tried`.

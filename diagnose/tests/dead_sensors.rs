@@ -8,22 +8,13 @@
 use std::path::Path;
 
 use hilsim_diagnose::{diagnose, Diagnosis, Options, Sensor, SimPhysics, Verdict};
+use hilsim_fixtures::rooms::ROOM_4X3;
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
-const ROOM: &str = r#"
-name = "dead-sensor-room"
-seed = 3
-
-[world]
-walls = [
-    { from = [0.0, 0.0], to = [4.0, 0.0] },
-    { from = [4.0, 0.0], to = [4.0, 3.0] },
-    { from = [4.0, 3.0], to = [0.0, 3.0] },
-    { from = [0.0, 3.0], to = [0.0, 0.0] },
-]
-cylinders = [{ center = [2.8, 1.9], radius = 0.12 }]
+/// The room's furniture (added to [`ROOM_4X3`]'s `[world]`), robot, drive and sensors.
+const FURNISHED: &str = r#"cylinders = [{ center = [2.8, 1.9], radius = 0.12 }]
 
 [robot]
 start = { x = 0.8, y = 0.8, yaw_deg = 0.0 }
@@ -55,7 +46,8 @@ noise_m = 0.002
 "#;
 
 fn scenario() -> Scenario {
-    Scenario::from_toml(ROOM, Path::new("dead-sensor-room.toml")).expect("the test's scenario")
+    let text = format!("name = \"dead-sensor-room\"\nseed = 3\n\n{ROOM_4X3}{FURNISHED}");
+    Scenario::from_toml(&text, Path::new("dead-sensor-room.toml")).expect("the test's scenario")
 }
 
 fn recording() -> Recording {

@@ -1,13 +1,9 @@
-//! What the sections share: the experiment's settings, the simulation, statistics and tables.
+//! What the sections share: the experiment's settings, statistics and tables.
 
-use hilsim_calibrator::em::experiment::Run;
 use hilsim_calibrator::em::{self, EmOptions, EmOutcome};
 use hilsim_calibrator::stats::median;
 use hilsim_calibrator::target_samples::{distance_metrics, TargetSamples};
 use hilsim_calibrator::Calibration;
-use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::Recording;
-use hilsim_sim::Scenario;
 
 /// The paper's speeds (Sec. VI).
 pub const SPEEDS: [f64; 3] = [0.1, 0.2, 0.3];
@@ -16,23 +12,6 @@ pub const SPEEDS: [f64; 3] = [0.1, 0.2, 0.3];
 pub const ACTUATION: (f64, f64) = (0.02, 0.01);
 /// The paper's Sec. V test windows: 12 samples.
 pub const WINDOW: usize = 12;
-
-/// A run of the experiment simulated.
-pub trait Record {
-    /// Simulates the run; the recording carries the truth.
-    fn record(&self) -> Recording;
-}
-
-impl Record for Run {
-    fn record(&self) -> Recording {
-        let scenario = Scenario::from_toml(&self.scenario_toml(), "issue-5.toml".as_ref())
-            .expect("the experiment's scenario is valid");
-        Emulation::new(&scenario, self.seed)
-            .expect("the experiment's sensors are valid")
-            .run()
-            .recording
-    }
-}
 
 /// Mean and standard error.
 pub fn mean_se(v: &[f64]) -> (f64, f64) {

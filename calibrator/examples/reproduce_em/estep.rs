@@ -1,8 +1,8 @@
 //! The E-step variants against each other.
 
-use hilsim_calibrator::em::experiment::{Run, LIDAR_ALPHA};
 use hilsim_calibrator::em::{EStep, EmOptions};
 use hilsim_calibrator::{Calibration, Sensor};
+use hilsim_fixtures::em_experiment::{Run, LIDAR_ALPHA};
 use rayon::prelude::*;
 
 use crate::common::*;

@@ -1,9 +1,9 @@
 //! Sec. VI-A, Fig. 3.
 
-use hilsim_calibrator::em::experiment::Run;
 use hilsim_calibrator::em::{EStep, EmOptions};
 use hilsim_calibrator::groundtruth;
 use hilsim_calibrator::stats::median;
+use hilsim_fixtures::em_experiment::Run;
 use rayon::prelude::*;
 
 use crate::common::*;

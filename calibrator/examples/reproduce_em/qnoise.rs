@@ -1,7 +1,7 @@
 //! Sensitivity to the assumed process noise, and estimating it.
 
-use hilsim_calibrator::em::experiment::Run;
 use hilsim_calibrator::em::EmOptions;
+use hilsim_fixtures::em_experiment::Run;
 use rayon::prelude::*;
 
 use crate::common::*;

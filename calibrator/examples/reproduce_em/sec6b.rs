@@ -1,9 +1,9 @@
 //! Sec. V / VI-B: reusing a calibration.
 
-use hilsim_calibrator::em::experiment::Run;
 use hilsim_calibrator::em::EmOptions;
 use hilsim_calibrator::target_samples::{distance_metrics, TargetSamples};
 use hilsim_calibrator::{groundtruth, smoothing, Calibration, Sensor};
+use hilsim_fixtures::em_experiment::Run;
 use rayon::prelude::*;
 
 use crate::common::*;

@@ -1,8 +1,8 @@
 //! Sec. VI-C, Figs. 8–9: heading errors.
 
-use hilsim_calibrator::em::experiment::{Run, LIDAR_ALPHA, LIDAR_BETA2, SONAR_ALPHA};
 use hilsim_calibrator::em::EmOptions;
 use hilsim_calibrator::Sensor;
+use hilsim_fixtures::em_experiment::{Run, LIDAR_ALPHA, LIDAR_BETA2, SONAR_ALPHA};
 use rayon::prelude::*;
 
 use crate::common::*;

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use hilsim_calibrator::landmarks::monte_carlo::Setup;
+use hilsim_fixtures::landmark_study::Setup;
 
 use crate::{mc, seed, Args, LANDMARK_COUNTS};
 

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use hilsim_calibrator::landmarks::monte_carlo::{Setup, Summary};
+use hilsim_fixtures::landmark_study::{Setup, Summary};
 
 use crate::{mc, seed, Args};
 

@@ -23,7 +23,7 @@ mod raw_scans;
 
 use std::time::Instant;
 
-use hilsim_calibrator::landmarks::monte_carlo::{monte_carlo, Setup, Summary};
+use hilsim_fixtures::landmark_study::{monte_carlo, Setup, Summary};
 
 struct Args {
     runs: usize,

@@ -233,7 +233,7 @@ fn span_check(
 mod tests {
     use super::*;
     use crate::landmarks::estimate::Observation;
-    use crate::landmarks::monte_carlo::PAPER_ALPHA;
+    use hilsim_fixtures::landmark_study::PAPER_ALPHA;
 
     /// Two stops 0.3 m apart, landmarks at 1 m and 3 m ahead-left: wide across landmarks, narrow
     /// along each.

@@ -11,7 +11,6 @@
 //! order, selects the order by AIC and by cross-validation and fits beta, [`inversion`] turns a
 //! reading into a distance. Beyond the paper, [`estimate`] adds residual-variance weights and
 //! heteroscedastic WLS, and [`joint`] refines the landmarks, stops and alpha together.
-//! [`monte_carlo`] is the paper's simulation study, pure maths.
 //!
 //! ```no_run
 //! use hilsim_calibrator::landmarks::{calibrate, Options};
@@ -32,7 +31,6 @@ pub mod detection;
 pub mod estimate;
 pub mod inversion;
 pub mod joint;
-pub mod monte_carlo;
 pub mod options;
 pub mod positions;
 pub mod regression;

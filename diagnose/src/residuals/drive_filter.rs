@@ -68,9 +68,9 @@ pub(super) fn drive_predictions(
 mod tests {
     use super::*;
     use crate::residuals::data::DRIVE_WINDOW_S;
-    use hilsim_calibrator::landmarks::monte_carlo::Xoshiro256pp;
-    use rand::Rng;
+    use rand::{Rng, SeedableRng};
     use rand_distr::StandardNormal;
+    use rand_xoshiro::Xoshiro256PlusPlus;
 
     /// A drive whose fixed scale error is 2 σ of the declared one (4 %): against the commands
     /// alone every moving window is biased the same way; the filter's innovations, standardised,
@@ -84,7 +84,7 @@ mod tests {
             wander_sd: 0.01,
             wander_tau_s: 10.0,
         };
-        let mut rng = Xoshiro256pp::seed_from_u64(3);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
         let noise_sd = 0.001_f64;
         let (mut wander, a) = (0.0_f64, (-DRIVE_WINDOW_S / 10.0).exp());
         let (mut increments, mut y) = (Vec::new(), Vec::new());

@@ -227,27 +227,16 @@ pub(crate) fn verdict_label(v: &Result<Verdict, String>) -> &'static str {
 mod tests {
     use std::path::Path;
 
+    use hilsim_fixtures::rooms::ROOM_4X3;
     use hilsim_recording::{CommandSample, TruthSample};
 
     use super::*;
 
     /// A 4 m × 3 m room, the robot starting at (1, 1) facing +x.
     fn room() -> Scenario {
+        let robot = "[robot]\nstart = { x = 1.0, y = 1.0 }\nwheel_base_m = 0.23\n";
         Scenario::from_toml(
-            r#"
-            name = "through-a-wall"
-            duration_s = 4.0
-            [world]
-            walls = [
-                { from = [0.0, 0.0], to = [4.0, 0.0] },
-                { from = [4.0, 0.0], to = [4.0, 3.0] },
-                { from = [4.0, 3.0], to = [0.0, 3.0] },
-                { from = [0.0, 3.0], to = [0.0, 0.0] },
-            ]
-            [robot]
-            start = { x = 1.0, y = 1.0 }
-            wheel_base_m = 0.23
-            "#,
+            &format!("name = \"through-a-wall\"\nduration_s = 4.0\n{ROOM_4X3}{robot}"),
             Path::new("through-a-wall.toml"),
         )
         .expect("the test's scenario")

@@ -3,21 +3,19 @@
 
 use std::path::Path;
 
+use hilsim_fixtures::rooms::ROOM_4X3;
+
 use super::common::*;
 
 /// A small room and a short drive (12 s: starts, a stop, a turn), every sensor; the lidar takes
 /// each revolution at one instant and the sonar looks along its axis. Small so that the tests,
 /// which run the unoptimised binary, stay quick.
-const ROOM: &str = r#"name = "diagnose-small"
-seed = 5
-[world]
-walls = [
-    { from = [0.0, 0.0], to = [4.0, 0.0] },
-    { from = [4.0, 0.0], to = [4.0, 3.0] },
-    { from = [4.0, 3.0], to = [0.0, 3.0] },
-    { from = [0.0, 3.0], to = [0.0, 0.0] },
-]
-cylinders = [{ center = [2.6, 1.3], radius = 0.1 }]
+fn room() -> String {
+    format!("name = \"diagnose-small\"\nseed = 5\n{ROOM_4X3}{FURNITURE_AND_ROBOT}")
+}
+
+/// What the room holds besides its walls, the robot, its drive and its sensors.
+const FURNITURE_AND_ROBOT: &str = r#"cylinders = [{ center = [2.6, 1.3], radius = 0.1 }]
 [robot]
 start = { x = 0.8, y = 0.8, yaw_deg = 0.0 }
 wheel_base_m = 0.23
@@ -48,7 +46,7 @@ noise_m = 0.002
 
 /// Writes the room with `effects` appended (and `seed`) as `name` in `dir`.
 fn scenario(dir: &Path, name: &str, seed: u64, effects: &str) -> String {
-    let text = ROOM.replace("seed = 5", &format!("seed = {seed}")) + effects;
+    let text = room().replace("seed = 5", &format!("seed = {seed}")) + effects;
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     path.to_str().unwrap().to_string()
@@ -175,7 +173,7 @@ fn the_nominal_run_is_none_and_the_report_renders() {
 #[test]
 fn declared_actuation_error_and_range_limits_are_noise_not_mismatch() {
     let tmp = tempfile::tempdir().unwrap();
-    let text = ROOM
+    let text = room()
         .replace(
             "turn_rate_deg_s = 60.0\n",
             "turn_rate_deg_s = 60.0\n[robot.actuation]\nscale_sd = 0.02\nwander_sd = 0.01\n",
@@ -367,7 +365,7 @@ fn bad_input_is_refused_with_one_line_naming_the_file() {
     // Too short a recording: 5 s.
     std::fs::write(
         tmp.path().join("short.toml"),
-        ROOM.replace("seed = 5", "seed = 5\nduration_s = 5.0"),
+        room().replace("seed = 5", "seed = 5\nduration_s = 5.0"),
     )
     .unwrap();
     record(tmp.path(), "short.toml", "short");
@@ -377,7 +375,7 @@ fn bad_input_is_refused_with_one_line_naming_the_file() {
     ));
     assert!(err.contains("short") && err.contains("too short"), "{err}");
     // A run of another scenario: it starts elsewhere.
-    let elsewhere = ROOM.replace("x = 0.8, y = 0.8", "x = 2.0, y = 2.2");
+    let elsewhere = room().replace("x = 0.8, y = 0.8", "x = 2.0, y = 2.2");
     std::fs::write(tmp.path().join("elsewhere.toml"), elsewhere).unwrap();
     record(tmp.path(), "elsewhere.toml", "other");
     let err = assert_bad_input(&hilsim(

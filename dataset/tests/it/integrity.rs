@@ -3,13 +3,11 @@
 //! must refuse such a run without ever bringing it into the target, however often it is asked;
 //! shards started at the same instant on a fresh directory (a Slurm job array) must all succeed.
 
-mod common;
-
 use std::fs;
 use std::path::Path;
 use std::sync::{Arc, Barrier};
 
-use common::*;
+use super::common::*;
 use hilsim_dataset::{merge, Error, Options, Plan, Progress, Shard};
 
 const VARIES: &[&str] = &[

@@ -1,12 +1,10 @@
 //! The manifest must say, for every run, its seed, its varied values, what its
 //! recording holds and a content hash anyone can recompute from the files with standard tools.
 
-mod common;
-
 use std::fs;
 use std::process::Command;
 
-use common::*;
+use super::common::*;
 use hilsim_dataset::{scan_run, Options};
 use hilsim_recording::Recording;
 use sha2::{Digest, Sha256};

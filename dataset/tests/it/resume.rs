@@ -3,12 +3,10 @@
 //! manifest left behind), a directory of another dataset must be refused, and a run that fails
 //! must be recorded while the others go on.
 
-mod common;
-
 use std::fs;
 use std::path::Path;
 
-use common::*;
+use super::common::*;
 use hilsim_dataset::{Error, Options, Shard};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_sim::Scenario;

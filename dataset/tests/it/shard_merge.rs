@@ -3,11 +3,9 @@
 //! dataset byte for byte; a merge of different datasets, or of a run changed after it was made,
 //! must be refused.
 
-mod common;
-
 use std::fs;
 
-use common::*;
+use super::common::*;
 use hilsim_dataset::{merge, Error, Options, Shard};
 
 const VARIES: &[&str] = &[

@@ -2,12 +2,10 @@
 //! (S, r, KEY) alone, drawn uniformly in its range; a `--vary` that cannot work is refused
 //! before any run, naming the key.
 
-mod common;
-
 use std::collections::HashSet;
 use std::path::Path;
 
-use common::*;
+use super::common::*;
 use hilsim_dataset::{draw, run_seed, Dataset, Error, Vary, MAX_SEED};
 use hilsim_sim::Scenario;
 

@@ -1,0 +1,7 @@
+//! The crate's integration tests, one binary (a binary per file would link the dependency tree
+//! once each).
+
+mod catalogue;
+mod dead_sensors;
+mod estimated_path;
+mod mismatch;

@@ -180,8 +180,8 @@ impl Metrics {
 ///
 /// Read back from its JSON, only `method` and the sensor models must be there and well formed
 /// (and `odometry`, when there); the figures that only describe the result read as absent (or
-/// 0 iterations, converged) where they are missing or malformed ([`lenient`]). Keys it does
-/// not know are ignored.
+/// 0 iterations, converged) where they are missing or malformed (`calibration/lenient.rs`).
+/// Keys it does not know are ignored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {
     /// The method used.

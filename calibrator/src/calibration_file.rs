@@ -358,7 +358,7 @@ mod tests {
     /// A calibration of any shape the calibrator makes, with finite figures (a NaN is written as
     /// `null`, which reads back as absent or NaN, never equal).
     fn any_calibration() -> impl Strategy<Value = Calibration> {
-        let figure = || prop_oneof![-1e3..1e3f64, -1e-6..1e-6f64];
+        let figure = || prop_oneof![-1e3..1e3f64, -1e-6..1e-6f64, proptest::num::f64::NORMAL];
         let model = (1..4usize, any::<bool>()).prop_flat_map(move |(n, with_sd)| {
             let sd = if with_sd { n } else { 0 };
             (

@@ -5,13 +5,15 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+pub(crate) mod lenient;
+
 /// The calibration methods and the sensors they calibrate (one definition each, shared with
 /// the scenario files: `hilsim_recording::names`).
 pub use hilsim_recording::{Method, Sensor};
 
 /// The fitted model of one sensor, eq. (2) of both papers:
 /// `reading = Σ alpha_i d^i + (Σ beta_i d^i) e`, lowest order first, metres.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SensorModel {
     /// Bias coefficients alpha_0..
     pub alpha: Vec<f64>,
@@ -19,10 +21,18 @@ pub struct SensorModel {
     pub beta: Vec<f64>,
     /// One standard error per alpha coefficient (each method's own: see its docs); empty when
     /// unknown (a model read back from JSON without them).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "lenient::null_as_default"
+    )]
     pub alpha_sd: Vec<f64>,
     /// One standard error per beta coefficient (0 for a coefficient the method holds at 0).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "lenient::null_as_default"
+    )]
     pub beta_sd: Vec<f64>,
 }
 
@@ -98,7 +108,7 @@ impl OdometryModel {
 /// distances; calibrated: the method's estimates), metres²; `nmse_*` is the EM paper's
 /// normalised MSE (Fig. 3): the mean over samples of each squared error divided by that
 /// sample's squared true distance (dimensionless).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// MSE of the raw readings.
     pub mse_raw: f64,
@@ -111,13 +121,17 @@ pub struct Metrics {
     /// The lidar model alone: each raw reading inverted through the fitted lidar model. For
     /// EM the figures above measure the smoothed distance, which also fuses the commands, the
     /// odometer and the sonar, and can look good while the lidar model is wrong.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "lenient::or_none"
+    )]
     pub lidar_model: Option<LidarModelMetrics>,
 }
 
 /// How well the fitted lidar model alone turns raw readings into distances: each raw reading
 /// inverted through it (the landmark paper's eq. 30) against the true distance.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LidarModelMetrics {
     /// MSE of the raw readings, m².
     pub mse_raw: f64,
@@ -163,36 +177,65 @@ impl Metrics {
 }
 
 /// What a calibration found.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+///
+/// Read back from its JSON, only `method` and the sensor models must be there and well formed
+/// (and `odometry`, when there); the figures that only describe the result read as absent (or
+/// 0 iterations, converged) where they are missing or malformed (`calibration/lenient.rs`).
+/// Keys it does not know are ignored.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {
     /// The method used.
+    #[serde(deserialize_with = "lenient::method")]
     pub method: Method,
     /// One model per calibrated sensor; sensors absent from the recording are absent here.
+    #[serde(default, deserialize_with = "lenient::sensors")]
     pub sensors: BTreeMap<Sensor, SensorModel>,
     /// Iterations the method ran (1 for closed-form methods).
+    #[serde(default, deserialize_with = "lenient::or_default")]
     pub iterations: usize,
     /// Whether it met its convergence criterion.
+    #[serde(
+        default = "lenient::yes",
+        deserialize_with = "lenient::true_unless_false"
+    )]
     pub converged: bool,
     /// Quality against the truth; present only when the recording has truth.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "lenient::or_none"
+    )]
     pub metrics: Option<Metrics>,
     /// The selected polynomial order (landmarks).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "lenient::or_none"
+    )]
     pub order: Option<usize>,
     /// Estimated landmark centres, metres, in the frame of the robot's pose at the start of the
     /// recording (x forward, y left) (landmarks).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "lenient::or_none"
+    )]
     pub landmarks: Option<Vec<[f64; 2]>>,
     /// The wheels and the lidar's mount (odometry).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub odometry: Option<OdometryModel>,
     /// The method's assumptions tested on the data ([`crate::checks`]); a failed one makes
     /// `hilsim calibrate` exit 1 with the result still printed.
+    #[serde(default, deserialize_with = "lenient::readable_items")]
     pub checks: Vec<crate::checks::Check>,
     /// Further method-specific facts for people: what was skipped and why (stops too short, a
     /// landmark track dropped), choices made (AIC and cross-validation). In the JSON as `notes`
     /// when there are any; their wording is not an interface.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "lenient::readable_items"
+    )]
     pub notes: Vec<String>,
 }
 

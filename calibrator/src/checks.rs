@@ -8,22 +8,29 @@
 //! a start distance metres off, a landmark seen from one place only) fail them by a wide margin.
 
 use hilsim_recording::{wrap_angle, CommandSample, OdometrySample, Recording};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use crate::calibration::lenient;
 use crate::SensorModel;
 
 /// One assumption tested on the data (interfaces.md: `checks`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+///
+/// Read back from JSON, a check needs its `name` and `pass`; a figure that is not a number (a
+/// NaN is written as `null`) reads as NaN and a missing `detail` as empty.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Check {
     /// What is tested, e.g. `lidar.bias_plausible`.
     pub name: String,
     /// The figure measured.
+    #[serde(default = "lenient::nan", deserialize_with = "lenient::number_or_nan")]
     pub value: f64,
     /// The bound it is held to.
+    #[serde(default = "lenient::nan", deserialize_with = "lenient::number_or_nan")]
     pub threshold: f64,
     /// Whether it held.
     pub pass: bool,
     /// In words: what the figure is and what a failure means.
+    #[serde(default, deserialize_with = "lenient::or_default")]
     pub detail: String,
 }
 

@@ -21,6 +21,7 @@ pub mod kalman_smoother;
 pub mod landmarks;
 pub mod odometry;
 pub mod random_walk_smoother;
+pub mod request;
 pub mod scan_match;
 mod smoothed_table;
 pub mod smoothing;
@@ -32,5 +33,6 @@ pub use calibration::{
     Calibration, LidarModelMetrics, Method, Metrics, OdometryModel, Sensor, SensorModel,
 };
 pub use error::CalibrationError;
+pub use request::Request;
 pub use smoothed_table::{smoothed_csv, SMOOTHED_CSV};
 pub use target_samples::{SampleOptions, START_DISTANCE_RANGE_M};

@@ -7,20 +7,16 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use hilsim_calibrator::landmarks::StopOptions;
-use hilsim_calibrator::{em, odometry, smoothing, Calibration, Method, SampleOptions, Settings};
+use hilsim_calibrator::{odometry, request, smoothing, Calibration, Method, Request, Settings};
 use hilsim_recording::{check_output_file, write_file_atomically, Meta, OutputTarget, Recording};
 
 use crate::cli::{CalibrateArgs, SmoothArgs};
 
 /// Prints the calibration; exit 1 when one of its checks failed (the result is still printed).
 pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let settings = settings(args)?;
+    let settings = request(args).settings()?;
     let method = args.method;
     let (calibration, input) = match (&args.recording, &args.tuples) {
-        (_, Some(tuples)) if method != Method::Odometry => {
-            bail!("--tuples: tuples are for --method odometry")
-        }
         (_, Some(tuples)) => (calibrate_tuples(tuples)?, tuples.as_path()),
         (Some(recording), None) => (
             calibrate_dir(recording, method, &settings)?,
@@ -50,105 +46,21 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     Ok(ExitCode::from(1))
 }
 
-/// Refuses a `value` that `ok` does not accept, saying `expected`.
-fn check(value: Option<f64>, ok: impl Fn(f64) -> bool, expected: &str) -> Result<()> {
-    match value {
-        Some(v) if !(v.is_finite() && ok(v)) => bail!("{expected}"),
-        _ => Ok(()),
+/// The calibration asked for by the flags, as given.
+fn request(args: &CalibrateArgs) -> Request<'_> {
+    Request {
+        method: args.method,
+        tuples: args.tuples.is_some(),
+        beam_deg: args.beam,
+        start_distance_m: args.start_distance,
+        settle_s: args.settle_s,
+        min_revolutions: args.min_revolutions,
+        priors: &args.priors,
+        wheel_radius_m: args.wheel_radius_m,
+        interval_s: args.interval_s,
+        lidar_latency_s: args.lidar_latency_s,
+        lidar_model: args.lidar_model.as_deref(),
     }
-}
-
-/// The numbers given, each in its range.
-fn check_ranges(args: &CalibrateArgs) -> Result<()> {
-    let (max_interval, max_latency) = (odometry::MAX_INTERVAL_S, odometry::MAX_LIDAR_LATENCY_S);
-    check(
-        args.settle_s,
-        |s| (0.0..=86_400.0).contains(&s),
-        "--settle-s: expected a settling time in seconds, from 0 to 86400",
-    )?;
-    check(
-        args.min_revolutions,
-        |n| (1.0..=1e6).contains(&n),
-        "--min-revolutions: expected a number of revolutions from 1 to 1000000",
-    )?;
-    check(
-        args.wheel_radius_m,
-        |r| r > 0.0 && r <= 10.0,
-        "--wheel-radius-m: expected a radius in metres, more than 0 and at most 10",
-    )?;
-    check(
-        args.interval_s,
-        |s| s > 0.0 && s <= max_interval,
-        &format!("--interval-s: expected seconds, more than 0 and at most {max_interval}"),
-    )?;
-    check(
-        args.lidar_latency_s,
-        |s| s.abs() <= max_latency,
-        &format!("--lidar-latency-s: expected seconds from -{max_latency} to {max_latency}"),
-    )?;
-    Ok(())
-}
-
-/// The calibrator's settings from the arguments, each checked before anything is read.
-fn settings(args: &CalibrateArgs) -> Result<Settings> {
-    let target = target_options(args.beam, args.start_distance)?;
-    check_ranges(args)?;
-    // Each method's own options: given to another, they would be silently ignored.
-    let odometry_options = args.wheel_radius_m.is_some()
-        || args.interval_s.is_some()
-        || args.lidar_latency_s.is_some();
-    if odometry_options && (args.method != Method::Odometry || args.tuples.is_some()) {
-        bail!(
-            "--wheel-radius-m, --interval-s and --lidar-latency-s are for --method odometry on \
-             a recording"
-        );
-    }
-    if !args.priors.is_empty() && args.method != Method::Em {
-        bail!("--prior: priors are for --method em");
-    }
-    let stop_options = args.settle_s.is_some() || args.min_revolutions.is_some();
-    if stop_options && args.method != Method::Landmarks {
-        bail!("--settle-s and --min-revolutions are for --method landmarks");
-    }
-    let priors: Vec<em::Prior> = args
-        .priors
-        .iter()
-        .map(|p| p.parse())
-        .collect::<Result<_, _>>()?;
-    let priors = em::Priors::new(&priors)?;
-    let lidar_bias = args.lidar_model.as_deref().map(lidar_bias).transpose()?;
-    let (stops, recording) = (
-        StopOptions::default(),
-        odometry::RecordingOptions::default(),
-    );
-    Ok(Settings {
-        target,
-        stops: StopOptions {
-            settle_s: args.settle_s,
-            min_revolutions: args.min_revolutions.unwrap_or(stops.min_revolutions),
-            ..stops
-        },
-        priors,
-        odometry: odometry::RecordingOptions {
-            nominal_wheel_radius_m: args.wheel_radius_m,
-            interval_s: args.interval_s.unwrap_or(recording.interval_s),
-            lidar_latency_s: args.lidar_latency_s,
-            lidar_bias,
-        },
-    })
-}
-
-/// The range bias of the lidar model in the calibration at `path` (`--lidar-model`).
-fn lidar_bias(path: &Path) -> Result<Vec<f64>> {
-    let model = Calibration::read(path)?;
-    let Some(lidar) = model.sensors.get(&hilsim_calibrator::Sensor::Lidar) else {
-        let method = model.method.name();
-        bail!(
-            "{}: the {method} method's calibration has no lidar model",
-            path.display()
-        );
-    };
-    Ok(lidar.alpha.clone())
 }
 
 /// The calibration of a recording directory, with a note for each key of its `meta.toml` the
@@ -182,26 +94,10 @@ fn calibrate_tuples(path: &Path) -> Result<Calibration> {
     odometry::calibrate_tuples(&tuples, unsound).with_context(|| format!("{origin}: odometry"))
 }
 
-fn target_options(beam: Option<f64>, start: Option<f64>) -> Result<SampleOptions> {
-    let beam_deg = beam.unwrap_or(0.0);
-    if !beam_deg.is_finite() {
-        bail!("--beam: expected a finite angle in degrees");
-    }
-    let range = hilsim_calibrator::START_DISTANCE_RANGE_M;
-    if let Some(d) = start.filter(|d| !range.contains(d)) {
-        let (lo, hi) = (range.start(), range.end());
-        bail!("--start-distance: expected a distance from {lo} to {hi} m, found {d:?}");
-    }
-    Ok(SampleOptions {
-        beam_deg,
-        start_distance_m: start,
-    })
-}
-
 /// Writes the smoothed distances; exit 1 when the recording fails a check against the
 /// calibration (the distances are still written; the failed checks go to stderr).
 pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let target = target_options(args.beam, args.start_distance)?;
+    let target = request::target(args.beam, args.start_distance)?;
     if let Some(csv) = &args.csv {
         let mut inputs = Recording::files_in(&args.recording);
         inputs.push(args.calibration.clone());

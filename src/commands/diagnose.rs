@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{anyhow, bail, Context, Result};
-use hilsim_diagnose::self_test::{self, Plan, Reality};
+use hilsim_diagnose::self_test::{self, Plan};
 use hilsim_diagnose::{show, Diagnosis, Floors, Options, SensorFloor, SimPhysics};
 use hilsim_recording::Recording;
 use hilsim_report::check_report_dir;
@@ -83,47 +83,22 @@ fn options(args: &DiagnoseArgs) -> Result<Options> {
     })
 }
 
-/// The self-test's nominal scenario and plan, checked before any trial is run.
+/// The self-test's plan, checked before its nominal scenario is read.
 fn self_test_plan(args: &DiagnoseArgs, n: i128) -> Result<(Scenario, Plan)> {
-    if n < 1 {
-        bail!("--self-test: expected at least one trial, found {n}");
-    }
-    let max = self_test::MAX_TRIALS;
-    let Some(n) = u64::try_from(n).ok().filter(|n| *n <= max) else {
-        bail!("--self-test: expected at most {max} trials, found {n}");
-    };
-    let strength = args.strength;
-    if !(strength.is_finite() && strength > 0.0 && strength <= 5.0) {
-        bail!("--strength: expected a factor in (0, 5], found {strength:?}");
-    }
-    if args.report.is_some() && args.trial.is_none() {
-        bail!("--report with --self-test needs --trial I: the report is of one trial");
-    }
+    let plan = Plan::from_flags(&self_test::Flags {
+        trials: n,
+        seed: args.seed,
+        strength: args.strength,
+        only: args.only.as_deref(),
+        reality: &args.reality,
+        without_truth: args.without_truth,
+        trial: args.trial,
+        report: args.report.is_some(),
+    })?;
     let scenario = match &args.sim {
         Some(path) => Scenario::load(path)?,
         None => hilsim_scenarios::builtin::diagnose_room()?,
     };
-    let reality = match args.reality.as_str() {
-        "independent" => Reality::Independent,
-        _ => Reality::Hilsim,
-    };
-    let only = match args.only.as_deref() {
-        None => None,
-        Some(name) => Some(Plan::class_named(name, reality).ok_or_else(|| {
-            anyhow!("--only: expected `none` or a catalogued effect, found `{name}`")
-        })?),
-    };
-    let plan = Plan {
-        trials: n,
-        seed: args.seed.unwrap_or(1),
-        strength,
-        only,
-        reality,
-        without_truth: args.without_truth,
-    };
-    if let Some(i) = args.trial.filter(|i| *i >= n) {
-        bail!("--trial: expected a trial below --self-test {n}, found {i}");
-    }
     Ok((scenario, plan))
 }
 

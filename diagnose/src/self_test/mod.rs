@@ -17,6 +17,7 @@ mod trial;
 /// before anything is allocated for it.
 pub const MAX_TRIALS: u64 = 100_000;
 
+pub use command::Flags;
 pub use draw::Drawn;
 pub use draw::OUTSIDE;
 pub use plan::{Plan, Reality};

@@ -36,7 +36,9 @@ impl Plan {
         let input = |message: String| Err(MismatchError::Input(message));
         let n = flags.trials;
         if n < 1 {
-            return input(format!("--self-test: expected at least one trial, found {n}"));
+            return input(format!(
+                "--self-test: expected at least one trial, found {n}"
+            ));
         }
         let Some(n) = u64::try_from(n).ok().filter(|n| *n <= MAX_TRIALS) else {
             return input(format!(

@@ -7,6 +7,7 @@
 pub mod builtin;
 pub mod calibrated;
 mod discover;
+mod firmware_plan;
 mod firmware_run;
 pub mod metrics;
 mod pipeline;
@@ -14,6 +15,7 @@ mod summary;
 mod test_results;
 
 pub use discover::{scenario_files, DiscoverError};
+pub use firmware_plan::{FirmwarePlan, FirmwarePlanError, FirmwareRequest};
 pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};
 pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};

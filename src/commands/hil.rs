@@ -9,80 +9,24 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-use std::time::Duration;
 
-use anyhow::{anyhow, bail, Context, Result};
-use hilsim_hil::firmware::{split_command_line, Firmware};
+use anyhow::{Context, Result};
+use hilsim_hil::firmware::Firmware;
 use hilsim_hil::hil_run::{self, HilConfig, HilPorts, HilReport, HilWorld};
-use hilsim_scenarios::FirmwareRun;
-use hilsim_sim::scenario::MAX_RUN_S;
-use hilsim_sim::Scenario;
+use hilsim_scenarios::{FirmwarePlan, FirmwareRequest, FirmwareRun};
 
 use crate::cli::HilArgs;
 use crate::progress::Progress;
 
-/// A firmware run as validated: nothing opened or started yet.
-struct HilPlan {
-    argv: Vec<String>,
-    origin: String,
-    scenario: Scenario,
-    world: HilWorld,
-    config: HilConfig,
-}
-
-/// Everything checked before a port is opened or the firmware started.
-fn plan(args: &HilArgs) -> Result<HilPlan> {
-    if let Some(d) = args.duration {
-        seconds("--duration", d)?;
-    }
-    let watchdog = seconds("--watchdog", args.watchdog)?;
-    let argv = split_command_line(&args.firmware).map_err(|e| anyhow!("--firmware: {e}"))?;
-    let origin = args.scenario.display().to_string();
-    let mut scenario = Scenario::load_with_duration(&args.scenario, args.duration)?;
-    scenario.seed = args.seed.unwrap_or(scenario.seed);
-    if scenario.files.schedule.is_some() || scenario.files.path.is_some() {
-        bail!(
-            "{origin}: the scenario replays a log's run (`[robot] path`, `[sensors.lidar] \
-             schedule`): under `hil` the firmware drives and the lidar turns as its unit does; \
-             `hilsim record` makes the run's twin"
-        );
-    }
-    let duration_s = scenario.duration_s.ok_or_else(|| {
-        anyhow!("{origin}: under `hil` the firmware drives: set `duration_s` or pass --duration")
-    })?;
-    let duration = seconds("duration_s", duration_s).with_context(|| origin.clone())?;
-    if let Some(dir) = &args.out {
-        // Refused before the run rather than after it; a missing parent is created when the
-        // recording is written, as `record` does.
-        hilsim_recording::check_replaceable_recording(dir)?;
-    }
-    let world = HilWorld::new(&scenario, scenario.seed)
-        .with_context(|| format!("{origin}: sensor model"))?;
-    let config = HilConfig {
-        watchdog,
-        ..HilConfig::new(duration)
-    };
-    Ok(HilPlan {
-        argv,
-        origin,
-        scenario,
-        world,
-        config,
-    })
-}
-
-fn seconds(flag: &str, value: f64) -> Result<Duration> {
-    if !value.is_finite() {
-        bail!("{flag} must be a number of seconds in (0, {MAX_RUN_S}], got a non-finite value");
-    }
-    if !(value > 0.0 && value <= MAX_RUN_S) {
-        bail!("{flag} must be a number of seconds in (0, {MAX_RUN_S}], got {value}");
-    }
-    Ok(Duration::from_secs_f64(value))
-}
-
 pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let plan = plan(args)?;
+    let plan = FirmwarePlan::new(&FirmwareRequest {
+        scenario: &args.scenario,
+        firmware: &args.firmware,
+        out: args.out.as_deref(),
+        duration_s: args.duration,
+        watchdog_s: args.watchdog,
+        seed: args.seed,
+    })?;
     // Ctrl-C must reach the harness, which then shuts the firmware down: the firmware is in a
     // process group of its own, out of the terminal's reach.
     let stop = Arc::new(AtomicBool::new(false));

@@ -11,6 +11,7 @@ mod firmware_plan;
 mod firmware_run;
 pub mod metrics;
 mod pipeline;
+mod ros2_export;
 mod summary;
 mod test_results;
 
@@ -19,4 +20,5 @@ pub use firmware_plan::{FirmwarePlan, FirmwarePlanError, FirmwareRequest};
 pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};
 pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};
+pub use ros2_export::{drawn_world, ExportError, ExportRequest, McapExport};
 pub use test_results::{TestResults, JUNIT_XML};

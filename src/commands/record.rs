@@ -3,13 +3,14 @@
 
 use anyhow::{Context, Result};
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::{BackgroundStream, RecordingStream};
+use hilsim_recording::{check_output_file, BackgroundStream, RecordingStream};
+use hilsim_scenarios::McapExport;
 
 use crate::cli::RecordArgs;
 
 pub fn record(args: &RecordArgs) -> Result<()> {
     if let Some(mcap) = &args.mcap {
-        super::export::check_mcap_output(mcap, std::slice::from_ref(&args.scenario))?;
+        check_output_file(mcap, hilsim_ros2::MCAP_FILE, &[&args.scenario])?;
     }
     let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
     let emulation = Emulation::new(&scenario, scenario.seed)
@@ -22,8 +23,8 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     sink.finish()?;
     if let Some(mcap) = &args.mcap {
         // The recording as written (it streamed to disk, so it is read back, as streams).
-        let world = super::export::world(&scenario);
-        super::export::write_mcap_of_dir(&args.out, Some(&world), mcap)?;
+        let world = hilsim_scenarios::drawn_world(&scenario);
+        McapExport::of_dir(&args.out, Some(world))?.write(mcap)?;
     }
     Ok(())
 }

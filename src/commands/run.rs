@@ -6,8 +6,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::{write_file_atomically, RecordingStream};
-use hilsim_scenarios::{builtin, Report, Via};
+use hilsim_recording::{check_output_file, write_file_atomically, RecordingStream};
+use hilsim_scenarios::{builtin, McapExport, Report, Via};
 use hilsim_sim::Scenario;
 
 use crate::cli::{self, RunArgs};
@@ -18,7 +18,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         |p| p.display().to_string(),
     );
     let (scenario, via) = validate(args, &origin)?;
-    let world = super::export::world(&scenario);
+    let world = hilsim_scenarios::drawn_world(&scenario);
     // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
     // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
     // its length; through the serial path the run is held whole and written from memory.
@@ -52,9 +52,9 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     if let Some(mcap) = &args.mcap {
         match &streamed_to {
-            Some(dir) => super::export::write_mcap_of_dir(dir, Some(&world), mcap)?,
-            None => super::export::write_mcap(&report.run.recording, Some(&world), mcap)?,
-        }
+            Some(dir) => McapExport::of_dir(dir, Some(world))?.write(mcap)?,
+            None => hilsim_ros2::export(&report.run.recording, Some(&world), mcap)?,
+        };
         if !args.json {
             writeln!(out, "wrote {}", mcap.display())?;
         }
@@ -74,7 +74,8 @@ fn validate(args: &RunArgs, origin: &str) -> Result<(Scenario, Via)> {
         hilsim_recording::tidy_after_killed_writers(dir)?;
     }
     if let Some(mcap) = &args.mcap {
-        super::export::check_mcap_output(mcap, &Vec::from_iter(args.scenario.clone()))?;
+        let inputs = Vec::from_iter(args.scenario.as_deref());
+        check_output_file(mcap, hilsim_ros2::MCAP_FILE, &inputs)?;
     }
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
     let model = scenario

@@ -47,7 +47,8 @@ pub use export::{
 };
 pub use hilsim_recording::decimal_of_f32;
 pub use import::{
-    angle_deg, import, read_file, Converter, Encoding, Fault, ImportOptions, ImportReport,
+    angle_deg, import, read_file, Converter, Encoding, Fault, FlagError, ImportFlags,
+    ImportOptions, ImportReport,
 };
 pub use tf::Source as TfSource;
 pub use topics::{Kind, Role};

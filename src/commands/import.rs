@@ -4,29 +4,19 @@
 //! --out DIR [--poses truth|odometry]`: a real robot's log (CARMEN `.log`/`.clf`, gzipped or
 //! not; CoreSLAM `.dat`) into a recording.
 
-use std::collections::BTreeMap;
 use std::io::Write;
 
 use anyhow::{bail, Result};
 use hilsim_logs::{CarmenOptions, LogKind, Poses};
 use hilsim_recording::{check_input_outside, tidy_after_killed_writers, Meta};
-use hilsim_ros2::{ImportOptions, Role};
+use hilsim_ros2::ImportFlags;
 
 use crate::cli::ImportArgs;
 
 /// A robot's log into a recording.
 fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<()> {
-    let bag_only = [
-        ("--meta", args.meta.is_some()),
-        ("--lidar", args.lidar.is_some()),
-        ("--odom", args.odom.is_some()),
-        ("--cmd", args.cmd.is_some()),
-        ("--sonar", args.sonar.is_some()),
-        ("--truth", args.truth.is_some()),
-        ("--wheel-radius-m", args.wheel_radius_m.is_some()),
-        ("--wheel-joints", args.wheel_joints.is_some()),
-    ];
-    if let Some((flag, _)) = bag_only.iter().find(|(_, given)| *given) {
+    let given = [(args.meta.is_some()).then_some("--meta"), flags(args).first_given()];
+    if let Some(flag) = given.into_iter().flatten().next() {
         bail!(
             "{flag} is for ROS bags; {} is a robot's log",
             args.bag.display()
@@ -51,6 +41,19 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<(
     Ok(())
 }
 
+/// The flags only a bag's import reads.
+fn flags(args: &ImportArgs) -> ImportFlags<'_> {
+    ImportFlags {
+        lidar: args.lidar.as_deref(),
+        odom: args.odom.as_deref(),
+        cmd: args.cmd.as_deref(),
+        sonar: args.sonar.as_deref(),
+        truth: args.truth.as_deref(),
+        wheel_radius_m: args.wheel_radius_m,
+        wheel_joints: args.wheel_joints.as_deref(),
+    }
+}
+
 pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     if let Some(kind) = LogKind::of(&args.bag) {
         return import_log(args, kind, out);
@@ -61,42 +64,8 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
             args.bag.display()
         );
     }
-    if args
-        .wheel_radius_m
-        .is_some_and(|r| !(r.is_finite() && r > 0.0 && r <= 10.0))
-    {
-        bail!("--wheel-radius-m: expected a radius in metres, above 0 and at most 10");
-    }
-    let wheel_joints = match args
-        .wheel_joints
-        .as_deref()
-        .map(|j| j.split(',').collect::<Vec<_>>())
-    {
-        None => None,
-        Some(names) => match names.as_slice() {
-            [left, right] if !left.is_empty() && !right.is_empty() && left != right => {
-                Some([(*left).to_string(), (*right).to_string()])
-            }
-            _ => bail!("--wheel-joints: expected LEFT,RIGHT, two different joint names"),
-        },
-    };
-    let meta = args.meta.as_deref().map(Meta::read).transpose()?;
-    let topics: BTreeMap<Role, String> = [
-        (Role::Lidar, &args.lidar),
-        (Role::Odometry, &args.odom),
-        (Role::Commands, &args.cmd),
-        (Role::Sonar, &args.sonar),
-        (Role::Truth, &args.truth),
-    ]
-    .into_iter()
-    .filter_map(|(role, topic)| Some((role, topic.clone()?)))
-    .collect();
-    let options = ImportOptions {
-        topics,
-        meta,
-        wheel_radius_m: args.wheel_radius_m,
-        wheel_joints,
-    };
+    let mut options = flags(args).options()?;
+    options.meta = args.meta.as_deref().map(Meta::read).transpose()?;
     // The bag is read while the recording is written: it must not be inside what is replaced.
     check_input_outside(&args.bag, &args.out)?;
     tidy_after_killed_writers(&args.out)?;

@@ -5,8 +5,7 @@
 use std::io::Write;
 
 use anyhow::{bail, Result};
-use hilsim_sim::Scenario;
-use hilsim_twin::{build_world, compare, Declared, PoseSource, TwinFiles, WorldOptions};
+use hilsim_twin::{build_world, PoseSource, TwinFiles, WorldOptions};
 
 use crate::cli::WorldArgs;
 
@@ -48,30 +47,10 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         (Some(c), Some(path)) => declared.calibrate(c, &path.display().to_string())?,
         _ => false,
     };
-    // First noiseless, to measure how far the log's readings are from the map's.
-    let noiseless = Declared {
-        lidar_noise: vec![0.0],
-        ..declared.clone()
-    };
-    world.write(&files, &noiseless)?;
-    let scenario = Scenario::from_toml(&world.scenario_toml(&files, &noiseless), &files.scenario)?;
-    let fit = compare(&scenario, &args.recording)?;
-    if !noise_calibrated && fit.spread_m.is_finite() {
-        // The spread of the log against its twin by range, as the papers' noise polynomial:
-        // the map's quantisation taken out (the diagnosis carries it itself), what is left is
-        // an upper bound of the lidar's noise.
-        let map = scenario.files.map.as_ref();
-        declared.lidar_noise = fit.noise_polynomial(map.map_or(0.0, |m| m.resolution_m()));
-    }
-    world.write(&files, &declared)?;
+    let (fit, declared) = world.write_measured(&files, declared, noise_calibrated)?;
     writeln!(out, "{}", fit.summary())?;
     if !noise_calibrated {
-        writeln!(
-            out,
-            "declared the lidar's noise (its spread against the twin by range, less the map's \
-             cells): {:?} (β₀, β₁, β₂ of σ = β₀ + β₁ d + β₂ d², metres)",
-            declared.lidar_noise
-        )?;
+        writeln!(out, "{}", declared.measured_noise_line())?;
     }
     writeln!(out, "wrote {}", files.scenario.display())?;
     Ok(())

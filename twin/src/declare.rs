@@ -4,7 +4,9 @@
 use hilsim_calibrator::{Calibration, Sensor};
 use hilsim_recording::Mount;
 
-use crate::{Declared, TwinError, TwinFit, COMPARED_WITHIN_M};
+use hilsim_sim::Scenario;
+
+use crate::{compare, Declared, TwinError, TwinFiles, TwinFit, TwinWorld, COMPARED_WITHIN_M};
 
 impl Declared {
     /// Takes what `calibration` (read from `origin`) found: an em, landmarks or groundtruth
@@ -39,6 +41,51 @@ impl Declared {
             )));
         }
         Ok(lidar.is_some())
+    }
+}
+
+impl TwinWorld {
+    /// Writes the twin declaring `declared`, with the lidar's noise measured unless
+    /// `noise_calibrated`: the twin is first written noiseless and its readings set against the
+    /// log's. Returns that fit and what was declared.
+    ///
+    /// # Errors
+    /// As [`TwinWorld::write`] and [`compare`].
+    pub fn write_measured(
+        &self,
+        files: &TwinFiles,
+        mut declared: Declared,
+        noise_calibrated: bool,
+    ) -> Result<(TwinFit, Declared), TwinError> {
+        let noiseless = Declared {
+            lidar_noise: vec![0.0],
+            ..declared.clone()
+        };
+        self.write(files, &noiseless)?;
+        let toml = self.scenario_toml(files, &noiseless);
+        let scenario = Scenario::from_toml(&toml, &files.scenario)?;
+        let fit = compare(&scenario, &self.recording)?;
+        if !noise_calibrated && fit.spread_m.is_finite() {
+            // The spread of the log against its twin by range, as the papers' noise polynomial:
+            // the map's quantisation taken out (the diagnosis carries it itself), what is left is
+            // an upper bound of the lidar's noise.
+            let map = scenario.files.map.as_ref();
+            declared.lidar_noise = fit.noise_polynomial(map.map_or(0.0, |m| m.resolution_m()));
+        }
+        self.write(files, &declared)?;
+        Ok((fit, declared))
+    }
+}
+
+impl Declared {
+    /// One line: the lidar's noise declared from the twin's spread.
+    #[must_use]
+    pub fn measured_noise_line(&self) -> String {
+        format!(
+            "declared the lidar's noise (its spread against the twin by range, less the map's \
+             cells): {:?} (β₀, β₁, β₂ of σ = β₀ + β₁ d + β₂ d², metres)",
+            self.lidar_noise
+        )
     }
 }
 

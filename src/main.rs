@@ -10,7 +10,7 @@ mod progress;
 use std::io::Write;
 use std::process::ExitCode;
 
-use clap::Parser;
+use clap::{CommandFactory, Parser};
 
 use cli::{Cli, Command, ScenarioCommand};
 
@@ -24,7 +24,7 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(err) => {
-            eprintln!("hilsim: {}", cli::usage_error_line(&err, &args));
+            eprintln!("hilsim: {}", hilsim_usage::error_line(&err, Cli::command(), &args));
             return ExitCode::from(2);
         }
     };

@@ -5,9 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::{check_output_file, write_file_atomically, RecordingStream};
-use hilsim_scenarios::{builtin, McapExport, Report, Via};
+use hilsim_recording::check_output_file;
+use hilsim_scenarios::{builtin, McapExport, RecordedRun, Report, Via};
 use hilsim_sim::Scenario;
 
 use crate::cli::{self, RunArgs};
@@ -35,16 +34,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     };
     let report = execute(args, scenario, &origin, via, streamed_to.as_deref(), out)?;
     if let Some(dir) = &args.report {
-        let title = format!("hilsim run: {}", report.scenario.name);
-        let name = format!("{origin} (seed {}, in memory)", report.scenario.seed);
-        let html = hilsim_report::render(hilsim_report::Inputs {
-            title: &title,
-            recording: &report.run.recording,
-            recording_name: &hilsim_report::drawn_name(&name, &report.thinning),
-            scenario: Some(&report.scenario),
-            calibrations: &report.calibrations,
-            truth_estimated: false,
-        });
+        let html = report.page(&origin);
         hilsim_report::write_report_files(dir, &[("index.html".into(), html)])?;
         if !args.json {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
@@ -107,37 +97,14 @@ fn execute(
     streamed_to: Option<&Path>,
     out: &mut dyn Write,
 ) -> Result<Report> {
-    let (report, stream) = match streamed_to {
-        Some(dir) => {
-            let emulation = Emulation::new(&scenario, scenario.seed)
-                .with_context(|| format!("{origin}: sensor model"))?;
-            let mut stream =
-                RecordingStream::create(dir, emulation.meta().clone(), emulation.tables())?;
-            drop(emulation);
-            let report = hilsim_scenarios::execute_into(scenario, origin, via, &mut stream)?;
-            (report, Some(stream))
-        }
-        None => (hilsim_scenarios::execute(scenario, origin, via)?, None),
-    };
-    let results = report.results_json();
+    let run = RecordedRun::execute(scenario, origin, via, streamed_to)?;
+    let results = run.report.results_json();
     if args.json {
         out.write_all(results.as_bytes())?;
     } else {
-        out.write_all(report.summary().as_bytes())?;
+        out.write_all(run.report.summary().as_bytes())?;
     }
-    let add_results = |tmp: &Path| -> Result<()> {
-        write_file_atomically(&tmp.join("results.json"), results.as_bytes())?;
-        Ok(())
-    };
-    match (stream, &args.out) {
-        (Some(stream), Some(_)) => stream.finish_with(add_results)?,
-        (Some(stream), None) => stream.finish()?,
-        (None, Some(dir)) => hilsim_recording::replace_recording_dir(dir, |tmp| -> Result<()> {
-            report.run.recording.write_files(tmp)?;
-            add_results(tmp)
-        })?,
-        (None, None) => {}
-    }
+    let report = run.finish(args.out.as_deref(), &results)?;
     if let (Some(dir), false) = (&args.out, args.json) {
         writeln!(out, "wrote {}", dir.display())?;
     }

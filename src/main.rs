@@ -24,7 +24,10 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(err) => {
-            eprintln!("hilsim: {}", hilsim_usage::error_line(&err, Cli::command(), &args));
+            eprintln!(
+                "hilsim: {}",
+                hilsim_usage::error_line(&err, Cli::command(), &args)
+            );
             return ExitCode::from(2);
         }
     };

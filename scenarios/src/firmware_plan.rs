@@ -168,8 +168,13 @@ mod tests {
         );
         let e = seconds("--duration", f64::NAN).unwrap_err().to_string();
         assert!(e.ends_with("got a non-finite value"), "{e}");
-        let e = seconds("--duration", f64::INFINITY).unwrap_err().to_string();
+        let e = seconds("--duration", f64::INFINITY)
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with("got a non-finite value"), "{e}");
-        assert_eq!(seconds("--duration", 2.5).unwrap(), Duration::from_secs_f64(2.5));
+        assert_eq!(
+            seconds("--duration", 2.5).unwrap(),
+            Duration::from_secs_f64(2.5)
+        );
     }
 }

@@ -102,6 +102,17 @@ pub enum RunError {
         /// Why.
         message: String,
     },
+    /// The serial path was asked for a lidar other than the Neato XV-11.
+    #[error(
+        "{origin}: `--via serial` reads the Neato XV-11's wire, and the lidar is a {model}: \
+         `hilsim serve` streams its protocol"
+    )]
+    SerialNeedsXv11 {
+        /// The scenario's file (or built-in name).
+        origin: String,
+        /// The scenario's lidar.
+        model: hilsim_sim::scenario::LidarModel,
+    },
     /// The run's worker stopped before it finished (a bug: it panicked).
     #[error("{0}: the run did not finish")]
     Unfinished(String),

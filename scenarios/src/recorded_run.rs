@@ -62,7 +62,8 @@ impl RecordedRun {
         out: Option<&Path>,
         results: &str,
     ) -> Result<Report, hilsim_recording::Error> {
-        let add_results = |tmp: &Path| write_file_atomically(&tmp.join("results.json"), results.as_bytes());
+        let add_results =
+            |tmp: &Path| write_file_atomically(&tmp.join("results.json"), results.as_bytes());
         match (self.stream, out) {
             (Some(stream), Some(_)) => stream.finish_with(add_results)?,
             (Some(stream), None) => stream.finish()?,
@@ -73,6 +74,25 @@ impl RecordedRun {
             (None, None) => {}
         }
         Ok(self.report)
+    }
+}
+
+impl Via {
+    /// Checks that `scenario`'s lidar can take this path: the serial path reads the Neato
+    /// XV-11's wire only. `origin` names the scenario.
+    ///
+    /// # Errors
+    /// The serial path for another unit.
+    pub fn check(self, scenario: &Scenario, origin: &str) -> Result<(), RunError> {
+        let lidar = scenario.sensors.lidar.as_ref();
+        let model = lidar.map(|l| l.model).unwrap_or_default();
+        if self == Via::Serial && model != hilsim_sim::scenario::LidarModel::Xv11 {
+            return Err(RunError::SerialNeedsXv11 {
+                origin: origin.to_string(),
+                model,
+            });
+        }
+        Ok(())
     }
 }
 

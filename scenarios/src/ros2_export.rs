@@ -90,7 +90,13 @@ impl McapExport {
     /// The first input found wrong, naming its file.
     pub fn prepare(request: &ExportRequest<'_>) -> Result<Self, ExportError> {
         let mut inputs: Vec<PathBuf> = Recording::files_in(request.recording);
-        inputs.extend(request.scenario.iter().chain(&request.calibration).map(|p| p.to_path_buf()));
+        inputs.extend(
+            request
+                .scenario
+                .iter()
+                .chain(&request.calibration)
+                .map(|p| p.to_path_buf()),
+        );
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         check_output_file(request.mcap, hilsim_ros2::MCAP_FILE, &inputs)?;
         let world = match request.scenario {

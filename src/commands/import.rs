@@ -15,7 +15,10 @@ use crate::cli::ImportArgs;
 
 /// A robot's log into a recording.
 fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<()> {
-    let given = [(args.meta.is_some()).then_some("--meta"), flags(args).first_given()];
+    let given = [
+        (args.meta.is_some()).then_some("--meta"),
+        flags(args).first_given(),
+    ];
     if let Some(flag) = given.into_iter().flatten().next() {
         bail!(
             "{flag} is for ROS bags; {} is a robot's log",

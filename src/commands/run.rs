@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use hilsim_recording::check_output_file;
 use hilsim_scenarios::{builtin, McapExport, RecordedRun, Report, Via};
 use hilsim_sim::Scenario;
@@ -68,22 +68,11 @@ fn validate(args: &RunArgs, origin: &str) -> Result<(Scenario, Via)> {
         check_output_file(mcap, hilsim_ros2::MCAP_FILE, &inputs)?;
     }
     let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
-    let model = scenario
-        .sensors
-        .lidar
-        .as_ref()
-        .map(|l| l.model)
-        .unwrap_or_default();
-    if args.via == cli::Via::Serial && model != hilsim_sim::scenario::LidarModel::Xv11 {
-        bail!(
-            "{origin}: `--via serial` reads the Neato XV-11's wire, and the lidar is a {model}: \
-             `hilsim serve` streams its protocol"
-        );
-    }
     let via = match args.via {
         cli::Via::Memory => Via::Memory,
         cli::Via::Serial => Via::Serial,
     };
+    via.check(&scenario, origin)?;
     Ok((scenario, via))
 }
 

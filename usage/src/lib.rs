@@ -117,7 +117,11 @@ mod tests {
         Command::new("tool").subcommand(
             Command::new("run")
                 .arg(Arg::new("out").long("out").required(true))
-                .arg(Arg::new("via").long("via").value_parser(["memory", "serial"])),
+                .arg(
+                    Arg::new("via")
+                        .long("via")
+                        .value_parser(["memory", "serial"]),
+                ),
         )
     }
 
@@ -129,7 +133,10 @@ mod tests {
 
     #[test]
     fn names_the_subcommand_to_ask_for_help() {
-        assert_eq!(line(&["tool", "run"]), "missing --out <out>; see tool run --help");
+        assert_eq!(
+            line(&["tool", "run"]),
+            "missing --out <out>; see tool run --help"
+        );
         assert_eq!(
             line(&["tool", "run", "--out", "x", "--via", "pty"]),
             "--via <via>: invalid value `pty` (expected one of: memory, serial); see tool run --help"

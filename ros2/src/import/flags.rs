@@ -52,7 +52,10 @@ impl ImportFlags<'_> {
             ("--wheel-radius-m", self.wheel_radius_m.is_some()),
             ("--wheel-joints", self.wheel_joints.is_some()),
         ];
-        given.iter().find(|(_, given)| *given).map(|(flag, _)| *flag)
+        given
+            .iter()
+            .find(|(_, given)| *given)
+            .map(|(flag, _)| *flag)
     }
 
     /// The options the flags ask for, with no `meta.toml` (the caller reads it).
@@ -132,7 +135,10 @@ mod tests {
         };
         assert_eq!(flags.first_given(), Some("--lidar"));
         let options = flags.options().unwrap();
-        assert_eq!(options.topics.get(&Role::Lidar).map(String::as_str), Some("/scan"));
+        assert_eq!(
+            options.topics.get(&Role::Lidar).map(String::as_str),
+            Some("/scan")
+        );
         assert_eq!(ImportFlags::default().first_given(), None);
     }
 }

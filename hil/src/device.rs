@@ -29,6 +29,21 @@ impl DeviceLink {
         Self::open_at(path, XV11_BAUD)
     }
 
+    /// As [`DeviceLink::open_at`], the error naming `path`: `PATH: why` when it is not a
+    /// terminal device, else `PATH: cannot open: why`.
+    ///
+    /// # Errors
+    /// As [`DeviceLink::open`].
+    pub fn open_named(path: &std::path::Path, baud: u32) -> io::Result<Self> {
+        Self::open_at(&path.to_string_lossy(), baud).map_err(|err| {
+            let shown = path.display();
+            match err.kind() {
+                io::ErrorKind::InvalidInput => io::Error::new(err.kind(), format!("{shown}: {err}")),
+                kind => io::Error::new(kind, format!("{shown}: cannot open: {err}")),
+            }
+        })
+    }
+
     /// Opens `path` at `baud`, 8N1 (the unit's speed: `UnitSpec::baud`).
     ///
     /// # Errors

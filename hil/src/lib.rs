@@ -20,6 +20,7 @@ pub mod process;
 mod pty;
 pub mod serve;
 mod serve_model;
+mod serve_setup;
 mod streamer;
 mod unit_streamer;
 
@@ -28,6 +29,7 @@ pub use device::{DeviceLink, XV11_BAUD};
 pub use link::{MemoryLink, SerialLink};
 pub use pty::PtyLink;
 pub use serve_model::{serve_model, ServeOptions};
+pub use serve_setup::ServeSetupError;
 pub use streamer::{
     Pacing, StreamStats, Streamer, BACKLOG_LIMIT, FAST_STALL_GRACE, LOSSLESS_TIMEOUT, STALL_DETECT,
 };

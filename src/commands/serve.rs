@@ -5,8 +5,7 @@ use std::io::Write;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Context, Result};
-use hilsim_hil::faults::WireFaults;
+use anyhow::{Context, Result};
 use hilsim_hil::serve::ServeReport;
 use hilsim_hil::{serve_model, DeviceLink, Pacing, PtyLink, SerialLink, ServeOptions};
 use hilsim_lidar_emulator::Emulation;
@@ -16,29 +15,13 @@ use crate::progress::Progress;
 
 pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
-    let origin = args.scenario.display();
-    let Some(lidar) = &scenario.sensors.lidar else {
-        bail!("{origin}: the scenario has no [sensors.lidar] to serve");
+    let origin = args.scenario.display().to_string();
+    let pacing = if args.fast {
+        Pacing::Fast
+    } else {
+        Pacing::Realtime
     };
-    if scenario.files.schedule.is_some() {
-        bail!(
-            "{origin}: the lidar replays a log's scans (`schedule`), which have no unit's packets \
-             to serve; `hilsim record` makes its twin"
-        );
-    }
-    let mut options = ServeOptions {
-        model: lidar.model,
-        pacing: if args.fast {
-            Pacing::Fast
-        } else {
-            Pacing::Realtime
-        },
-        // Validation has checked the table: its faults resolve.
-        faults: WireFaults::new(&scenario.link.faults().unwrap_or_default(), scenario.seed),
-        client_connected: false,
-    };
-    let emulation = Emulation::new(&scenario, scenario.seed)
-        .with_context(|| format!("{origin}: sensor model"))?;
+    let (mut options, emulation) = ServeOptions::for_scenario(&scenario, &origin, pacing)?;
     // Ctrl-C (or SIGTERM, SIGHUP) ends the stream and still prints what was sent; a second
     // one ends the process at once.
     let stop = Arc::new(AtomicBool::new(false));
@@ -46,7 +29,7 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         .context("cannot set up signal handling")?;
     let report = match &args.port {
         Some(path) => {
-            let link = open_device(path, options.model.spec().baud)?;
+            let link = DeviceLink::open_named(path, options.model.spec().baud)?;
             writeln!(out, "serial: {}", path.display())?;
             out.flush()?;
             run(emulation, link, options, &stop)?
@@ -70,14 +53,6 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
         report.write_summary(out)?;
     }
     Ok(())
-}
-
-/// The serial device at `path`, opened 8N1 at `baud`.
-fn open_device(path: &std::path::Path, baud: u32) -> Result<DeviceLink> {
-    DeviceLink::open_at(&path.to_string_lossy(), baud).map_err(|err| match err.kind() {
-        std::io::ErrorKind::InvalidInput => anyhow!("{}: {err}", path.display()),
-        _ => anyhow!("{}: cannot open: {err}", path.display()),
-    })
 }
 
 /// Serves the stream, what is sent shown as a status line on a terminal (stderr; stdout keeps

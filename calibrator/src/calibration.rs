@@ -245,6 +245,20 @@ impl Calibration {
         self.checks.iter().filter(|c| !c.pass)
     }
 
+    /// When a check failed, why the result is not to be trusted, as one line naming the
+    /// failed checks.
+    #[must_use]
+    pub fn untrusted(&self) -> Option<String> {
+        let failed: Vec<&str> = self.failed_checks().map(|c| c.name.as_str()).collect();
+        (!failed.is_empty()).then(|| {
+            format!(
+                "the recording does not fit the method's assumptions ({}); the result above is \
+                 not to be trusted",
+                failed.join(", ")
+            )
+        })
+    }
+
     /// The JSON object of `hilsim calibrate --json`.
     #[must_use]
     pub fn to_json(&self) -> serde_json::Value {

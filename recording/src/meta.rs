@@ -132,6 +132,25 @@ pub struct SourceMeta {
 }
 
 impl Meta {
+    /// A note for each key of the `meta.toml` in the recording directory `dir` that the format
+    /// does not have, its name terminal-safe: a misspelt key reads as absent, so a result made
+    /// from the recording says so. None when the file cannot be read (reading the recording
+    /// reports that).
+    #[must_use]
+    pub fn unknown_key_notes(dir: &std::path::Path) -> Vec<String> {
+        let meta = dir.join("meta.toml");
+        let text = crate::input::read_small_text(&meta, crate::input::MAX_META_BYTES, "meta.toml");
+        let keys = text.map(|text| Self::unknown_keys(&text)).unwrap_or_default();
+        keys.iter()
+            .map(|key| {
+                format!(
+                    "meta.toml: `{}` is not a key of the recording format; ignored",
+                    crate::printable(key)
+                )
+            })
+            .collect()
+    }
+
     /// The keys of a `meta.toml` text that the format does not define, as dotted paths
     /// (`bogus`, `lidar.x_mm`). Reading ignores them, so that other tools may add their own; but
     /// a misspelt key reads as absent, so a calibration notes them. Empty for text that is not
@@ -187,6 +206,17 @@ fn unknown_in(given: &toml::Table, known: &toml::Table, prefix: &str, out: &mut 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unknown_keys_of_a_directory_are_noted_terminal_safe() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(Meta::unknown_key_notes(dir.path()).is_empty());
+        std::fs::write(dir.path().join("meta.toml"), "\"b\\u001b\" = 1\n[robot]\nwheel_base_m = 0.3\n").unwrap();
+        let notes = Meta::unknown_key_notes(dir.path());
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(!notes[0].contains('\u{1b}'), "{notes:?}");
+        assert!(notes[0].ends_with("is not a key of the recording format; ignored"));
+    }
 
     #[test]
     fn keys_the_format_does_not_define_are_listed_as_paths() {

@@ -29,20 +29,10 @@ pub fn calibrate(args: &CalibrateArgs, out: &mut dyn Write) -> Result<ExitCode> 
     } else {
         out.write_all(calibration.describe().as_bytes())?;
     }
-    let failed: Vec<&str> = calibration
-        .failed_checks()
-        .map(|c| c.name.as_str())
-        .collect();
-    if failed.is_empty() {
+    let Some(why) = calibration.untrusted() else {
         return Ok(ExitCode::SUCCESS);
-    }
-    eprintln!(
-        "hilsim: {}: {}: the recording does not fit the method's assumptions ({}); the result \
-         above is not to be trusted",
-        input.display(),
-        method.name(),
-        failed.join(", ")
-    );
+    };
+    eprintln!("hilsim: {}: {}: {why}", input.display(), method.name());
     Ok(ExitCode::from(1))
 }
 
@@ -69,17 +59,7 @@ fn calibrate_dir(dir: &Path, method: Method, settings: &Settings) -> Result<Cali
     let rec = Recording::read_dir(dir)?;
     let mut calibration = hilsim_calibrator::calibrate_with(&rec, method, settings)
         .with_context(|| format!("{}: {}", dir.display(), method.name()))?;
-    // Read whole once more (it was read, so it is small): a misspelt key reads as absent.
-    let meta = dir.join("meta.toml");
-    let max = hilsim_recording::MAX_META_BYTES;
-    if let Ok(text) = hilsim_recording::read_small_text(&meta, max, "meta.toml") {
-        for key in Meta::unknown_keys(&text) {
-            calibration.notes.push(format!(
-                "meta.toml: `{}` is not a key of the recording format; ignored",
-                hilsim_recording::printable(&key)
-            ));
-        }
-    }
+    calibration.notes.extend(Meta::unknown_key_notes(dir));
     Ok(calibration)
 }
 

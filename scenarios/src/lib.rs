@@ -21,6 +21,6 @@ pub use firmware_plan::{FirmwarePlan, FirmwarePlanError, FirmwareRequest};
 pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};
 pub use pipeline::{execute, execute_all, execute_into, Report, RunError, Via};
-pub use recorded_run::RecordedRun;
+pub use recorded_run::{RecordedRun, StreamTarget};
 pub use ros2_export::{drawn_world, ExportError, ExportRequest, McapExport};
 pub use test_results::{TestResults, JUNIT_XML};

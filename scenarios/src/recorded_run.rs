@@ -2,13 +2,76 @@
 //! memory bounded whatever its length), or, through the serial path, held whole and written
 //! after the run; the run's `results.json` beside it.
 
-use std::path::Path;
+use std::io;
+use std::path::{Path, PathBuf};
 
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{write_file_atomically, RecordingStream};
 use hilsim_sim::Scenario;
 
 use crate::pipeline::{execute, execute_into, Report, RunError, Via};
+
+/// Where a run's recording goes as it is taken: to the recording directory asked for, or, for
+/// an MCAP file alone, to a temporary directory beside it (removed when this is dropped), so
+/// that the run's memory is bounded whatever its length; nowhere through the serial path, whose
+/// run is held whole and written from memory.
+pub struct StreamTarget {
+    // Held only to be removed when dropped.
+    _scratch: Option<tempfile::TempDir>,
+    dir: Option<PathBuf>,
+}
+
+impl StreamTarget {
+    /// The target of a run by `via` asked to write the recording to `out` and an MCAP file to
+    /// `mcap`.
+    ///
+    /// # Errors
+    /// The temporary directory cannot be made (naming where).
+    pub fn new(via: Via, out: Option<&Path>, mcap: Option<&Path>) -> io::Result<Self> {
+        let scratch = match (out, mcap, via) {
+            (None, Some(mcap), Via::Memory) => Some(scratch_dir(mcap)?),
+            _ => None,
+        };
+        let dir = match via {
+            Via::Memory => out
+                .map(Path::to_path_buf)
+                .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
+            Via::Serial => None,
+        };
+        Ok(Self {
+            _scratch: scratch,
+            dir,
+        })
+    }
+
+    /// The directory the recording is streamed to, if any.
+    #[must_use]
+    pub fn dir(&self) -> Option<&Path> {
+        self.dir.as_deref()
+    }
+}
+
+/// A temporary directory beside `mcap` (the same file system, removed when dropped) for the
+/// recording an MCAP file is exported from.
+fn scratch_dir(mcap: &Path) -> io::Result<tempfile::TempDir> {
+    let parent = mcap
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    // Standard output or a device has no directory of its own to put it beside.
+    let parent = if parent.starts_with("/dev") || parent.starts_with("/proc") {
+        std::env::temp_dir()
+    } else {
+        parent.to_path_buf()
+    };
+    tempfile::Builder::new()
+        .prefix(".hilsim-run.")
+        .tempdir_in(&parent)
+        .map_err(|e| {
+            let why = format!("{}: cannot make a temporary directory: {e}", parent.display());
+            io::Error::new(e.kind(), why)
+        })
+}
 
 /// A run whose recording is not yet in place: [`RecordedRun::finish`] puts it there.
 pub struct RecordedRun {

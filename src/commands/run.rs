@@ -1,12 +1,12 @@
 //! `hilsim run [SCENARIO] [--out DIR] [--seed N] [--via memory|serial] [--json]`: the main job.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use hilsim_recording::check_output_file;
-use hilsim_scenarios::{builtin, McapExport, RecordedRun, Report, Via};
+use hilsim_scenarios::{builtin, McapExport, RecordedRun, Report, StreamTarget, Via};
 use hilsim_sim::Scenario;
 
 use crate::cli::{self, RunArgs};
@@ -18,21 +18,8 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
     );
     let (scenario, via) = validate(args, &origin)?;
     let world = hilsim_scenarios::drawn_world(&scenario);
-    // In process, the recording goes to disk as it is taken (to `--out`, or for `--mcap` alone
-    // to a temporary directory beside the MCAP file), so the run's memory is bounded whatever
-    // its length; through the serial path the run is held whole and written from memory.
-    let scratch = match (&args.out, &args.mcap, via) {
-        (None, Some(mcap), Via::Memory) => Some(scratch_dir(mcap)?),
-        _ => None,
-    };
-    let streamed_to: Option<PathBuf> = match via {
-        Via::Memory => args
-            .out
-            .clone()
-            .or_else(|| scratch.as_ref().map(|s| s.path().join("recording"))),
-        Via::Serial => None,
-    };
-    let report = execute(args, scenario, &origin, via, streamed_to.as_deref(), out)?;
+    let streamed = StreamTarget::new(via, args.out.as_deref(), args.mcap.as_deref())?;
+    let report = execute(args, scenario, &origin, via, streamed.dir(), out)?;
     if let Some(dir) = &args.report {
         let html = report.page(&origin);
         hilsim_report::write_report_files(dir, &[("index.html".into(), html)])?;
@@ -41,7 +28,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
         }
     }
     if let Some(mcap) = &args.mcap {
-        match &streamed_to {
+        match streamed.dir() {
             Some(dir) => McapExport::of_dir(dir, Some(world))?.write(mcap)?,
             None => hilsim_ros2::export(&report.run.recording, Some(&world), mcap)?,
         };
@@ -49,7 +36,7 @@ pub fn run(args: &RunArgs, out: &mut dyn Write) -> Result<ExitCode> {
             writeln!(out, "wrote {}", mcap.display())?;
         }
     }
-    drop(scratch);
+    drop(streamed);
     Ok(super::exit_code(report.passed()))
 }
 
@@ -98,23 +85,4 @@ fn execute(
         writeln!(out, "wrote {}", dir.display())?;
     }
     Ok(report)
-}
-
-/// A temporary directory beside `mcap` (the same file system, removed when dropped) for the
-/// recording an MCAP file is exported from.
-fn scratch_dir(mcap: &Path) -> Result<tempfile::TempDir> {
-    let parent = mcap
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    // Standard output or a device has no directory of its own to put it beside.
-    let parent = if parent.starts_with("/dev") || parent.starts_with("/proc") {
-        std::env::temp_dir()
-    } else {
-        parent.to_path_buf()
-    };
-    tempfile::Builder::new()
-        .prefix(".hilsim-run.")
-        .tempdir_in(&parent)
-        .with_context(|| format!("{}: cannot make a temporary directory", parent.display()))
 }

@@ -38,7 +38,9 @@ impl DeviceLink {
         Self::open_at(&path.to_string_lossy(), baud).map_err(|err| {
             let shown = path.display();
             match err.kind() {
-                io::ErrorKind::InvalidInput => io::Error::new(err.kind(), format!("{shown}: {err}")),
+                io::ErrorKind::InvalidInput => {
+                    io::Error::new(err.kind(), format!("{shown}: {err}"))
+                }
                 kind => io::Error::new(kind, format!("{shown}: cannot open: {err}")),
             }
         })

@@ -140,7 +140,9 @@ impl Meta {
     pub fn unknown_key_notes(dir: &std::path::Path) -> Vec<String> {
         let meta = dir.join("meta.toml");
         let text = crate::input::read_small_text(&meta, crate::input::MAX_META_BYTES, "meta.toml");
-        let keys = text.map(|text| Self::unknown_keys(&text)).unwrap_or_default();
+        let keys = text
+            .map(|text| Self::unknown_keys(&text))
+            .unwrap_or_default();
         keys.iter()
             .map(|key| {
                 format!(
@@ -211,7 +213,11 @@ mod tests {
     fn unknown_keys_of_a_directory_are_noted_terminal_safe() {
         let dir = tempfile::tempdir().unwrap();
         assert!(Meta::unknown_key_notes(dir.path()).is_empty());
-        std::fs::write(dir.path().join("meta.toml"), "\"b\\u001b\" = 1\n[robot]\nwheel_base_m = 0.3\n").unwrap();
+        std::fs::write(
+            dir.path().join("meta.toml"),
+            "\"b\\u001b\" = 1\n[robot]\nwheel_base_m = 0.3\n",
+        )
+        .unwrap();
         let notes = Meta::unknown_key_notes(dir.path());
         assert_eq!(notes.len(), 1, "{notes:?}");
         assert!(!notes[0].contains('\u{1b}'), "{notes:?}");

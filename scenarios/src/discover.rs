@@ -1,4 +1,4 @@
-//! Finding the scenario files `hilsim scenario test` runs.
+//! Finding the scenario files `hilsim scenario test` runs, and loading them all before any runs.
 
 use std::collections::HashSet;
 use std::io;
@@ -71,4 +71,42 @@ fn collect(
         }
     }
     Ok(())
+}
+
+/// Why the scenarios under some paths cannot be loaded.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LoadError {
+    /// A path cannot be searched.
+    #[error(transparent)]
+    Discover(#[from] DiscoverError),
+    /// A scenario file is unreadable or invalid.
+    #[error(transparent)]
+    Scenario(#[from] hilsim_sim::ScenarioError),
+    /// No scenario file under the paths (listed).
+    #[error("{0}: no scenario files (*.toml) found")]
+    Empty(String),
+}
+
+/// Every scenario file under `roots` (as [`scenario_files`] finds them), each loaded: all are
+/// validated before any runs, so that bad input fails before work starts.
+///
+/// # Errors
+/// A path cannot be searched, a file is invalid, or there is no file at all.
+pub fn load_scenarios(
+    roots: &[PathBuf],
+) -> Result<Vec<(PathBuf, hilsim_sim::Scenario)>, LoadError> {
+    let mut files = Vec::new();
+    for root in roots {
+        files.extend(scenario_files(root)?);
+    }
+    let scenarios: Vec<(PathBuf, hilsim_sim::Scenario)> = files
+        .into_iter()
+        .map(|f| hilsim_sim::Scenario::load(&f).map(|s| (f, s)))
+        .collect::<Result<_, _>>()?;
+    if scenarios.is_empty() {
+        let roots: Vec<String> = roots.iter().map(|p| p.display().to_string()).collect();
+        return Err(LoadError::Empty(roots.join(", ")));
+    }
+    Ok(scenarios)
 }

@@ -16,7 +16,7 @@ mod ros2_export;
 mod summary;
 mod test_results;
 
-pub use discover::{scenario_files, DiscoverError};
+pub use discover::{load_scenarios, scenario_files, DiscoverError, LoadError};
 pub use firmware_plan::{FirmwarePlan, FirmwarePlanError, FirmwareRequest};
 pub use firmware_run::FirmwareRun;
 pub use metrics::{Metrics, Outcome};

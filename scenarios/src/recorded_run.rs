@@ -68,7 +68,10 @@ fn scratch_dir(mcap: &Path) -> io::Result<tempfile::TempDir> {
         .prefix(".hilsim-run.")
         .tempdir_in(&parent)
         .map_err(|e| {
-            let why = format!("{}: cannot make a temporary directory: {e}", parent.display());
+            let why = format!(
+                "{}: cannot make a temporary directory: {e}",
+                parent.display()
+            );
             io::Error::new(e.kind(), why)
         })
 }

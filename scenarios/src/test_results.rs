@@ -21,6 +21,25 @@ pub const JUNIT_XML: FileKind = FileKind {
 pub struct TestResults(pub Vec<(String, Report)>);
 
 impl TestResults {
+    /// Runs `scenarios` on `workers` threads, each named by its file; the results in the
+    /// input order.
+    ///
+    /// # Errors
+    /// The first scenario, in the input order, that could not be run to the end.
+    pub fn execute(
+        scenarios: Vec<(std::path::PathBuf, hilsim_sim::Scenario)>,
+        workers: usize,
+    ) -> Result<Self, crate::RunError> {
+        let named: Vec<(String, hilsim_sim::Scenario)> = scenarios
+            .into_iter()
+            .map(|(path, s)| (path.display().to_string(), s))
+            .collect();
+        let reports = crate::execute_all(&named, workers);
+        let results = named.iter().zip(reports);
+        let results = results.map(|((path, _), report)| report.map(|r| (path.clone(), r)));
+        results.collect::<Result<Vec<_>, _>>().map(Self)
+    }
+
     /// The scenarios that failed an assertion.
     #[must_use]
     pub fn failed(&self) -> usize {

@@ -35,13 +35,11 @@ fn main() -> ExitCode {
     let mut out = stdout.lock();
     let result = match &cli.command {
         Command::Run(args) => commands::run::run(args, &mut out),
-        Command::Record(args) => commands::record::record(args).map(|()| ExitCode::SUCCESS),
+        Command::Record(args) => commands::record::record(args),
         Command::Calibrate(args) => commands::calibrate::calibrate(args, &mut out),
         Command::Smooth(args) => commands::calibrate::smooth(args, &mut out),
-        Command::Serve(args) => commands::serve::serve(args, &mut out).map(|()| ExitCode::SUCCESS),
-        Command::Decode(args) => {
-            commands::decode::decode(args, &mut out).map(|()| ExitCode::SUCCESS)
-        }
+        Command::Serve(args) => commands::serve::serve(args, &mut out),
+        Command::Decode(args) => commands::decode::decode(args, &mut out),
         Command::Scenario(ScenarioCommand::Test(args)) => {
             commands::scenario_test::test(args, &mut out)
         }
@@ -49,13 +47,9 @@ fn main() -> ExitCode {
         Command::Hil(args) => commands::hil::hil(args, &mut out),
         Command::Diagnose(args) => commands::diagnose::diagnose(args, &mut out),
         Command::Report(args) => commands::report::report(args, &mut out),
-        Command::Import(args) => {
-            commands::import::import(args, &mut out).map(|()| ExitCode::SUCCESS)
-        }
-        Command::Export(args) => {
-            commands::export::export(args, &mut out).map(|()| ExitCode::SUCCESS)
-        }
-        Command::World(args) => commands::world::world(args, &mut out).map(|()| ExitCode::SUCCESS),
+        Command::Import(args) => commands::import::import(args, &mut out),
+        Command::Export(args) => commands::export::export(args, &mut out),
+        Command::World(args) => commands::world::world(args, &mut out),
     };
     let _ = out.flush();
     match result {

@@ -23,6 +23,20 @@ pub fn straight_board() -> Result<Scenario, ScenarioError> {
     Scenario::from_toml(STRAIGHT_BOARD, Path::new(STRAIGHT_BOARD_ORIGIN))
 }
 
+/// The scenario file at `path`, or the default scenario when none is given, its seed replaced
+/// by `seed` when one is given.
+///
+/// # Errors
+/// The file is unreadable or invalid.
+pub fn load_or_default(path: Option<&Path>, seed: Option<u64>) -> Result<Scenario, ScenarioError> {
+    let mut scenario = match path {
+        Some(path) => Scenario::load(path)?,
+        None => straight_board()?,
+    };
+    scenario.seed = seed.unwrap_or(scenario.seed);
+    Ok(scenario)
+}
+
 /// The self-test room, parsed.
 ///
 /// # Errors

@@ -3,6 +3,7 @@
 //! are in `hilsim_hil::decode` and docs/interfaces.md).
 
 use std::io::Write;
+use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use hilsim_hil::{decode_capture, CaptureError, Decoded};
@@ -11,7 +12,7 @@ use hilsim_recording::OutputTarget;
 use crate::cli::DecodeArgs;
 
 /// Decodes the capture, writes `--csv`, and prints the counts (one JSON object with `--json`).
-pub fn decode(args: &DecodeArgs, stdout: &mut dyn Write) -> Result<()> {
+pub fn decode(args: &DecodeArgs, stdout: &mut dyn Write) -> Result<ExitCode> {
     let decoded =
         decode_capture(&args.input, args.model, args.csv.as_deref()).map_err(|err| match err {
             // Its own type, so that a closed pipe is recognised.
@@ -38,5 +39,6 @@ pub fn decode(args: &DecodeArgs, stdout: &mut dyn Write) -> Result<()> {
             (Decoded::Unit(_), _) => "cannot write the counts",
             (Decoded::Xv11(_), true) => "stderr: cannot write",
             (Decoded::Xv11(_), false) => "stdout: cannot write",
-        })
+        })?;
+    Ok(ExitCode::SUCCESS)
 }

@@ -32,7 +32,7 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(dir) = &args.report {
         check_report_dir(dir, &[show::MAP_FILE])?;
     }
-    let mut scenario = super::load_scenario(Some(sim), None)?;
+    let mut scenario = hilsim_scenarios::builtin::load_or_default(Some(sim), None)?;
     if let Some(path) = &args.calibration {
         let calibration = hilsim_calibrator::Calibration::read(path)?;
         scenario = hilsim_scenarios::calibrated::with_calibration(&scenario, &calibration)

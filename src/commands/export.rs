@@ -2,6 +2,7 @@
 //! ROS 2 messages in an MCAP file.
 
 use std::io::Write;
+use std::process::ExitCode;
 
 use anyhow::Result;
 use hilsim_recording::OutputTarget;
@@ -9,7 +10,7 @@ use hilsim_scenarios::{ExportRequest, McapExport};
 
 use crate::cli::ExportArgs;
 
-pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
+pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     // Every input is read before the output is opened.
     let export = McapExport::prepare(&ExportRequest {
         recording: &args.recording,
@@ -24,5 +25,5 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<()> {
     } else {
         writeln!(out, "wrote {}", args.mcap.display())?;
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

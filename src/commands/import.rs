@@ -5,6 +5,7 @@
 //! not; CoreSLAM `.dat`) into a recording.
 
 use std::io::Write;
+use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 use hilsim_logs::{CarmenOptions, LogKind, Poses};
@@ -14,7 +15,7 @@ use hilsim_ros2::ImportFlags;
 use crate::cli::ImportArgs;
 
 /// A robot's log into a recording.
-fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<()> {
+fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<ExitCode> {
     let given = [
         (args.meta.is_some()).then_some("--meta"),
         flags(args).first_given(),
@@ -41,7 +42,7 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<(
     log.recording.write_dir(&args.out)?;
     log.write_summary(out)?;
     writeln!(out, "wrote {}", args.out.display())?;
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The flags only a bag's import reads.
@@ -57,7 +58,7 @@ fn flags(args: &ImportArgs) -> ImportFlags<'_> {
     }
 }
 
-pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
+pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(kind) = LogKind::of(&args.bag) {
         return import_log(args, kind, out);
     }
@@ -75,5 +76,5 @@ pub fn import(args: &ImportArgs, out: &mut dyn Write) -> Result<()> {
     let report = hilsim_ros2::import(&args.bag, &args.out, &options)?;
     report.write_summary(out)?;
     writeln!(out, "wrote {}", args.out.display())?;
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -23,16 +23,3 @@ pub fn exit_code(passed: bool) -> std::process::ExitCode {
         std::process::ExitCode::from(1)
     }
 }
-
-/// Loads a scenario file, or the built-in one, and applies a `--seed` override.
-pub fn load_scenario(
-    path: Option<&std::path::Path>,
-    seed: Option<u64>,
-) -> anyhow::Result<hilsim_sim::Scenario> {
-    let mut scenario = match path {
-        Some(path) => hilsim_sim::Scenario::load(path)?,
-        None => hilsim_scenarios::builtin::straight_board()?,
-    };
-    scenario.seed = seed.unwrap_or(scenario.seed);
-    Ok(scenario)
-}

@@ -1,6 +1,8 @@
 //! `hilsim record SCENARIO --out DIR [--seed N]`: the samples go to disk as they are taken, so a
 //! run of any length records in flat memory, written by a thread of its own.
 
+use std::process::ExitCode;
+
 use anyhow::{Context, Result};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{check_output_file, BackgroundStream, RecordingStream};
@@ -8,11 +10,11 @@ use hilsim_scenarios::McapExport;
 
 use crate::cli::RecordArgs;
 
-pub fn record(args: &RecordArgs) -> Result<()> {
+pub fn record(args: &RecordArgs) -> Result<ExitCode> {
     if let Some(mcap) = &args.mcap {
         check_output_file(mcap, hilsim_ros2::MCAP_FILE, &[&args.scenario])?;
     }
-    let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
+    let scenario = hilsim_scenarios::builtin::load_or_default(Some(&args.scenario), args.seed)?;
     let emulation = Emulation::new(&scenario, scenario.seed)
         .with_context(|| format!("{}: sensor model", args.scenario.display()))?;
     hilsim_recording::tidy_after_killed_writers(&args.out)?;
@@ -26,5 +28,5 @@ pub fn record(args: &RecordArgs) -> Result<()> {
         let world = hilsim_scenarios::drawn_world(&scenario);
         McapExport::of_dir(&args.out, Some(world))?.write(mcap)?;
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

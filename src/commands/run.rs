@@ -54,7 +54,7 @@ fn validate(args: &RunArgs, origin: &str) -> Result<(Scenario, Via)> {
         let inputs = Vec::from_iter(args.scenario.as_deref());
         check_output_file(mcap, hilsim_ros2::MCAP_FILE, &inputs)?;
     }
-    let scenario = super::load_scenario(args.scenario.as_deref(), args.seed)?;
+    let scenario = hilsim_scenarios::builtin::load_or_default(args.scenario.as_deref(), args.seed)?;
     let via = match args.via {
         cli::Via::Memory => Via::Memory,
         cli::Via::Serial => Via::Serial,

@@ -2,6 +2,7 @@
 //! [--seed N]`.
 
 use std::io::Write;
+use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -13,8 +14,8 @@ use hilsim_lidar_emulator::Emulation;
 use crate::cli::ServeArgs;
 use crate::progress::Progress;
 
-pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
-    let scenario = super::load_scenario(Some(&args.scenario), args.seed)?;
+pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<ExitCode> {
+    let scenario = hilsim_scenarios::builtin::load_or_default(Some(&args.scenario), args.seed)?;
     let origin = args.scenario.display().to_string();
     let pacing = if args.fast {
         Pacing::Fast
@@ -52,7 +53,7 @@ pub fn serve(args: &ServeArgs, out: &mut dyn Write) -> Result<()> {
     } else {
         report.write_summary(out)?;
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Serves the stream, what is sent shown as a status line on a terminal (stderr; stdout keeps

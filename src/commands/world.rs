@@ -3,6 +3,7 @@
 //! its twin's readings come to the log's.
 
 use std::io::Write;
+use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 use hilsim_twin::{build_world, PoseSource, TwinFiles, WorldOptions};
@@ -30,7 +31,7 @@ fn options(args: &WorldArgs) -> Result<WorldOptions> {
     })
 }
 
-pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
+pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<ExitCode> {
     let options = options(args)?;
     let calibration = args
         .calibration
@@ -53,5 +54,5 @@ pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<()> {
         writeln!(out, "{}", declared.measured_noise_line())?;
     }
     writeln!(out, "wrote {}", files.scenario.display())?;
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

@@ -5,34 +5,13 @@
 use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
-use hilsim_twin::{build_world, PoseSource, TwinFiles, WorldOptions};
+use anyhow::Result;
+use hilsim_twin::{build_world, TwinFiles, WorldOptions};
 
 use crate::cli::WorldArgs;
 
-/// The world's options, the cell size checked.
-fn options(args: &WorldArgs) -> Result<WorldOptions> {
-    if !(args.resolution_m.is_finite() && (0.005..=1.0).contains(&args.resolution_m)) {
-        bail!(
-            "--resolution-m {}: expected a cell size from 0.005 to 1 m; see hilsim world --help",
-            args.resolution_m
-        );
-    }
-    let poses = match args.poses.as_str() {
-        "truth" => PoseSource::Truth,
-        "odometry" => PoseSource::Odometry,
-        _ => PoseSource::Auto,
-    };
-    Ok(WorldOptions {
-        map: args.map.clone(),
-        resolution_m: args.resolution_m,
-        poses,
-        ..WorldOptions::default()
-    })
-}
-
 pub fn world(args: &WorldArgs, out: &mut impl Write) -> Result<ExitCode> {
-    let options = options(args)?;
+    let options = WorldOptions::from_flags(args.map.clone(), args.resolution_m, &args.poses)?;
     let calibration = args
         .calibration
         .as_deref()

@@ -44,6 +44,37 @@ impl Default for WorldOptions {
     }
 }
 
+impl WorldOptions {
+    /// The options `hilsim world`'s flags ask for: the user's map, the built map's cell size
+    /// (from 0.005 to 1 m) and the path's source by name (`truth`, `odometry`, else `auto`).
+    ///
+    /// # Errors
+    /// A cell size out of range, naming the flag.
+    pub fn from_flags(
+        map: Option<PathBuf>,
+        resolution_m: f64,
+        poses: &str,
+    ) -> Result<Self, TwinError> {
+        if !(resolution_m.is_finite() && (0.005..=1.0).contains(&resolution_m)) {
+            return Err(TwinError::Input(format!(
+                "--resolution-m {resolution_m}: expected a cell size from 0.005 to 1 m; see \
+                 hilsim world --help"
+            )));
+        }
+        let poses = match poses {
+            "truth" => PoseSource::Truth,
+            "odometry" => PoseSource::Odometry,
+            _ => PoseSource::Auto,
+        };
+        Ok(Self {
+            map,
+            resolution_m,
+            poses,
+            ..Self::default()
+        })
+    }
+}
+
 /// A beam's end counts as occupied when at least this many beams ended in its cell …
 const MIN_HITS: u32 = 2;
 /// … and at least this share of the beams that reached the cell ended there: a person walking
@@ -435,4 +466,24 @@ fn toml_comment(s: &str) -> String {
     s.chars()
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_check_the_cell_size_and_name_the_pose_source() {
+        for bad in [0.0, 0.004, 1.5, f64::NAN] {
+            let err = WorldOptions::from_flags(None, bad, "auto").unwrap_err();
+            assert!(err.to_string().starts_with("--resolution-m "), "{err}");
+        }
+        let options = WorldOptions::from_flags(None, 0.05, "odometry").unwrap();
+        assert_eq!(options.poses, PoseSource::Odometry);
+        assert_eq!(options.resolution_m, 0.05);
+        assert_eq!(
+            WorldOptions::from_flags(None, 0.05, "auto").unwrap().poses,
+            PoseSource::Auto
+        );
+    }
 }

@@ -52,6 +52,12 @@ pub enum LogError {
         /// What is missing.
         message: String,
     },
+    /// Poses asked of a CoreSLAM log, which has encoder counts.
+    #[error("--poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses")]
+    PosesOfCoreSlam,
+    /// The recording cannot be written where asked.
+    #[error(transparent)]
+    Recording(#[from] hilsim_recording::Error),
     /// An option out of its range.
     #[error("option {name}: {message}")]
     Option {

@@ -18,5 +18,5 @@ mod text;
 pub use carmen::{read_carmen, CarmenOptions, Clock, Poses};
 pub use coreslam::{read_coreslam, CoreSlamOptions};
 pub use error::LogError;
-pub use log_file::{read_log, LogImport, LogKind};
+pub use log_file::{import_log, read_log, LogImport, LogKind};
 pub use text::{read_text, MAX_TEXT_BYTES};

@@ -6,7 +6,9 @@ use std::path::Path;
 
 use hilsim_recording::Recording;
 
-use crate::{read_carmen, read_coreslam, read_text, CarmenOptions, CoreSlamOptions, LogError};
+use crate::{
+    read_carmen, read_coreslam, read_text, CarmenOptions, CoreSlamOptions, LogError, Poses,
+};
 
 /// The formats of robot log read, by the file's name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,6 +47,35 @@ pub struct LogImport {
     pub recording: Recording,
     /// What was assumed, skipped or repaired.
     pub notes: Vec<String>,
+}
+
+/// Imports the log at `path`, of format `kind`, as the recording directory `out` (the log must
+/// not be inside it): a CARMEN log's poses are `poses` (`odometry`; anything else, the
+/// default, truth).
+///
+/// # Errors
+/// Poses asked of a CoreSLAM log; as [`read_log`]; the recording cannot be written.
+pub fn import_log(
+    path: &Path,
+    kind: LogKind,
+    poses: Option<&str>,
+    out: &Path,
+) -> Result<LogImport, LogError> {
+    if kind == LogKind::CoreSlam && poses.is_some() {
+        return Err(LogError::PosesOfCoreSlam);
+    }
+    let carmen = CarmenOptions {
+        poses: match poses {
+            Some("odometry") => Poses::Odometry,
+            _ => Poses::Truth,
+        },
+        ..CarmenOptions::default()
+    };
+    hilsim_recording::check_input_outside(path, out)?;
+    let log = read_log(path, kind, &carmen)?;
+    hilsim_recording::tidy_after_killed_writers(out)?;
+    log.recording.write_dir(out)?;
+    Ok(log)
 }
 
 /// Reads the log at `path`, of format `kind` (a CARMEN log's poses as `carmen` says).

@@ -8,7 +8,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};
-use hilsim_logs::{CarmenOptions, LogKind, Poses};
+use hilsim_logs::LogKind;
 use hilsim_recording::{check_input_outside, tidy_after_killed_writers, Meta};
 use hilsim_ros2::ImportFlags;
 
@@ -26,20 +26,7 @@ fn import_log(args: &ImportArgs, kind: LogKind, out: &mut dyn Write) -> Result<E
             args.bag.display()
         );
     }
-    if kind == LogKind::CoreSlam && args.log_poses.is_some() {
-        bail!("--poses is for CARMEN logs; a CoreSLAM log has encoder counts, not poses");
-    }
-    let carmen = CarmenOptions {
-        poses: match args.log_poses.as_deref() {
-            Some("odometry") => Poses::Odometry,
-            _ => Poses::Truth,
-        },
-        ..CarmenOptions::default()
-    };
-    check_input_outside(&args.bag, &args.out)?;
-    let log = hilsim_logs::read_log(&args.bag, kind, &carmen)?;
-    tidy_after_killed_writers(&args.out)?;
-    log.recording.write_dir(&args.out)?;
+    let log = hilsim_logs::import_log(&args.bag, kind, args.log_poses.as_deref(), &args.out)?;
     log.write_summary(out)?;
     writeln!(out, "wrote {}", args.out.display())?;
     Ok(ExitCode::SUCCESS)

@@ -5,8 +5,8 @@ use std::fmt;
 use std::path::Path;
 use std::time::Duration;
 
-use hilsim_hil::firmware::{split_command_line, SplitError};
-use hilsim_hil::hil_run::{HilConfig, HilWorld};
+use hilsim_hil::firmware::{split_command_line, Firmware, SplitError};
+use hilsim_hil::hil_run::{HilConfig, HilPorts, HilWorld};
 use hilsim_lidar_emulator::ModelError;
 use hilsim_sim::scenario::{ScenarioError, MAX_RUN_S};
 use hilsim_sim::Scenario;
@@ -33,6 +33,8 @@ pub struct FirmwareRequest<'a> {
 pub struct FirmwarePlan {
     /// The firmware's command line as words.
     pub argv: Vec<String>,
+    /// The firmware's command line on one line, whatever its own line breaks.
+    pub command_line: String,
     /// The scenario's file, as shown in messages.
     pub origin: String,
     /// The scenario, its seed and duration overridden as asked.
@@ -74,6 +76,15 @@ pub enum FirmwarePlanError {
     /// The output directory may not be replaced.
     #[error(transparent)]
     Output(#[from] hilsim_recording::Error),
+    /// The firmware cannot be started.
+    #[error("--firmware: cannot start `{program}`")]
+    Start {
+        /// The program.
+        program: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
     /// A sensor's model makes no sense.
     #[error("{origin}: sensor model")]
     SensorModel {
@@ -133,13 +144,45 @@ impl FirmwarePlan {
             watchdog,
             ..HilConfig::new(duration)
         };
+        let command_line = request.firmware.split_whitespace().collect::<Vec<_>>().join(" ");
         Ok(Self {
             argv,
+            command_line,
             origin,
             scenario,
             world,
             config,
         })
+    }
+}
+
+impl FirmwarePlan {
+    /// Starts the firmware, the paths of `ports` in its environment (`HILSIM_LIDAR_PORT`,
+    /// `HILSIM_ROBOT_PORT`).
+    ///
+    /// # Errors
+    /// The program cannot be started.
+    pub fn spawn(&self, ports: &HilPorts) -> Result<Firmware, FirmwarePlanError> {
+        let env = [
+            ("HILSIM_LIDAR_PORT", ports.lidar_path()),
+            ("HILSIM_ROBOT_PORT", ports.robot_path()),
+        ];
+        Firmware::spawn(&self.argv, &env).map_err(|source| FirmwarePlanError::Start {
+            program: self.argv[0].clone(),
+            source,
+        })
+    }
+
+    /// One line saying what runs: the firmware started as `pid`, the scenario, for how long.
+    #[must_use]
+    pub fn started_line(&self, pid: u32) -> String {
+        format!(
+            "firmware: pid {pid} `{}`; {} ({}) for {:.1} s in real time",
+            self.command_line,
+            hilsim_recording::printable(&self.scenario.name),
+            hilsim_recording::printable(&self.origin),
+            self.config.duration.as_secs_f64()
+        )
     }
 }
 

@@ -35,23 +35,8 @@ pub fn hil(args: &HilArgs, out: &mut dyn Write) -> Result<ExitCode> {
     writeln!(out, "lidar: {}", ports.lidar_path())?;
     writeln!(out, "robot: {}", ports.robot_path())?;
     out.flush()?;
-    let env = [
-        ("HILSIM_LIDAR_PORT", ports.lidar_path()),
-        ("HILSIM_ROBOT_PORT", ports.robot_path()),
-    ];
-    let firmware = Firmware::spawn(&plan.argv, &env)
-        .with_context(|| format!("--firmware: cannot start `{}`", plan.argv[0]))?;
-    // On one line, whatever the command's own line breaks.
-    let command: Vec<&str> = args.firmware.split_whitespace().collect();
-    writeln!(
-        out,
-        "firmware: pid {} `{}`; {} ({}) for {:.1} s in real time",
-        firmware.pid(),
-        command.join(" "),
-        hilsim_recording::printable(&plan.scenario.name),
-        hilsim_recording::printable(&plan.origin),
-        plan.config.duration.as_secs_f64()
-    )?;
+    let firmware = plan.spawn(&ports)?;
+    writeln!(out, "{}", plan.started_line(firmware.pid()))?;
     out.flush()?;
     let report = run_shown(plan.world, ports, firmware, &plan.config, &stop)?;
     let run = FirmwareRun::judge(report, &plan.scenario.expect);

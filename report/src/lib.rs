@@ -26,6 +26,26 @@ pub use view::Inputs;
 /// The most rows of one table a report draws from ([`hilsim_recording::MAX_ROWS_HELD`]).
 pub const MAX_ROWS: u64 = hilsim_recording::MAX_ROWS_HELD;
 
+/// The page of `hilsim report`: the recording named `name` (the part `thinning` kept), the
+/// scenario it is a run of and the calibrations to show.
+#[must_use]
+pub fn recording_page(
+    name: &str,
+    recording: &hilsim_recording::Recording,
+    thinning: &hilsim_recording::Thinning,
+    scenario: Option<&hilsim_sim::Scenario>,
+    calibrations: &[hilsim_calibrator::Calibration],
+) -> String {
+    render(Inputs {
+        title: &format!("hilsim report: {name}"),
+        recording,
+        recording_name: &drawn_name(name, thinning),
+        scenario,
+        calibrations,
+        truth_estimated: false,
+    })
+}
+
 /// The recording's name as a page gives it: with which part was drawn, when not all of it.
 #[must_use]
 pub fn drawn_name(name: &str, thinning: &hilsim_recording::Thinning) -> String {

@@ -144,7 +144,11 @@ impl FirmwarePlan {
             watchdog,
             ..HilConfig::new(duration)
         };
-        let command_line = request.firmware.split_whitespace().collect::<Vec<_>>().join(" ");
+        let command_line = request
+            .firmware
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         Ok(Self {
             argv,
             command_line,

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use hilsim_recording::RecordingDir;
-use hilsim_report::Inputs;
+use hilsim_report::recording_page;
 use hilsim_sim::Scenario;
 
 use crate::cli::ReportArgs;
@@ -27,15 +27,13 @@ pub fn report(args: &ReportArgs, out: &mut dyn Write) -> Result<ExitCode> {
         None => Vec::new(),
     };
     let name = args.recording.display().to_string();
-    let title = format!("hilsim report: {name}");
-    let html = hilsim_report::render(Inputs {
-        title: &title,
-        recording: &recording,
-        recording_name: &hilsim_report::drawn_name(&name, &thinning),
-        scenario: scenario.as_ref(),
-        calibrations: &calibrations,
-        truth_estimated: false,
-    });
+    let html = recording_page(
+        &name,
+        &recording,
+        &thinning,
+        scenario.as_ref(),
+        &calibrations,
+    );
     hilsim_report::write_report_files(&args.out, &[("index.html".into(), html)])?;
     writeln!(out, "report: {}", args.out.join("index.html").display())?;
     Ok(ExitCode::SUCCESS)

@@ -1,4 +1,5 @@
-//! One sensor's practical floor as a user types it (`SENSOR=MM`, `hilsim diagnose --floor`).
+//! The practical floors as a user types them: one sensor's (`SENSOR=MM`, `hilsim diagnose
+//! --floor`) and the noise share (`--floor-noise-share`).
 
 use std::fmt;
 use std::str::FromStr;
@@ -20,7 +21,7 @@ enum FloorSensor {
     Drive,
 }
 
-/// Why a `SENSOR=MM` floor was refused: what was expected and what was found.
+/// Why a floor was refused: what was expected and what was found.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ParseFloorError(String);
 
@@ -76,6 +77,33 @@ impl Floors {
         *slot = floor.metres;
         self
     }
+
+    /// The default floors with each of `floors` (`SENSOR=MM`, `--floor`) and the share of the
+    /// declared noise `noise_share` (`--floor-noise-share`, ≥ 0) when given.
+    ///
+    /// # Errors
+    /// A floor or share that is not one, naming its flag.
+    pub fn from_flags(
+        floors: &[String],
+        noise_share: Option<f64>,
+    ) -> Result<Self, ParseFloorError> {
+        let mut result = Self::default();
+        for floor in floors {
+            let floor: SensorFloor = floor
+                .parse()
+                .map_err(|e: ParseFloorError| ParseFloorError(format!("--floor: {}", e.0)))?;
+            result = result.with(floor);
+        }
+        if let Some(x) = noise_share {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(ParseFloorError(format!(
+                    "--floor-noise-share: expected a share ≥ 0, found {x}"
+                )));
+            }
+            result.noise_share = x;
+        }
+        Ok(result)
+    }
 }
 
 #[cfg(test)]
@@ -88,6 +116,23 @@ mod tests {
         let floors = Floors::default().with(floor);
         assert_eq!(floors.sonar_m, 0.012);
         assert_eq!(floors.lidar_m, Floors::default().lidar_m);
+    }
+
+    #[test]
+    fn flags_name_themselves_in_errors() {
+        let floors = Floors::from_flags(&["lidar=5".to_string()], Some(0.5)).expect("floors");
+        assert_eq!(floors.lidar_m, 0.005);
+        assert_eq!(floors.noise_share, 0.5);
+        let err = Floors::from_flags(&["lidar".to_string()], None).expect_err("no size");
+        assert_eq!(
+            err.to_string(),
+            "--floor: expected SENSOR=MM, found `lidar`"
+        );
+        let err = Floors::from_flags(&[], Some(f64::NAN)).expect_err("not a share");
+        assert_eq!(
+            err.to_string(),
+            "--floor-noise-share: expected a share ≥ 0, found NaN"
+        );
     }
 
     #[test]

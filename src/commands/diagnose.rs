@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{anyhow, bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan};
-use hilsim_diagnose::{show, Diagnosis, Floors, Options, SensorFloor, SimPhysics};
+use hilsim_diagnose::{show, Diagnosis, Floors, Options, SimPhysics};
 use hilsim_recording::Recording;
 use hilsim_report::check_report_dir;
 use hilsim_sim::Scenario;
@@ -28,7 +28,11 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     let (Some(sim), Some(real)) = (&args.sim, &args.real) else {
         bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
     };
-    let options = options(args)?;
+    let floors = Floors::from_flags(&args.floors, args.floor_noise_share)?;
+    let options = Options {
+        floors,
+        ..Options::default()
+    };
     if let Some(dir) = &args.report {
         check_report_dir(dir, &[show::MAP_FILE])?;
     }
@@ -62,25 +66,6 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     let mismatch = args.fail_on_mismatch && diagnosis.verdict.name() != "none";
     Ok(super::exit_code(!mismatch))
-}
-
-/// The diagnosis's options from `--floor` and `--floor-noise-share`.
-fn options(args: &DiagnoseArgs) -> Result<Options> {
-    let mut floors = Floors::default();
-    for floor in &args.floors {
-        let floor: SensorFloor = floor.parse().context("--floor")?;
-        floors = floors.with(floor);
-    }
-    if let Some(x) = args.floor_noise_share {
-        if !(x.is_finite() && x >= 0.0) {
-            bail!("--floor-noise-share: expected a share ≥ 0, found {x}");
-        }
-        floors.noise_share = x;
-    }
-    Ok(Options {
-        floors,
-        ..Options::default()
-    })
 }
 
 /// The self-test's plan, checked before its nominal scenario is read.

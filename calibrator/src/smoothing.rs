@@ -59,6 +59,24 @@ pub fn smooth(
     smooth_checked(rec, trained, opts).map(|(estimates, _)| estimates)
 }
 
+/// The calibration at `path` for the smoother: read, and holding a sensor model to apply (em's
+/// lidar, sonar, odometer).
+///
+/// # Errors
+/// As [`Calibration::read`]; a calibration without a sensor model.
+pub fn read_trained(path: &std::path::Path) -> Result<Calibration, CalibrationError> {
+    let trained = Calibration::read(path)?;
+    if trained.sensors.is_empty() {
+        return Err(CalibrationError::Invalid(format!(
+            "{}: the {} method's calibration holds no sensor model; smooth applies em's (lidar, \
+             sonar, odometer)",
+            path.display(),
+            trained.method.name()
+        )));
+    }
+    Ok(trained)
+}
+
 /// As [`smooth`], with the recording checked against the calibration as EM checks its own
 /// ([`crate::checks`]): a straight run at one target, the lidar's innovations of the trained
 /// size and white. A recording the calibration does not fit (another lidar, a wrong start

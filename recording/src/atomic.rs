@@ -28,6 +28,13 @@ pub enum OutputTarget {
 }
 
 impl OutputTarget {
+    /// Whether writing to `path` writes this process's standard output (then a command's own
+    /// lines go beside it, to stderr, not into it).
+    #[must_use]
+    pub fn is_stdout(path: &Path) -> bool {
+        Self::of(path).is_ok_and(|t| t == Self::Stdout)
+    }
+
     /// What writing to `path` means.
     ///
     /// # Errors

@@ -84,15 +84,7 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         check_output_file(csv, hilsim_calibrator::SMOOTHED_CSV, &inputs)?;
     }
-    let trained = hilsim_calibrator::Calibration::read(&args.calibration)?;
-    if trained.sensors.is_empty() {
-        bail!(
-            "{}: the {} method's calibration holds no sensor model; smooth applies em's (lidar, \
-             sonar, odometer)",
-            args.calibration.display(),
-            trained.method.name()
-        );
-    }
+    let trained = smoothing::read_trained(&args.calibration)?;
     let rec = Recording::read_dir(&args.recording)?;
     let (estimates, checks) =
         smoothing::smooth_checked(&rec, &trained, &hilsim_calibrator::em_options(target))
@@ -102,9 +94,12 @@ pub fn smooth(args: &SmoothArgs, out: &mut dyn Write) -> Result<ExitCode> {
         Some(path) => {
             write_file_atomically(path, csv.as_bytes())?;
             // With the table on standard output, the line saying so goes beside it.
-            let on_stdout = OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout);
             let mut stderr = std::io::stderr();
-            let out: &mut dyn Write = if on_stdout { &mut stderr } else { out };
+            let out: &mut dyn Write = if OutputTarget::is_stdout(path) {
+                &mut stderr
+            } else {
+                out
+            };
             let (n, recording) = (estimates.len(), args.recording.display());
             writeln!(
                 out,

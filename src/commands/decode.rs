@@ -20,10 +20,7 @@ pub fn decode(args: &DecodeArgs, stdout: &mut dyn Write) -> Result<ExitCode> {
             err => anyhow::Error::new(err),
         })?;
     // With the table on standard output, the counts go beside it, not into it.
-    let beside = args
-        .csv
-        .as_deref()
-        .is_some_and(|path| OutputTarget::of(path).is_ok_and(|t| t == OutputTarget::Stdout));
+    let beside = args.csv.as_deref().is_some_and(OutputTarget::is_stdout);
     let mut stderr = std::io::stderr();
     let out: &mut dyn Write = if beside { &mut stderr } else { stdout };
     let written = if args.json {

@@ -20,7 +20,7 @@ pub fn export(args: &ExportArgs, out: &mut dyn Write) -> Result<ExitCode> {
     })?;
     export.write(&args.mcap)?;
     // Written to standard output, the file is the output: the line saying so goes beside it.
-    if OutputTarget::of(&args.mcap).is_ok_and(|t| t == OutputTarget::Stdout) {
+    if OutputTarget::is_stdout(&args.mcap) {
         eprintln!("wrote {}", args.mcap.display());
     } else {
         writeln!(out, "wrote {}", args.mcap.display())?;

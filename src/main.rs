@@ -68,16 +68,14 @@ fn main() -> ExitCode {
 
 /// Whether `err` comes from writing to a pipe whose reader has gone.
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
-    let broken = |io: &std::io::Error| io.kind() == std::io::ErrorKind::BrokenPipe;
-    let broken_writing = |err: &hilsim_recording::Error| matches!(&err.kind, hilsim_recording::ErrorKind::Io(io) if broken(io));
     err.chain().any(|cause| {
-        cause.downcast_ref::<std::io::Error>().is_some_and(broken)
+        let io = cause.downcast_ref::<std::io::Error>();
+        io.is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
             || cause
                 .downcast_ref::<hilsim_recording::Error>()
-                .is_some_and(broken_writing)
-            || matches!(
-                cause.downcast_ref::<hilsim_ros2::Error>(),
-                Some(hilsim_ros2::Error::Recording(err)) if broken_writing(err)
-            )
+                .is_some_and(hilsim_recording::Error::is_broken_pipe)
+            || cause
+                .downcast_ref::<hilsim_ros2::Error>()
+                .is_some_and(hilsim_ros2::Error::is_broken_pipe)
     })
 }

@@ -25,6 +25,13 @@ pub enum ErrorKind {
 }
 
 impl Error {
+    /// Whether writing to a pipe whose reader has gone failed (`hilsim … | head`): not an error
+    /// to report, a reason to stop quietly.
+    #[must_use]
+    pub fn is_broken_pipe(&self) -> bool {
+        matches!(&self.kind, ErrorKind::Io(io) if io.kind() == std::io::ErrorKind::BrokenPipe)
+    }
+
     pub(crate) fn io(path: &Path, err: std::io::Error) -> Self {
         Self {
             path: path.to_path_buf(),

@@ -20,6 +20,13 @@ pub enum Error {
 }
 
 impl Error {
+    /// Whether writing to a pipe whose reader has gone failed (see
+    /// [`hilsim_recording::Error::is_broken_pipe`]).
+    #[must_use]
+    pub fn is_broken_pipe(&self) -> bool {
+        matches!(self, Self::Recording(err) if err.is_broken_pipe())
+    }
+
     pub(crate) fn bag(path: &Path, message: impl Into<String>) -> Self {
         Self::Bag {
             path: path.to_path_buf(),

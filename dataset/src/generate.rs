@@ -44,6 +44,18 @@ pub struct Options {
     pub only: Option<u64>,
 }
 
+impl Options {
+    /// Worker threads as `--jobs` asks for them (`None`: one per core).
+    ///
+    /// # Errors
+    /// Zero threads.
+    pub fn jobs(jobs: Option<usize>) -> Result<Option<NonZeroUsize>, Error> {
+        let zero = || Error::Parameter("--jobs 0: expected at least 1".into());
+        jobs.map(|j| NonZeroUsize::new(j).ok_or_else(zero))
+            .transpose()
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Self {

@@ -31,6 +31,14 @@ pub struct Vary {
 }
 
 impl Vary {
+    /// Each `KEY=LO..HI` of `specs` (`--vary`, repeatable), in order.
+    ///
+    /// # Errors
+    /// The first that is not one.
+    pub fn parse_all(specs: &[String]) -> Result<Vec<Self>, Error> {
+        specs.iter().map(|s| s.parse()).collect()
+    }
+
     /// A vary of `key` over `[lo, hi]`.
     ///
     /// # Errors

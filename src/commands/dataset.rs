@@ -7,7 +7,6 @@
 //! merge, a run is failed or missing, 2 bad input.
 
 use std::io::{IsTerminal, Write};
-use std::num::NonZeroUsize;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, Result};
@@ -21,12 +20,8 @@ pub fn dataset(args: &DatasetArgs, out: &mut dyn Write) -> Result<ExitCode> {
     }
     // Validate everything before opening anything.
     let shard = args.shard.as_deref().map(str::parse::<Shard>).transpose()?;
-    let varies: Vec<Vary> = args
-        .vary
-        .iter()
-        .map(|s| s.parse())
-        .collect::<Result<_, _>>()?;
-    let jobs = jobs(args.jobs)?;
+    let varies = Vary::parse_all(&args.vary)?;
+    let jobs = Options::jobs(args.jobs)?;
     let (Some(scenario), Some(runs), Some(dir)) = (&args.scenario, args.runs, &args.out) else {
         return Err(anyhow!("dataset: SCENARIO, --runs and --out are required"));
     };
@@ -51,15 +46,10 @@ pub fn dataset(args: &DatasetArgs, out: &mut dyn Write) -> Result<ExitCode> {
 }
 
 fn merge_command(args: &MergeArgs, out: &mut dyn Write) -> Result<ExitCode> {
-    let s = merge(&args.out, &args.sources, jobs(args.jobs)?)?;
+    let s = merge(&args.out, &args.sources, Options::jobs(args.jobs)?)?;
     writeln!(out, "{}", s.line(&args.out))?;
     let complete = s.failed == 0 && s.missing == 0;
     Ok(super::exit_code(complete))
-}
-
-fn jobs(jobs: Option<usize>) -> Result<Option<NonZeroUsize>> {
-    jobs.map(|j| NonZeroUsize::new(j).ok_or_else(|| anyhow!("--jobs 0: expected at least 1")))
-        .transpose()
 }
 
 /// Progress on stdout: a bar when it is a terminal, else one line per run.

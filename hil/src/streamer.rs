@@ -75,6 +75,15 @@ impl Default for StreamStats {
 }
 
 impl StreamStats {
+    /// One line for a status line: what was sent by `t_s` seconds of simulated time.
+    #[must_use]
+    pub fn describe(&self, t_s: f64) -> String {
+        format!(
+            "{t_s:.1} s simulated, {} revolutions sent, {} dropped",
+            self.revolutions_sent, self.revolutions_dropped
+        )
+    }
+
     /// Packets whose lateness was measured (realtime pacing only).
     #[must_use]
     pub fn paced_packets(&self) -> u64 {

@@ -77,10 +77,7 @@ fn run_shown(
     );
     let mut next_line_s = STATUS_LINE_EVERY_S;
     hil_run::run_with_progress(world, ports, Some(firmware), config, stop, &mut |p| {
-        let message = format!(
-            "{:.1} of {total_s:.1} s, {} requests, {} lidar revolutions sent, {} dropped",
-            p.t_s, p.requests, p.revolutions_sent, p.revolutions_dropped
-        );
+        let message = p.describe(total_s);
         if status.is_shown() {
             status.message(message);
         } else if on_terminal && p.t_s >= next_line_s {

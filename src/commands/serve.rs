@@ -66,10 +66,7 @@ fn run<L: SerialLink>(
 ) -> Result<ServeReport> {
     let status = Progress::on_stderr(true, None, "{spinner} serve: {msg}");
     serve_model(emulation, link, options, stop, &mut |stats, t_s| {
-        status.message(format!(
-            "{t_s:.1} s simulated, {} revolutions sent, {} dropped",
-            stats.revolutions_sent, stats.revolutions_dropped
-        ));
+        status.message(stats.describe(t_s));
     })
     .context("the serial link failed")
 }

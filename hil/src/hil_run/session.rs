@@ -67,6 +67,17 @@ pub struct HilProgress {
     pub requests: u64,
 }
 
+impl HilProgress {
+    /// One line for a status line: how far a run of `total_s` seconds has come.
+    #[must_use]
+    pub fn describe(&self, total_s: f64) -> String {
+        format!(
+            "{:.1} of {total_s:.1} s, {} requests, {} lidar revolutions sent, {} dropped",
+            self.t_s, self.requests, self.revolutions_sent, self.revolutions_dropped
+        )
+    }
+}
+
 /// Simulated time between two calls of a run's progress callback, seconds.
 const PROGRESS_EVERY_S: f64 = 0.1;
 

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{anyhow, bail, Context, Result};
 use hilsim_diagnose::self_test::{self, Plan};
-use hilsim_diagnose::{show, Diagnosis, Floors, Options, SimPhysics};
+use hilsim_diagnose::{show, Floors, Options, SimPhysics};
 use hilsim_recording::Recording;
 use hilsim_report::check_report_dir;
 use hilsim_sim::Scenario;
@@ -54,7 +54,8 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         .with_context(|| real.display().to_string())?;
     drop(status);
     if let Some(dir) = &args.report {
-        write_report(dir, &diagnosis, (sim, &scenario), (real, &recording))?;
+        let files = show::report_files_of(&diagnosis, (sim, &scenario), (real, &recording));
+        hilsim_report::write_report_files(dir, &files)?;
     }
     if args.json {
         writeln!(out, "{}", show::to_json(&diagnosis))?;
@@ -98,7 +99,8 @@ fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCo
             run.recording.write_dir(&rec_dir)?;
             let origin = format!("<built-in {}>", scenario.name);
             let sim = (Path::new(&origin), &scenario);
-            write_report(dir, &run.diagnosis, sim, (&rec_dir, &run.recording))?;
+            let files = show::report_files_of(&run.diagnosis, sim, (&rec_dir, &run.recording));
+            hilsim_report::write_report_files(dir, &files)?;
         }
         if args.json {
             writeln!(out, "{}", run.to_json())?;
@@ -128,22 +130,4 @@ fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCo
         out.write_all(result.to_text(&command, wall_s).as_bytes())?;
     }
     Ok(super::exit_code(result.passed()))
-}
-
-/// Writes `index.html`, its plots and the map into `dir` (created if needed), each file
-/// atomically.
-fn write_report(
-    dir: &Path,
-    d: &Diagnosis,
-    (sim, scenario): (&Path, &Scenario),
-    (real, recording): (&Path, &Recording),
-) -> Result<()> {
-    let title = format!(
-        "hilsim diagnose: {} against {}",
-        real.display(),
-        sim.display()
-    );
-    let name = real.display().to_string();
-    let files = show::report_files(d, &title, scenario, recording, &name);
-    Ok(hilsim_report::write_report_files(dir, &files)?)
 }

@@ -12,7 +12,7 @@ mod text;
 
 pub use self::html::html;
 pub use self::json::to_json;
-pub use self::page::{report_files, MAP_FILE};
+pub use self::page::{report_files, report_files_of, MAP_FILE};
 pub use self::svg::svg;
 pub use self::text::summary;
 pub use crate::plot::PlotData;

@@ -1,6 +1,8 @@
 //! A diagnosis's report as files: its residual plots, the map of where the mismatch was
 //! located, and the page that holds them with the verdict.
 
+use std::path::Path;
+
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 
@@ -8,6 +10,22 @@ use crate::Diagnosis;
 
 /// The map's file beside a diagnosis's page.
 pub const MAP_FILE: &str = "map.svg";
+
+/// The files of the report of a diagnosis of the recording at `real` against the scenario at
+/// `sim`, as [`report_files`] makes them, titled by both.
+#[must_use]
+pub fn report_files_of(
+    d: &Diagnosis,
+    (sim, scenario): (&Path, &Scenario),
+    (real, recording): (&Path, &Recording),
+) -> Vec<(String, String)> {
+    let title = format!(
+        "hilsim diagnose: {} against {}",
+        real.display(),
+        sim.display()
+    );
+    report_files(d, &title, scenario, recording, &real.display().to_string())
+}
 
 /// The files of a diagnosis's report, by name: a residual plot per variable (SVG), the map
 /// ([`MAP_FILE`]) and `index.html`, last.

@@ -992,9 +992,12 @@ fn settle(
             (refit.params[i] - proposal[i]).abs() <= REALIGN_SETTLED * refit.params[i].abs()
         });
         // Followed when one size term (`Effect::size_terms`) is all the refit chose freely, but
-        // for the warm-up's time constant, which the path does not take up (it is fitted to
-        // the drift's decay); a mount's yaw and position are iterated plainly.
-        let settles_alone = usize::from(effect == Effect::LidarWarmupDrift);
+        // for the parameters of its form (`Effect::form_params`), which the path does not take
+        // up; a mount's yaw and position are iterated plainly.
+        let settles_alone = free
+            .iter()
+            .filter(|i| effect.form_params().contains(i))
+            .count();
         let size = effect
             .size_terms()
             .iter()

@@ -131,4 +131,3 @@ fn slip_sentence(gain_s: f64, braking_share: Option<f64>) -> String {
         _ => format!("{even} the encoders lead the true travel by {ms:.0} ms × the wheel's speed."),
     }
 }
-

@@ -281,11 +281,10 @@ fn accelerating_wheels_slip_and_the_encoders_lead_by_gain_times_speed() {
     nominal.duration_s = Some(3.5);
     let mut slipping = nominal.clone();
     let gain = 0.05;
-    slipping.effects.odometer_wheel_slip =
-        Some(hilsim_sim::scenario::OdometerWheelSlip {
-            gain_s: gain,
-            braking_gain_s: None,
-        });
+    slipping.effects.odometer_wheel_slip = Some(hilsim_sim::scenario::OdometerWheelSlip {
+        gain_s: gain,
+        braking_gain_s: None,
+    });
     let a = record(&nominal).odometry.unwrap();
     let b = record(&slipping).odometry.unwrap();
     for (ra, rb) in a.iter().zip(&b) {
@@ -335,4 +334,3 @@ fn a_slip_that_braking_does_not_give_back_accumulates_stage_by_stage() {
         assert!((end.right_m - at_rest.right_m - lead).abs() < 1e-9);
     }
 }
-

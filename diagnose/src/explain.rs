@@ -352,6 +352,30 @@ fn free_standard_errors(
     log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
 ) -> Vec<f64> {
     let free = effect.free(params);
+    let mut param_sd = in_free_standard_errors(effect, params, &free, best, log_likelihood);
+    // A form the data do not determine (an incidence's power of tan θ where nothing is met
+    // obliquely) leaves the curvature singular: the size's error is then given at that form.
+    if param_sd.iter().any(|sd| !sd.is_finite()) {
+        let sized: Vec<usize> = free
+            .iter()
+            .copied()
+            .filter(|i| !effect.form_params().contains(i))
+            .collect();
+        if sized.len() < free.len() {
+            param_sd = in_free_standard_errors(effect, params, &sized, best, log_likelihood);
+        }
+    }
+    param_sd
+}
+
+/// The standard errors of `params`' parameters `free` (the others 0).
+fn in_free_standard_errors(
+    effect: Effect,
+    params: &[f64],
+    free: &[usize],
+    best: f64,
+    log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
+) -> Vec<f64> {
     let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
     let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
     let mut in_free = |y: &[f64]| {

@@ -57,7 +57,11 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
 fn fits_worse(c: &CandidateFit) -> bool {
     let rises =
         |before: f64, after: f64| after.partial_cmp(&before) == Some(std::cmp::Ordering::Greater);
-    rises(c.rmse_before, c.rmse_after) && !(c.scaled_rmse.1 <= c.scaled_rmse.0)
+    let scaled_falls = matches!(
+        c.scaled_rmse.1.partial_cmp(&c.scaled_rmse.0),
+        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+    );
+    rises(c.rmse_before, c.rmse_after) && !scaled_falls
 }
 
 /// Whether `c` changes its sensor's readings by more than the practical floor, over the readings

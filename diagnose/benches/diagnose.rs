@@ -33,6 +33,7 @@ fn setup() -> (Scenario, Recording) {
     real.effects.lidar_incidence_angle = Some(hilsim_sim::scenario::LidarIncidenceAngle {
         coefficient: 0.02,
         collimated_m: 0.0,
+        exponent: 1.0,
     });
     (nominal, record(&real))
 }

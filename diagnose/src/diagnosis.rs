@@ -103,7 +103,7 @@ pub fn diagnose_with_progress(
         along_encoders.as_ref(),
         options,
     )?;
-    let ctx = context(physics, recording, &aligned);
+    let ctx = context(physics, recording, &aligned, options);
     let mut notes = aligned.notes.clone();
     let drive_ctx = along_encoders.as_ref().map(|a| along(&ctx, a));
     progress(Stage::Gathering);
@@ -458,6 +458,7 @@ fn context<'a>(
     physics: &'a dyn Physics,
     recording: &'a Recording,
     aligned: &'a Aligned,
+    options: &Options,
 ) -> Context<'a> {
     Context {
         physics,
@@ -468,6 +469,7 @@ fn context<'a>(
         yaw_sd_rad: aligned.yaw_sd_rad,
         estimated: aligned.alignment == Alignment::Estimated,
         placed_through: None,
+        floors: options.floors,
     }
 }
 
@@ -506,7 +508,7 @@ fn replayed_under_drive(
     let Some(along) = along else {
         return Ok(aligned);
     };
-    let ctx = context(physics, recording, along);
+    let ctx = context(physics, recording, along, options);
     let Some(drive) = drive_along(&ctx)? else {
         return Ok(aligned);
     };
@@ -992,9 +994,12 @@ fn settle(
             (refit.params[i] - proposal[i]).abs() <= REALIGN_SETTLED * refit.params[i].abs()
         });
         // Followed when one size term (`Effect::size_terms`) is all the refit chose freely, but
-        // for the warm-up's time constant, which the path does not take up (it is fitted to
-        // the drift's decay); a mount's yaw and position are iterated plainly.
-        let settles_alone = usize::from(effect == Effect::LidarWarmupDrift);
+        // for the parameters of its form (`Effect::form_params`), which the path does not take
+        // up; a mount's yaw and position are iterated plainly.
+        let settles_alone = free
+            .iter()
+            .filter(|i| effect.form_params().contains(i))
+            .count();
         let size = effect
             .size_terms()
             .iter()

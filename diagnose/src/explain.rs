@@ -7,7 +7,7 @@
 use crate::catalogue::{Effect, ParamSpec, Sensor};
 use crate::optimize::{maximize_shapes, refine, standard_errors};
 use crate::physics::Hypothesis;
-use crate::residuals::{fits, log_likelihood, rmse, Context, Predictive, SensorData};
+use crate::residuals::{fits, log_likelihood, rmse, Context, Fit, Predictive, SensorData};
 
 /// One candidate effect, fitted and scored against a base model (the nominal one, or the
 /// effects already named in its sensor).
@@ -53,6 +53,17 @@ pub struct CandidateFit {
     pub size_m: f64,
     /// The declared noise over those readings (RMS predicted standard deviation), metres.
     pub size_noise_m: f64,
+    /// How far beyond its sensor's practical floor ([`crate::locate::Floors`]) the effect
+    /// changes the readings, as a multiple of the floor: the median over the hundredth of the
+    /// held-out readings (at least 30) it changes most in units of the floor there. A range
+    /// sensor's floor grows with its noise, and so with the range: an effect that acts at short
+    /// range or on a near object (an incidence on a post) is measured where it shows, not under
+    /// the far walls' noise.
+    pub floor_multiple: f64,
+    /// Held-out root mean square of the residuals in units of their predicted standard
+    /// deviations, before and after the fit, over the readings of `rmse_before`: a
+    /// heteroscedastic sensor's RMSE in metres is its noisiest readings'.
+    pub scaled_rmse: (f64, f64),
     /// The latest reading scored, seconds from the recording's start (a warm-up's clock):
     /// how long a drift could be seen to settle.
     pub seen_until_s: f64,
@@ -61,6 +72,10 @@ pub struct CandidateFit {
 /// Readings the size of an effect is measured over: this share of the held-out ones, at
 /// least [`SIZE_MIN_READINGS`].
 const SIZE_SHARE: f64 = 0.1;
+/// The share of the held-out readings the multiple of the floor is measured over (at least
+/// [`SIZE_MIN_READINGS`]): an effect that shows on one object of a room (the oblique readings of
+/// a post, a hundredth or two of a scan) is measured on that object.
+const FLOOR_MULTIPLE_SHARE: f64 = 0.01;
 const SIZE_MIN_READINGS: usize = 30;
 
 /// Training rows for fitting: every `stride`-th, at most `max_rows`.
@@ -104,7 +119,9 @@ fn predictive_mean(p: &Predictive) -> f64 {
 
 /// The effect size: the change of the predictive mean from `before` to `after` over the
 /// readings it changes most (the share [`SIZE_SHARE`]), with the predicted standard deviation
-/// there. For a range sensor it is the median of those changes (and the standard deviation of
+/// there; and the multiple of the practical floor (`floor` of a reading's standard deviation)
+/// the effect changes the readings by where it changes them most in units of that floor (the
+/// median over the share [`FLOOR_MULTIPLE_SHARE`]). For a range sensor it is the median of those changes (and the standard deviation of
 /// that reading): a geometric effect (a mount, a delay) flips a few readings at an object's
 /// edge between two surfaces metres apart, which would make a millimetre's effect look a metre
 /// large. The encoders' and the drive's predictions have no such jumps, and an effect of
@@ -114,7 +131,8 @@ fn effect_size(
     after: &[Predictive],
     ranges: bool,
     world_reach_m: &[f64],
-) -> (f64, f64) {
+    floor: &dyn Fn(f64) -> f64,
+) -> ((f64, f64), f64) {
     let mut change: Vec<(f64, f64)> = before
         .iter()
         .zip(after)
@@ -134,20 +152,51 @@ fn effect_size(
         })
         .collect();
     if change.is_empty() {
-        return (0.0, f64::NAN);
+        return ((0.0, f64::NAN), 0.0);
     }
-    let k = ((change.len() as f64 * SIZE_SHARE) as usize)
-        .max(SIZE_MIN_READINGS)
-        .min(change.len());
-    change.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let top = &change[..k];
-    if ranges {
-        return top[k / 2];
-    }
-    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
-        (top.iter().map(|x| f(x).powi(2)).sum::<f64>() / k as f64).sqrt()
+    let n = change.len();
+    let top_k = |share: f64| ((n as f64 * share) as usize).max(SIZE_MIN_READINGS).min(n);
+    let size_of_top = |top: &[(f64, f64)]| {
+        let k = top.len();
+        if ranges {
+            return top[k / 2];
+        }
+        let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
+            (top.iter().map(|x| f(x).powi(2)).sum::<f64>() / k as f64).sqrt()
+        };
+        (rms(&|x| x.0), rms(&|x| x.1))
     };
-    (rms(&|x| x.0), rms(&|x| x.1))
+    change.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let in_metres = size_of_top(&change[..top_k(SIZE_SHARE)]);
+    let mut multiples: Vec<f64> = change
+        .iter()
+        .map(|&(d, sd)| {
+            let f = floor(sd);
+            if f > 0.0 {
+                d / f
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    multiples.sort_by(|a, b| b.total_cmp(a));
+    let k = top_k(FLOOR_MULTIPLE_SHARE);
+    (in_metres, multiples[k / 2])
+}
+
+/// The root mean square of `fits`' residuals in units of their standard deviations, over those
+/// `keep` keeps.
+fn scaled_rms(fits: &[Fit], keep: impl Fn(usize) -> bool) -> f64 {
+    let scaled: Vec<f64> = fits
+        .iter()
+        .enumerate()
+        .filter(|(i, f)| f.residual.is_finite() && f.sd > 0.0 && keep(*i))
+        .map(|(_, f)| (f.residual / f.sd).powi(2))
+        .collect();
+    if scaled.is_empty() {
+        return f64::NAN;
+    }
+    (scaled.iter().sum::<f64>() / scaled.len() as f64).sqrt()
 }
 
 /// Scores `effect` with `params` on top of `base`: its gains over the base on both halves,
@@ -181,17 +230,20 @@ pub(crate) fn score(
     let both = |i: usize| before[i].residual.is_finite() && !after[i].outlier;
     let (rmse_before, _, _) = rmse(&before, both);
     let (rmse_after, noise_floor, heldout_n) = rmse(&after, both);
+    let scaled_rmse = (scaled_rms(&before, both), scaled_rms(&after, both));
     let ranges = matches!(data.sensor, Sensor::Lidar | Sensor::Sonar);
     let reach: Vec<f64> = heldout.iter().map(|&i| data.world_reach(i)).collect();
-    let (size_m, size_noise_m) = if ctx.conditions(data) {
+    let floor = |noise_m: f64| ctx.floors.floor_m(data.sensor, noise_m);
+    let ((size_m, size_noise_m), floor_multiple) = if ctx.conditions(data) {
         effect_size(
             &ctx.predict_unconditioned(data, base, &heldout),
             &ctx.predict_unconditioned(data, &fitted, &heldout),
             ranges,
             &reach,
+            &floor,
         )
     } else {
-        effect_size(&before_p, &after_p, ranges, &reach)
+        effect_size(&before_p, &after_p, ranges, &reach, &floor)
     };
     let train_gain = best - train_base;
     CandidateFit {
@@ -210,6 +262,8 @@ pub(crate) fn score(
         heldout_ll_per_reading: heldout_ll / after.len().max(1) as f64,
         size_m,
         size_noise_m,
+        floor_multiple,
+        scaled_rmse,
         seen_until_s: data.t.iter().copied().fold(0.0, f64::max),
     }
 }
@@ -298,6 +352,30 @@ fn free_standard_errors(
     log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
 ) -> Vec<f64> {
     let free = effect.free(params);
+    let mut param_sd = in_free_standard_errors(effect, params, &free, best, log_likelihood);
+    // A form the data do not determine (an incidence's power of tan θ where nothing is met
+    // obliquely) leaves the curvature singular: the size's error is then given at that form.
+    if param_sd.iter().any(|sd| !sd.is_finite()) {
+        let sized: Vec<usize> = free
+            .iter()
+            .copied()
+            .filter(|i| !effect.form_params().contains(i))
+            .collect();
+        if sized.len() < free.len() {
+            param_sd = in_free_standard_errors(effect, params, &sized, best, log_likelihood);
+        }
+    }
+    param_sd
+}
+
+/// The standard errors of `params`' parameters `free` (the others 0).
+fn in_free_standard_errors(
+    effect: Effect,
+    params: &[f64],
+    free: &[usize],
+    best: f64,
+    log_likelihood: &mut dyn FnMut(&[f64]) -> f64,
+) -> Vec<f64> {
     let specs: Vec<ParamSpec> = free.iter().map(|&i| effect.params()[i]).collect();
     let at: Vec<f64> = free.iter().map(|&i| params[i]).collect();
     let mut in_free = |y: &[f64]| {

@@ -5,12 +5,12 @@
 //!
 //! An effect earns its place when it improves the held-out log-likelihood by more than
 //! [`Options::min_gain`], its BIC gain on the training half is positive, it does not raise its
-//! sensor's held-out RMSE (a likelihood gained on a few readings while the rest fit worse is
-//! not the effect: a lidar mount offset shifted a few millimetres gains tens of nats against a
+//! sensor's held-out RMSE in metres and in units of the readings' noise (a likelihood gained on
+//! a few readings while the rest fit worse is not the effect: a lidar mount offset shifted a few millimetres gains tens of nats against a
 //! periodic range error outside the catalogue while the RMSE rises), its fitted parameter
 //! departs from the effect's absence by more than the sensors resolve (`Effect::departs`),
 //! and it changes the predicted readings by more than the sensor's practical floor
-//! ([`crate::locate::Floors`]): a small difference between the recording and the simulation
+//! ([`crate::locate::Floors`]) where it changes them most, in metres or in units of their noise: a small difference between the recording and the simulation
 //! that some effect can mimic is not that effect. Against a path estimated from the lidar, a
 //! delay of the sonar or the encoders must also exceed the path's own timing
 //! ([`Options::path_timing_s`]).
@@ -42,12 +42,33 @@ pub(crate) struct Selection {
 pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Options) -> bool {
     c.heldout_gain > options.min_gain
         && c.bic_gain > 0.0
-        && c.rmse_after.partial_cmp(&c.rmse_before) != Some(std::cmp::Ordering::Greater)
+        && !fits_worse(c)
         && c.effect.departs(&c.params, declared_cone)
-        && c.size_m > options.floors.floor_m(c.sensor, c.size_noise_m)
+        && beyond_floor(c, options)
         && !within_path_timing(c, options)
         && !below_mount_floor(c, options)
         && settles_within_run(c)
+}
+
+/// Whether `c` raises its sensor's held-out RMSE both in metres and in units of the readings'
+/// own noise. In metres alone a range sensor's RMSE is its far readings', whose noise grows as
+/// the square of the range: an effect that explains near readings (an incidence on a post) while
+/// the far walls' noise moves the RMSE by a hair would be refused.
+fn fits_worse(c: &CandidateFit) -> bool {
+    let rises =
+        |before: f64, after: f64| after.partial_cmp(&before) == Some(std::cmp::Ordering::Greater);
+    let scaled_falls = matches!(
+        c.scaled_rmse.1.partial_cmp(&c.scaled_rmse.0),
+        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+    );
+    rises(c.rmse_before, c.rmse_after) && !scaled_falls
+}
+
+/// Whether `c` changes its sensor's readings by more than the practical floor, over the readings
+/// it changes most in metres or over those it changes most in units of the floor there (whose
+/// share of the noise is the readings' own: `Floors`).
+fn beyond_floor(c: &CandidateFit, options: &Options) -> bool {
+    c.size_m > options.floors.floor_m(c.sensor, c.size_noise_m) || c.floor_multiple > 1.0
 }
 
 /// The least share of a recording a warm-up's drift must settle within: its time constant at
@@ -245,6 +266,8 @@ mod tests {
             heldout_ll_per_reading: 2.0,
             size_m: 0.02,
             size_noise_m: 0.01,
+            floor_multiple: 4.0,
+            scaled_rmse: (1.5, 1.0),
             seen_until_s: 60.0,
         }
     }

@@ -386,6 +386,12 @@ impl Physics for SimPhysics {
                 wheel_base_m,
             ));
         }
+        // A slip whose braking gain differs from its driving one needs the wheels' changes of
+        // speed while braking (with equal gains they add nothing).
+        let braking = match effects.odometer_wheel_slip {
+            Some(slip) if slip.braking_gain() != slip.gain_s => braking_along(trajectory, &travel),
+            _ => vec![[0.0; 2]; ts.len()],
+        };
         times
             .iter()
             .map(|&t| {
@@ -402,12 +408,60 @@ impl Physics for SimPhysics {
                 // the emulator); the slip being linear in speed, dividing both is the same.
                 let scaled = [0, 1].map(|w| speed[w] / radius_scale[w]);
                 OdometryPrediction {
-                    wheels: [0, 1].map(|w| predictor.predict(at[w] / radius_scale[w], scaled[w])),
+                    wheels: [0, 1].map(|w| {
+                        predictor.predict(
+                            at[w] / radius_scale[w],
+                            scaled[w],
+                            braking[k][w] / radius_scale[w],
+                        )
+                    }),
                     speed_mps: speed,
                 }
             })
             .collect()
     }
+}
+
+/// The span a wheel's speed is measured over to tell its braking, seconds: the robots' changes
+/// of speed take a few tenths of a second (a motor's lag, a ramp), while differences of a path's
+/// poses a physics step apart carry its rounding (a truth file's micrometres over 10 ms are
+/// 0.1 mm/s) and an estimated path's noise.
+const BRAKING_SPEED_SPAN_S: f64 = 0.2;
+/// Changes of a wheel's speed smaller than this are not counted as speeding up or braking,
+/// m/s: a play operator's width, so that the noise left in the measured speed does not add up
+/// over a run (a tenth of the slowest speeds the catalogue's robots drive at, 0.05 m/s).
+const BRAKING_PLAY_MPS: f64 = 0.005;
+
+/// Each wheel's changes of speed while braking, summed from the start to each of `trajectory`'s
+/// points (`travel` its wheels' travel there), as
+/// [`braking_change_mps`](hilsim_lidar_emulator::effects::braking_change_mps) sums them in the
+/// emulator from the true speeds; here from the path's speeds over [`BRAKING_SPEED_SPAN_S`],
+/// through a play of [`BRAKING_PLAY_MPS`].
+fn braking_along(trajectory: &Trajectory, travel: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    use hilsim_lidar_emulator::effects::braking_change_mps;
+    let half = BRAKING_SPEED_SPAN_S / 2.0;
+    let mut held = [0.0_f64; 2];
+    let mut sum = [0.0_f64; 2];
+    trajectory
+        .times()
+        .iter()
+        .map(|&t| {
+            let (a, b) = (
+                trajectory.interpolate(travel, t - half),
+                trajectory.interpolate(travel, t + half),
+            );
+            for w in 0..2 {
+                let speed = (b[w] - a[w]) / BRAKING_SPEED_SPAN_S;
+                let gap = speed - held[w];
+                if gap.abs() > BRAKING_PLAY_MPS {
+                    let next = speed - BRAKING_PLAY_MPS.copysign(gap);
+                    sum[w] += braking_change_mps(held[w], next);
+                    held[w] = next;
+                }
+            }
+            sum
+        })
+        .collect()
 }
 
 fn empty_lidar() -> LidarPrediction {

@@ -4,7 +4,7 @@
 use hilsim_recording::OdometrySample;
 use hilsim_sim::{rng, scenario, StepState};
 
-use crate::effects::slip_travel_m;
+use crate::effects::{braking_change_mps, slip_travel_m};
 use rand_distr::{Distribution, StandardNormal};
 
 /// The emulated encoders.
@@ -15,8 +15,12 @@ pub struct Odometer {
     period_s: f64,
     rng: rng::Rng,
     next: u64,
-    /// `[effects.odometer_wheel_slip]`: slip velocity per unit of acceleration, seconds.
-    slip_gain_s: Option<f64>,
+    /// `[effects.odometer_wheel_slip]`.
+    slip: Option<scenario::OdometerWheelSlip>,
+    /// Each wheel's speed over the last physics step, m/s.
+    wheel_speeds_mps: [f64; 2],
+    /// Each wheel's changes of speed while braking, summed since the start, m/s.
+    braking_mps: [f64; 2],
     /// `[effects.odometer_wheel_radius]`: each wheel's radius over nominal (1 when off). The
     /// encoders count turns and multiply by the nominal radius: they report travel / scale.
     radius_scale: [f64; 2],
@@ -33,7 +37,8 @@ impl Odometer {
 
     /// The odometer of a scenario with `[effects.odometer_wheel_slip]` when switched on: each
     /// wheel's encoder leads its true travel by `gain_s · v`, v the wheel's speed during the
-    /// physics step (see `effects`).
+    /// physics step, and by `(braking_gain_s − gain_s)` times its changes of speed while braking
+    /// besides (see `effects`).
     #[must_use]
     pub fn with_effects(
         config: &scenario::Odometer,
@@ -47,7 +52,9 @@ impl Odometer {
             period_s: 1.0 / config.rate_hz,
             rng: rng::stream(seed, "odometer"),
             next: 0,
-            slip_gain_s: effects.odometer_wheel_slip.map(|e| e.gain_s),
+            slip: effects.odometer_wheel_slip,
+            wheel_speeds_mps: [0.0; 2],
+            braking_mps: [0.0; 2],
             radius_scale: effects
                 .odometer_wheel_radius
                 .map_or([1.0, 1.0], |r| [r.left_scale, r.right_scale]),
@@ -70,8 +77,17 @@ impl Odometer {
         }
     }
 
-    /// Readings whose instant falls in `[step.t0, step.t1)`.
+    /// Readings whose instant falls in `[step.t0, step.t1)`; called once for every physics step.
     pub fn observe(&mut self, step: &StepState, out: &mut Vec<OdometrySample>) {
+        // The wheels' speeds during this step, from their true travel.
+        let dt = step.t1 - step.t0;
+        if self.slip.is_some() && dt > 0.0 {
+            for w in 0..2 {
+                let speed = (step.wheels1[w] - step.wheels0[w]) / dt;
+                self.braking_mps[w] += braking_change_mps(self.wheel_speeds_mps[w], speed);
+                self.wheel_speeds_mps[w] = speed;
+            }
+        }
         loop {
             let t = self.next as f64 * self.period_s;
             if t >= step.t1 {
@@ -82,11 +98,10 @@ impl Odometer {
                 continue;
             }
             let [mut left, mut right] = step.wheels_at(t);
-            if let Some(gain) = self.slip_gain_s {
-                // The wheels' speeds during this step, from their true travel.
-                let dt = step.t1 - step.t0;
-                left += slip_travel_m(gain, (step.wheels1[0] - step.wheels0[0]) / dt);
-                right += slip_travel_m(gain, (step.wheels1[1] - step.wheels0[1]) / dt);
+            if let Some(slip) = &self.slip {
+                let [v, braking] = [self.wheel_speeds_mps, self.braking_mps];
+                left += slip_travel_m(slip, v[0], braking[0]);
+                right += slip_travel_m(slip, v[1], braking[1]);
             }
             let [left_scale, right_scale] = self.radius_scale;
             out.push(OdometrySample {

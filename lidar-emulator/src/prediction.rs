@@ -480,7 +480,7 @@ impl SonarPredictor {
 pub struct OdometerPredictor {
     scale: f64,
     sd_m: f64,
-    slip_gain_s: Option<f64>,
+    slip: Option<scenario::OdometerWheelSlip>,
 }
 
 impl OdometerPredictor {
@@ -491,17 +491,19 @@ impl OdometerPredictor {
         Self {
             scale: 1.0 + config.slip,
             sd_m: (config.noise_m * config.noise_m + tick_var).sqrt(),
-            slip_gain_s: effects.odometer_wheel_slip.map(|e| e.gain_s),
+            slip: effects.odometer_wheel_slip,
         }
     }
 
     /// The expected reading of one wheel whose true cumulative travel is `travel_m` while it
-    /// turns at `speed_mps` (its speed during the physics step), and the reading's spread.
+    /// turns at `speed_mps` (its speed during the physics step), `braking_mps` its changes of
+    /// speed while braking summed since the start
+    /// ([`braking_change_mps`](crate::effects::braking_change_mps)), and the reading's spread.
     #[must_use]
-    pub fn predict(&self, travel_m: f64, speed_mps: f64) -> Gaussian {
-        let slip = self
-            .slip_gain_s
-            .map_or(0.0, |g| crate::effects::slip_travel_m(g, speed_mps));
+    pub fn predict(&self, travel_m: f64, speed_mps: f64, braking_mps: f64) -> Gaussian {
+        let slip = self.slip.as_ref().map_or(0.0, |slip| {
+            crate::effects::slip_travel_m(slip, speed_mps, braking_mps)
+        });
         Gaussian::new(1.0, (travel_m + slip) * self.scale, self.sd_m)
     }
 }

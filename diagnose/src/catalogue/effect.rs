@@ -180,12 +180,12 @@ impl Effect {
     /// The fit's ranges are wide enough for any plausible unit (several times the self-test's
     /// draws) and the grids fine enough that the likelihood is unimodal between neighbouring
     /// points. The self-test's moderate ranges (× its strength unless said): incidence κ
-    /// ±[0.01, 0.03]; reflectivity c ±[0.008, 0.02] m; mixed pixels half-width [0.5, 1.5]°
+    /// ±[0.01, 0.03] (its power of `tan θ` 1); reflectivity c ±[0.008, 0.02] m; mixed pixels half-width [0.5, 1.5]°
     /// (at most 5°); motion skew the head's own period; warm-up k ±[0.004, 0.01] /m with τ in
     /// [5, 20] s (unscaled) — these two, on a fair coin, moved whole to their second term (the
     /// same scored error; `draw_values`); sonar cone [8, 20]° (at most 60°); air temperature 20 °C ±
     /// [15, 30] °C (within [−50, 60] °C, scored as the departure from 20 °C); slip gain
-    /// [0.03, 0.1] s; motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
+    /// [0.03, 0.1] s (braking alike); motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
     /// position ±[0.01, 0.03] m; latency [0.02, 0.08] s; each wheel's radius scale 1 ±
     /// [0.01, 0.03]; wheel-base scale 1 ± [0.03, 0.1].
     #[must_use]
@@ -193,7 +193,10 @@ impl Effect {
         use super::params::SelfTestRange as R;
         // The collimated beam's term over ±5 cm at 45° on a 1 cm grid; the self-test draws
         // its size as κ's (`draw_values` puts it all in one or the other).
-        const INCIDENCE: [ParamSpec; 2] = [
+        // The power of tan θ over [0.5, 4] on a √2 grid through 1 (the footprint's depth) and 2
+        // (an asymmetry that grows with it, `1/cos² θ − 1`): the form of the growth, which
+        // the self-test's catalogue reality does not vary.
+        const INCIDENCE: [ParamSpec; 3] = [
             lin(
                 "coefficient",
                 "",
@@ -202,6 +205,13 @@ impl Effect {
                 R::uniform(0.01, 0.03).signed(),
             ),
             lin("collimated_m", "m", (-0.05, 0.05), 11, R::zero()),
+            log(
+                "exponent",
+                "",
+                (0.5, 4.0),
+                7,
+                R::zero().around(1.0, 0.5, 4.0),
+            ),
         ];
         const REFLECTIVITY: [ParamSpec; 1] = [lin(
             "coefficient_m",
@@ -263,7 +273,21 @@ impl Effect {
         // needs a positive slip ratio: Wong, *Theory of Ground Vehicles*, ch. 1), so the
         // encoders lead. Encoders that lag the travel by `L v` are a late stamp, the
         // odometer's `sensor_latency`, which is otherwise a slip with g = −L.
-        const SLIP: [ParamSpec; 1] = [lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1))];
+        //
+        // The braking gain as a share of the driving one over [−1.5, 1.5] on a 0.5 grid
+        // through 1 (even: braking gives back what speeding up led), 0 (slip only while speeding
+        // up) and −1 (a lead gained at every change of speed): the form, which the self-test's
+        // catalogue reality keeps even.
+        const SLIP: [ParamSpec; 2] = [
+            lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1)),
+            lin(
+                "braking_share",
+                "",
+                (-1.5, 1.5),
+                7,
+                R::zero().around(1.0, -1.5, 1.5),
+            ),
+        ];
         const LAG: [ParamSpec; 1] = [log(
             "time_constant_s",
             "s",
@@ -364,14 +388,28 @@ impl Effect {
     /// term and its early position error named as a wheel radius or slip; a drift that does not settle within the run, which the term freed
     /// took up beside a concealed reflectivity, is not named (`select::earns_place`).
     ///
-    /// The incidence's two terms, a diverging beam's `κ d tan θ` and a collimated one's
-    /// `c tan θ`, are alternatives: searched each alone and not refined together (see
-    /// [`Effect::shapes_refined_together`]).
+    /// The incidence's two terms, a diverging beam's `κ d tanᵖ θ` and a collimated one's
+    /// `c tanᵖ θ`, are alternatives: searched each alone (each with the power p of its growth)
+    /// and not refined together (see [`Effect::shapes_refined_together`]).
     #[must_use]
     pub fn shapes(self) -> &'static [&'static [usize]] {
         match self {
             Effect::LidarWarmupDrift => &[&[0, 1], &[2, 1]],
-            Effect::LidarIncidenceAngle => &[&[0], &[1]],
+            Effect::LidarIncidenceAngle => &[&[0, 2], &[1, 2]],
+            _ => &[],
+        }
+    }
+
+    /// The parameters that set its form, not its size (indices into [`Effect::params`]): the
+    /// warm-up's time constant, the incidence's power of `tan θ` and the slip's braking share. A path estimated from the
+    /// lidar takes up part of an effect's size, not of its form, so the realignment follows the
+    /// size alone to its fixed point.
+    #[must_use]
+    pub const fn form_params(self) -> &'static [usize] {
+        match self {
+            Effect::LidarWarmupDrift => &[1],
+            Effect::LidarIncidenceAngle => &[2],
+            Effect::OdometerWheelSlip => &[1],
             _ => &[],
         }
     }
@@ -425,17 +463,19 @@ impl Effect {
     /// The parameter values at which the effect is absent (what the nominal model assumes),
     /// given the declared sonar cone for the beam width and the declared calibration
     /// temperature (20 °C) for the speed of sound. The warm-up drift is absent at k = 0 for
-    /// any τ.
+    /// any τ, the incidence at κ = c = 0 for any power of `tan θ` (held at 1, the catalogue's
+    /// first-order form).
     #[must_use]
     pub fn absent(self, declared_half_angle_deg: f64) -> Vec<f64> {
         match self {
             Effect::LidarWarmupDrift => vec![0.0, 10.0, 0.0],
-            Effect::LidarIncidenceAngle => vec![0.0, 0.0],
+            Effect::LidarIncidenceAngle => vec![0.0, 0.0, 1.0],
             Effect::SonarBeamWidth => vec![declared_half_angle_deg],
             Effect::SonarSpeedOfSound => vec![20.0],
             Effect::LidarMountOffset => vec![0.0; 3],
             Effect::OdometerWheelRadius => vec![1.0, 1.0],
             Effect::DriveWheelBase => vec![1.0],
+            Effect::OdometerWheelSlip => vec![0.0, 1.0],
             _ => vec![0.0],
         }
     }

@@ -47,6 +47,7 @@ impl Effect {
                 e.lidar_incidence_angle = Some(scenario::LidarIncidenceAngle {
                     coefficient: p(0),
                     collimated_m: p(1),
+                    exponent: params.get(2).copied().unwrap_or(1.0),
                 });
             }
             Effect::LidarReflectivity => {
@@ -82,7 +83,12 @@ impl Effect {
                 });
             }
             Effect::OdometerWheelSlip => {
-                e.odometer_wheel_slip = Some(scenario::OdometerWheelSlip { gain_s: p(0) });
+                // The braking gain as a share of the driving one; even (1) when not fitted.
+                let share = params.get(1).copied().unwrap_or(1.0);
+                e.odometer_wheel_slip = Some(scenario::OdometerWheelSlip {
+                    gain_s: p(0),
+                    braking_gain_s: (share != 1.0).then(|| share * p(0)),
+                });
             }
             Effect::DriveMotorLag => {
                 e.drive_motor_lag = (p(0) > 0.0).then_some(scenario::DriveMotorLag {

@@ -12,9 +12,10 @@ impl Effect {
             Effect::LidarIncidenceAngle => format!(
                 "The simulated lidar ranges every surface as if it met it head-on; the real one's \
                  range error grows with the angle of incidence ({:+.1} mm at 45° at 1 m, {:+.1} mm \
-                 at 4 m).",
+                 at 4 m{}).",
                 (p(0) + p(1)) * 1000.0,
-                (p(0) * 4.0 + p(1)) * 1000.0
+                (p(0) * 4.0 + p(1)) * 1000.0,
+                incidence_form(p(2))
             ),
             Effect::LidarReflectivity => format!(
                 "The simulated lidar ranges every material alike; the real one's range walks with \
@@ -54,11 +55,7 @@ impl Effect {
                  the real air was at {:.1} °C, which scales every range.",
                 p(0)
             ),
-            Effect::OdometerWheelSlip => format!(
-                "The simulated wheels grip perfectly; the real ones slip as they accelerate, so \
-                 the encoders lead the true travel by {:.0} ms × the wheel's speed.",
-                p(0) * 1000.0
-            ),
+            Effect::OdometerWheelSlip => slip_sentence(p(0), params.get(1).copied()),
             Effect::DriveMotorLag => format!(
                 "The simulated wheels reach a commanded speed at once; the real ones follow it \
                  with a first-order lag of {:.2} s.",
@@ -90,5 +87,47 @@ impl Effect {
                 100.0 / p(0)
             ),
         }
+    }
+}
+
+/// How the incidence's error grows past 45°, where its form departs from the catalogue's
+/// first-order `tan θ` (the footprint's depth) by more than its grid resolves; else nothing.
+fn incidence_form(exponent: f64) -> String {
+    // A tenth of the fit's √2 grid step in the power.
+    if !exponent.is_finite() || (exponent - 1.0).abs() < 0.04 {
+        return String::new();
+    }
+    let pace = if exponent > 1.0 { "faster" } else { "slower" };
+    format!(
+        "; it grows as tan^{exponent:.2} θ, {pace} than the footprint's depth: the shape differs \
+         from the catalogue's tan θ"
+    )
+}
+
+/// The slip's sentence: its driving gain, and how braking departs from giving back the lead
+/// when the braking share (the braking gain over the driving one) is not even.
+fn slip_sentence(gain_s: f64, braking_share: Option<f64>) -> String {
+    let ms = gain_s * 1000.0;
+    let even = "The simulated wheels grip perfectly; the real ones slip as they accelerate, so";
+    // Within a tenth of the fit's 0.5 grid step of even.
+    match braking_share {
+        Some(share) if share.is_finite() && (share - 1.0).abs() >= 0.05 => {
+            let braking = if share.abs() < 0.05 {
+                "braking gives none of it back".to_string()
+            } else if share < 0.0 {
+                format!(
+                    "braking adds {:.0} ms × the change of speed to the lead instead of giving it \
+                     back",
+                    -share * ms
+                )
+            } else {
+                format!("braking gives back {:.0} % of it", share * 100.0)
+            };
+            format!(
+                "{even} the encoders gain {ms:.0} ms × the change of speed on speeding up, and \
+                 {braking}: the shape differs from the catalogue's even slip."
+            )
+        }
+        _ => format!("{even} the encoders lead the true travel by {ms:.0} ms × the wheel's speed."),
     }
 }

@@ -4,6 +4,7 @@
 use hilsim_recording::{Mount, Recording};
 
 use crate::catalogue::{mounted, Effect, Sensor};
+use crate::locate::Floors;
 use crate::physics::{Gaussian, Hypothesis, LidarQuery, Mixture, Physics};
 use crate::trajectory::Trajectory;
 
@@ -176,6 +177,8 @@ pub(crate) struct Context<'a> {
     /// the robot's path it implies (`Trajectory::under_mount`); `None`: the path is the
     /// robot's under every hypothesis.
     pub placed_through: Option<Mount>,
+    /// The practical floors an effect's change of the readings is measured against.
+    pub floors: Floors,
 }
 
 impl Context<'_> {

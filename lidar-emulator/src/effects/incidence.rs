@@ -15,6 +15,14 @@
 //! error with obliquity (Soudarissanane, Lindenbergh, Menenti, Teunissen, "Scanning geometry: influencing
 //! factor on the quality of terrestrial laser scanning points", ISPRS J. Photogramm. Remote
 //! Sens. 66 (2011)).
+//!
+//! The fixed fraction is the first-order case. Where the asymmetry of the returned light across
+//! the footprint itself grows with the footprint's depth (a Gaussian spot whose near edge is
+//! both nearer and met less obliquely: the irradiance's gradient along the footprint is ∝ tan θ),
+//! the centroid's offset is the depth times an asymmetry ∝ tan θ, `∝ tan² θ = 1/cos² θ − 1`;
+//! a receiver that resolves the spot's skew only once the footprint outgrows a pixel stays
+//! near zero up to some angle and rises steeply past it. The model takes the power as a
+//! parameter: `Δd = (κ d + c) tanᵖ θ`, p = 1 the footprint's depth.
 
 use hilsim_sim::scenario::LidarIncidenceAngle;
 
@@ -31,22 +39,29 @@ pub fn tan_incidence(cos_incidence: f64) -> f64 {
     theta.tan()
 }
 
-/// The range error `(κ d + c) tan θ`, metres, of a beam at range `d_m` meeting a surface with
-/// `cos θ = cos_incidence`, for `effect`'s κ (`coefficient`) and c (`collimated_m`).
+/// The range error `(κ d + c) tanᵖ θ`, metres, of a beam at range `d_m` meeting a surface with
+/// `cos θ = cos_incidence`, for `effect`'s κ (`coefficient`), c (`collimated_m`) and p
+/// (`exponent`).
 ///
 /// ```
 /// use hilsim_lidar_emulator::effects::incidence_error_m;
 /// use hilsim_sim::scenario::LidarIncidenceAngle;
-/// let diverging = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0 };
+/// let diverging = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0, exponent: 1.0 };
 /// // 45°: tan θ = 1, so 1 % of 2 m.
 /// let e = incidence_error_m(&diverging, 2.0, std::f64::consts::FRAC_1_SQRT_2);
 /// assert!((e - 0.02).abs() < 1e-12);
 /// assert_eq!(incidence_error_m(&diverging, 2.0, 1.0), 0.0);
-/// let collimated = LidarIncidenceAngle { coefficient: 0.0, collimated_m: 0.005 };
+/// let collimated = LidarIncidenceAngle { coefficient: 0.0, collimated_m: 0.005, exponent: 1.0 };
 /// let e = incidence_error_m(&collimated, 4.0, std::f64::consts::FRAC_1_SQRT_2);
 /// assert!((e - 0.005).abs() < 1e-12);
+/// // tan² θ = 3 at 60°.
+/// let skewed = LidarIncidenceAngle { exponent: 2.0, ..collimated };
+/// let e = incidence_error_m(&skewed, 4.0, 0.5);
+/// assert!((e - 0.015).abs() < 1e-12);
 /// ```
 #[must_use]
 pub fn incidence_error_m(effect: &LidarIncidenceAngle, d_m: f64, cos_incidence: f64) -> f64 {
-    (effect.coefficient * d_m + effect.collimated_m) * tan_incidence(cos_incidence)
+    let tan = tan_incidence(cos_incidence);
+    // `powf` of an exponent of 1 is exact, so the first-order model is unchanged by it.
+    (effect.coefficient * d_m + effect.collimated_m) * tan.powf(effect.exponent)
 }

@@ -15,13 +15,13 @@ use super::warmup::warmup_error_m;
 /// let nominal = LidarEffects::default();
 /// assert!(nominal.is_nominal());
 /// use hilsim_sim::scenario::LidarIncidenceAngle;
-/// let incidence = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0 };
+/// let incidence = LidarIncidenceAngle { coefficient: 0.01, collimated_m: 0.0, exponent: 1.0 };
 /// let tilted = LidarEffects { incidence: Some(incidence), ..LidarEffects::default() };
 /// assert!(!tilted.is_nominal());
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LidarEffects {
-    /// `lidar_incidence_angle`: `(κ d + c) tan θ`.
+    /// `lidar_incidence_angle`: `(κ d + c) tanᵖ θ`.
     pub incidence: Option<LidarIncidenceAngle>,
     /// `lidar_reflectivity`: (c metres, ρ_ref) of `c (ρ_ref / ρ − 1)`.
     pub reflectivity: Option<(f64, f64)>,

@@ -23,4 +23,4 @@ pub use mounting::{real_mount, stamped_s};
 pub use reflectivity::range_walk_m;
 pub use speed_of_sound::{sonar_range_scale, speed_of_sound_mps};
 pub use warmup::warmup_error_m;
-pub use wheel_slip::slip_travel_m;
+pub use wheel_slip::{braking_change_mps, slip_travel_m};

@@ -76,6 +76,7 @@ fn incidence_angle_adds_kappa_d_tan_theta() {
     tilted.effects.lidar_incidence_angle = Some(hilsim_sim::scenario::LidarIncidenceAngle {
         coefficient: kappa,
         collimated_m: 0.0,
+        exponent: 1.0,
     });
     let (a, b) = (lidar(&nominal), lidar(&tilted));
     for angle in [0u16, 5, 10] {
@@ -280,8 +281,10 @@ fn accelerating_wheels_slip_and_the_encoders_lead_by_gain_times_speed() {
     nominal.duration_s = Some(3.5);
     let mut slipping = nominal.clone();
     let gain = 0.05;
-    slipping.effects.odometer_wheel_slip =
-        Some(hilsim_sim::scenario::OdometerWheelSlip { gain_s: gain });
+    slipping.effects.odometer_wheel_slip = Some(hilsim_sim::scenario::OdometerWheelSlip {
+        gain_s: gain,
+        braking_gain_s: None,
+    });
     let a = record(&nominal).odometry.unwrap();
     let b = record(&slipping).odometry.unwrap();
     for (ra, rb) in a.iter().zip(&b) {
@@ -299,5 +302,35 @@ fn accelerating_wheels_slip_and_the_encoders_lead_by_gain_times_speed() {
             "t = {}",
             ra.t_s
         );
+    }
+}
+
+/// A slip that differs between speeding up and braking: after two 0.4 m stages (each from rest
+/// to 0.2 m/s and back), the encoders lead by what the braking did not give back, `(g − g_b)
+/// 0.2 m/s` a stage: none for even gains, `g 0.2` a stage for slip only while speeding up, twice
+/// that for gains of opposite sign (a lead gained at every change of speed).
+#[test]
+fn a_slip_that_braking_does_not_give_back_accumulates_stage_by_stage() {
+    let odometer = "[sensors.odometer]\nnoise_m = 0.0\ntick_m = 1e-6\n";
+    let stage = "[[drive]]\nspeed_mps = 0.2\ndistance_m = 0.4\n[[drive]]\nstop_s = 1.0\n";
+    let mut nominal = scenario("", &format!("{odometer}{stage}{stage}"));
+    nominal.duration_s = Some(6.0);
+    let gain = 0.05;
+    let last = |s: &hilsim_sim::Scenario| *record(s).odometry.unwrap().last().unwrap();
+    let at_rest = last(&nominal);
+    for (braking, stages_lead) in [(gain, 0.0), (0.0, gain * 0.2), (-gain, 2.0 * gain * 0.2)] {
+        let mut slipping = nominal.clone();
+        slipping.effects.odometer_wheel_slip = Some(hilsim_sim::scenario::OdometerWheelSlip {
+            gain_s: gain,
+            braking_gain_s: Some(braking),
+        });
+        let end = last(&slipping);
+        // Two stages; tick 1 µm, a motor-less drive's speed steps exactly: tolerance 5 µm.
+        let lead = end.left_m - at_rest.left_m;
+        assert!(
+            (lead - 2.0 * stages_lead).abs() < 5e-6,
+            "braking gain {braking}: lead {lead}"
+        );
+        assert!((end.right_m - at_rest.right_m - lead).abs() < 1e-9);
     }
 }

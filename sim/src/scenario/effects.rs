@@ -89,9 +89,11 @@ impl Effects {
     }
 }
 
-/// `[effects.lidar_incidence_angle]`: range error `(coefficient · d + collimated_m) · tan θ`, θ
-/// the angle between the beam and the surface normal: the footprint of a diverging beam (its
-/// depth grows with the range) and of a collimated one (a fixed width).
+/// `[effects.lidar_incidence_angle]`: range error `(coefficient · d + collimated_m) · tanᵖ θ`,
+/// θ the angle between the beam and the surface normal, p the `exponent`: the footprint of a
+/// diverging beam (its depth grows with the range) and of a collimated one (a fixed width), its
+/// centroid's offset growing as the footprint's depth (p = 1) or faster (see
+/// `hilsim_lidar_emulator::effects::incidence_error_m`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LidarIncidenceAngle {
@@ -101,6 +103,17 @@ pub struct LidarIncidenceAngle {
     /// Metres: the range-independent error per unit of `tan θ` (at 45°); default 0.
     #[serde(default)]
     pub collimated_m: f64,
+    /// The power of `tan θ` the error grows with; default 1 (the footprint's depth).
+    #[serde(default = "LidarIncidenceAngle::footprint_exponent")]
+    pub exponent: f64,
+}
+
+impl LidarIncidenceAngle {
+    /// The error growing as the footprint's depth, `tan θ`: the exponent when none is given.
+    #[must_use]
+    pub const fn footprint_exponent() -> f64 {
+        1.0
+    }
 }
 
 /// `[effects.lidar_reflectivity]`: range walk `coefficient_m · (reference / ρ − 1)`, ρ the
@@ -176,12 +189,25 @@ fn default_calibrated_at() -> f64 {
 }
 
 /// `[effects.odometer_wheel_slip]`: each wheel's slip velocity is `gain_s` times its
-/// acceleration, so the encoders lead the true travel by `gain_s · v_wheel`.
+/// acceleration while it speeds up and `braking_gain_s` times it while it brakes, so the
+/// encoders lead the true travel by `gain_s · v_wheel` when the two are equal.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OdometerWheelSlip {
-    /// Seconds: slip velocity per unit of wheel acceleration.
+    /// Seconds: slip velocity per unit of wheel acceleration while the wheel speeds up.
     pub gain_s: f64,
+    /// Seconds: the same while the wheel brakes (its speed's magnitude falls); default
+    /// `gain_s`, the encoders giving back on braking what they led by on speeding up.
+    #[serde(default)]
+    pub braking_gain_s: Option<f64>,
+}
+
+impl OdometerWheelSlip {
+    /// The slip's gain while braking: `braking_gain_s`, or `gain_s` when not given.
+    #[must_use]
+    pub fn braking_gain(&self) -> f64 {
+        self.braking_gain_s.unwrap_or(self.gain_s)
+    }
 }
 
 /// `[effects.drive_motor_lag]`: each wheel's speed follows its command through a first-order

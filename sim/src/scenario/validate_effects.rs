@@ -49,6 +49,7 @@ pub(super) fn validate(s: &Scenario) -> Check {
         needs(p("coefficient"), lidar.is_some(), "lidar")?;
         within(p("coefficient"), x.coefficient, -0.2, 0.2, "a coefficient")?;
         within(p("collimated_m"), x.collimated_m, -0.1, 0.1, "metres")?;
+        within(p("exponent"), x.exponent, 0.25, 4.0, "an exponent")?;
     }
     if let Some(x) = e.lidar_reflectivity {
         let p = |k: &'static str| key_path!["effects", "lidar_reflectivity", k];
@@ -114,6 +115,9 @@ pub(super) fn validate(s: &Scenario) -> Check {
         let p = |k: &'static str| key_path!["effects", "odometer_wheel_slip", k];
         needs(p("gain_s"), s.sensors.odometer.is_some(), "odometer")?;
         within(p("gain_s"), x.gain_s, -1.0, 1.0, "seconds")?;
+        if let Some(braking) = x.braking_gain_s {
+            within(p("braking_gain_s"), braking, -1.0, 1.0, "seconds")?;
+        }
     }
     if let Some(x) = e.drive_motor_lag {
         let p = |k: &'static str| key_path!["effects", "drive_motor_lag", k];

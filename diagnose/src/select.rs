@@ -50,10 +50,11 @@ pub(crate) fn earns_place(c: &CandidateFit, declared_cone: f64, options: &Option
         && settles_within_run(c)
 }
 
-/// Whether `c` raises its sensor's held-out RMSE both in metres and in units of the readings'
-/// own noise. In metres alone a range sensor's RMSE is its far readings', whose noise grows as
-/// the square of the range: an effect that explains near readings (an incidence on a post) while
-/// the far walls' noise moves the RMSE by a hair would be refused.
+/// Whether `c` raises its sensor's held-out RMSE in metres beyond the RMSE's own sampling error,
+/// or within it while it raises the RMSE in units of the readings' noise too. In metres alone a
+/// range sensor's RMSE is its far readings', whose noise grows as the square of the range: an
+/// effect that explains near readings (an incidence on a post) while the far walls' noise moves
+/// the RMSE by a hair would be refused.
 fn fits_worse(c: &CandidateFit) -> bool {
     let rises =
         |before: f64, after: f64| after.partial_cmp(&before) == Some(std::cmp::Ordering::Greater);
@@ -61,7 +62,10 @@ fn fits_worse(c: &CandidateFit) -> bool {
         c.scaled_rmse.1.partial_cmp(&c.scaled_rmse.0),
         Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
     );
-    rises(c.rmse_before, c.rmse_after) && !scaled_falls
+    // An RMSE of n readings has a relative standard error of 1/√(2n).
+    let sampling = 1.0 / (2.0 * c.heldout_n.max(1) as f64).sqrt();
+    rises(c.rmse_before * (1.0 + sampling), c.rmse_after)
+        || (rises(c.rmse_before, c.rmse_after) && !scaled_falls)
 }
 
 /// Whether `c` changes its sensor's readings by more than the practical floor, over the readings

@@ -274,7 +274,7 @@ impl Effect {
         // encoders lead. Encoders that lag the travel by `L v` are a late stamp, the
         // odometer's `sensor_latency`, which is otherwise a slip with g = −L.
         //
-        // The braking gain as a share of the driving one over [−1.5, 1.5] on a 0.5 grid
+        // The braking gain as a share of the driving one over [−1, 1] on a 0.5 grid
         // through 1 (even: braking gives back what speeding up led), 0 (slip only while speeding
         // up) and −1 (a lead gained at every change of speed): the form, which the self-test's
         // catalogue reality keeps even.
@@ -283,9 +283,9 @@ impl Effect {
             lin(
                 "braking_share",
                 "",
-                (-1.5, 1.5),
-                7,
-                R::zero().around(1.0, -1.5, 1.5),
+                (-1.0, 1.0),
+                5,
+                R::zero().around(1.0, -1.0, 1.0),
             ),
         ];
         const LAG: [ParamSpec; 1] = [log(

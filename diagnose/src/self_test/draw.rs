@@ -326,7 +326,7 @@ fn draw_value(range: &SelfTestRange, d: &mut Draws, strength: f64, nominal: &Sce
         DrawSource::LidarRevolution => {
             return 60.0 / nominal.sensors.lidar.as_ref().map_or(300.0, |l| l.rpm);
         }
-        DrawSource::Zero => return 0.0,
+        DrawSource::Zero => return range.around.unwrap_or(0.0),
     };
     // The sign is drawn before the magnitude.
     let sign = if range.signed { d.sign() } else { 1.0 };

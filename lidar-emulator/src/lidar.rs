@@ -169,7 +169,7 @@ impl Lidar {
     }
 
     /// The lidar of a scenario with the scenario's `[effects]` that concern it (incidence angle,
-    /// reflectivity, mixed pixels, motion skew, warm-up drift), drawing from the run's `lidar`
+    /// reflectivity, mixed pixels, motion skew, warm-up drift, range bias), drawing from the run's `lidar`
     /// stream. The effects draw no random numbers: with all of them off the readings are those
     /// of [`Lidar::new`], bit for bit.
     ///
@@ -180,8 +180,9 @@ impl Lidar {
         effects: &scenario::Effects,
         seed: u64,
     ) -> Result<Self, ModelError> {
+        let lidar_effects = LidarEffects::from_scenario(effects);
         let model = RangeModel::builder()
-            .bias(&config.bias)
+            .bias(lidar_effects.bias(&config.bias))
             .noise(&config.noise)
             .build()?;
         let mut motor = rng::stream(seed, "lidar.motor");
@@ -202,7 +203,7 @@ impl Lidar {
             index: 0,
             rev_start_s: 0.0,
             rev_rpm: 0.0,
-            effects: LidarEffects::from_scenario(effects),
+            effects: lidar_effects,
             snapshot: config.timing == scenario::LidarTiming::PerRevolution
                 && effects.lidar_motion_skew.is_none(),
             rev_pose: None,

@@ -173,7 +173,7 @@ impl LidarPredictor {
     pub fn new(config: &scenario::Lidar, effects: LidarEffects) -> Result<Self, ModelError> {
         Ok(Self {
             model: RangeModel::builder()
-                .bias(&config.bias)
+                .bias(effects.bias(&config.bias))
                 .noise(&config.noise)
                 .build()?,
             mount: config.mount.into(),

@@ -44,6 +44,18 @@ pub enum Concealed {
     WheelRadius { left_scale: f64, right_scale: f64 },
     /// The wheels' effective contact points are `scale` times the nominal base apart.
     WheelBase { scale: f64 },
+    /// The lidar's own calibration is not the declared one, as a triangulation unit's geometry
+    /// makes it (`d = f b / x`: focal length f, baseline b, x the spot's image; Konolige et al.,
+    /// "A low-cost laser distance sensor", ICRA 2008): its range origin `origin_m` off the
+    /// head's axis, its baseline `baseline_ratio` times the one its firmware converts with, and
+    /// its laser turned by a small δ towards the camera (`pointing_per_m` = δ / b). The spot's
+    /// image then lies at `f (b' / d + δ)`, so where the declared unit reads d this one reads
+    /// `origin_m + d / (baseline_ratio + d δ / b)` (to first order in δ a range error `−d² δ / b`).
+    LidarTriangulation {
+        origin_m: f64,
+        baseline_ratio: f64,
+        pointing_per_m: f64,
+    },
     /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
     /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
     /// the sensor, which moves with 1/d; over a room's ranges it reads as a ripple in d).
@@ -68,6 +80,7 @@ impl Concealed {
             Self::SensorLatency { .. } => "sensor_latency",
             Self::WheelRadius { .. } => "odometer_wheel_radius",
             Self::WheelBase { .. } => "drive_wheel_base",
+            Self::LidarTriangulation { .. } => "lidar_range_bias",
             Self::LidarPeriodicRange { .. } => "lidar_periodic_range",
         }
     }

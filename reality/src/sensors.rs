@@ -211,7 +211,21 @@ impl Run<'_> {
                 _ => 0.0,
             };
         }
-        let reading = poly(&cfg.bias, measured) + poly(&cfg.noise, d) * e;
+        let mut reading = poly(&cfg.bias, measured) + poly(&cfg.noise, d) * e;
+        for c in self.concealed {
+            if let Concealed::LidarTriangulation {
+                origin_m,
+                baseline_ratio,
+                pointing_per_m,
+            } = *c
+            {
+                // What the unit's own geometry reads where the declared calibration reads
+                // `measured`; a denominator kept positive, as a spot stays on the sensor.
+                let own =
+                    origin_m + measured / (baseline_ratio + measured * pointing_per_m).max(0.1);
+                reading += own - measured;
+            }
+        }
         let intensity =
             INTENSITY_AT_1M * hit.reflectivity / 0.8 * hit.incidence_rad.cos() * d.powf(-0.7);
         Some((reading.max(0.0), Some(hit.range_m), intensity))

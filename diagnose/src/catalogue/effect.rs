@@ -37,12 +37,14 @@ pub enum Effect {
     OdometerWheelRadius,
     /// `drive_wheel_base`.
     DriveWheelBase,
+    /// `lidar_range_bias`.
+    LidarRangeBias,
 }
 
 impl Effect {
     /// The whole catalogue, in `interfaces.md` order (`sensor_latency` once per sensor it
     /// concerns).
-    pub const ALL: [Effect; 15] = [
+    pub const ALL: [Effect; 16] = [
         Effect::LidarIncidenceAngle,
         Effect::LidarReflectivity,
         Effect::LidarMixedPixels,
@@ -58,13 +60,14 @@ impl Effect {
         Effect::SensorLatency(Sensor::Odometer),
         Effect::OdometerWheelRadius,
         Effect::DriveWheelBase,
+        Effect::LidarRangeBias,
     ];
 
     /// The catalogue's entries (its names, each once), in `interfaces.md` order.
     ///
     /// ```
     /// use hilsim_diagnose::Effect;
-    /// assert_eq!(Effect::entries().len(), 13);
+    /// assert_eq!(Effect::entries().len(), 14);
     /// assert_eq!(Effect::entries()[10], "sensor_latency");
     /// ```
     #[must_use]
@@ -113,6 +116,7 @@ impl Effect {
             Effect::SensorLatency(_) => "sensor_latency",
             Effect::OdometerWheelRadius => "odometer_wheel_radius",
             Effect::DriveWheelBase => "drive_wheel_base",
+            Effect::LidarRangeBias => "lidar_range_bias",
         }
     }
 
@@ -145,7 +149,7 @@ impl Effect {
     #[must_use]
     pub fn sensor(self) -> Sensor {
         match self {
-            Effect::LidarMountOffset => Sensor::Lidar,
+            Effect::LidarMountOffset | Effect::LidarRangeBias => Sensor::Lidar,
             Effect::SensorLatency(s) => s,
             Effect::OdometerWheelRadius | Effect::DriveWheelBase => Sensor::Odometer,
             Effect::LidarIncidenceAngle
@@ -187,7 +191,8 @@ impl Effect {
     /// [15, 30] °C (within [−50, 60] °C, scored as the departure from 20 °C); slip gain
     /// [0.03, 0.1] s (braking alike); motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
     /// position ±[0.01, 0.03] m; latency [0.02, 0.08] s; each wheel's radius scale 1 ±
-    /// [0.01, 0.03]; wheel-base scale 1 ± [0.03, 0.1].
+    /// [0.01, 0.03]; wheel-base scale 1 ± [0.03, 0.1]; range bias ±[10, 60] mm at 2 m and scale
+    /// error ±[0.5, 3] % (its quadratic term not drawn).
     #[must_use]
     pub const fn params(self) -> &'static [ParamSpec] {
         use super::params::SelfTestRange as R;
@@ -348,8 +353,34 @@ impl Effect {
             13,
             R::uniform(0.03, 0.1).signed().around(1.0, 0.5, 1.5),
         )];
+        // The range bias as its error at 2 m (the middle of a room's ranges), its slope there
+        // and its curvature about it, `a + s (d − 2 m) + q (d − 2 m)²`: in the papers'
+        // `c + s d + q d²` the offset and the scale trade against each other over a room's
+        // ranges (the simplex, started on the grid, ran along their valley to the box's
+        // corner), while about the middle the three are nearly independent. The error at 2 m
+        // over ±0.2 m on a 5 cm grid, the scale error over ±10 % on a 5 % grid, the curvature
+        // over ±0.02 /m (a third of the XV-11's own 0.058 /m, the landmark paper's Sec. 4.1):
+        // the readings' means are linear in all three, so the likelihood is unimodal.
+        const RANGE_BIAS: [ParamSpec; 3] = [
+            lin(
+                "at_2m_m",
+                "m",
+                (-0.2, 0.2),
+                9,
+                R::uniform(0.01, 0.06).signed(),
+            ),
+            lin(
+                "scale_error",
+                "",
+                (-0.1, 0.1),
+                5,
+                R::uniform(0.005, 0.03).signed(),
+            ),
+            lin("quadratic_per_m", "1/m", (-0.02, 0.02), 3, R::zero()),
+        ];
         match self {
             Effect::LidarMountOffset => &MOUNT,
+            Effect::LidarRangeBias => &RANGE_BIAS,
             Effect::SensorLatency(Sensor::Lidar) => &LIDAR_LATENCY,
             Effect::SensorLatency(Sensor::Sonar) => &SONAR_LATENCY,
             Effect::SensorLatency(Sensor::Odometer) => &ODOMETER_LATENCY,
@@ -472,7 +503,7 @@ impl Effect {
             Effect::LidarIncidenceAngle => vec![0.0, 0.0, 1.0],
             Effect::SonarBeamWidth => vec![declared_half_angle_deg],
             Effect::SonarSpeedOfSound => vec![20.0],
-            Effect::LidarMountOffset => vec![0.0; 3],
+            Effect::LidarMountOffset | Effect::LidarRangeBias => vec![0.0; 3],
             Effect::OdometerWheelRadius => vec![1.0, 1.0],
             Effect::DriveWheelBase => vec![1.0],
             Effect::OdometerWheelSlip => vec![0.0, 1.0],
@@ -501,10 +532,11 @@ impl Effect {
     /// - wheel radius: a scale of 0.003: a rubber tyre's rolling radius changes by that much
     ///   under load (0.1 mm of deflection on a 35 mm wheel), and two simulators integrating a
     ///   wheel's arc differ by 0.1 % (an independent reality's faithful runs fit 0.999);
-    /// - wheel base: a scale of 0.0005, 1 mm of turn per 2 m of wheel travel.
+    /// - wheel base: a scale of 0.0005, 1 mm of turn per 2 m of wheel travel;
+    /// - range bias: 1 mm at 2 m, or 1 mm at 0 and 4 m of its scale error or curvature.
     ///
     /// An effect of several parameters that all describe its size (the mount, the two
-    /// wheels, the warm-up's and the incidence's two terms) departs when any of them does.
+    /// wheels, the warm-up's and the incidence's two terms, the range bias's three) departs when any of them does.
     #[must_use]
     pub fn departs(self, params: &[f64], declared_half_angle_deg: f64) -> bool {
         let Some(&value) = params.first() else {
@@ -524,6 +556,9 @@ impl Effect {
             Effect::OdometerWheelRadius => return beyond(0, 0.003) || beyond(1, 0.003),
             Effect::LidarWarmupDrift => return beyond(0, 0.000_25) || beyond(2, 0.001),
             Effect::LidarIncidenceAngle => return beyond(0, 0.001) || beyond(1, 0.001),
+            Effect::LidarRangeBias => {
+                return beyond(0, 0.001) || beyond(1, 0.000_5) || beyond(2, 0.000_25);
+            }
             _ => {}
         }
         let absent = absent[0];
@@ -541,7 +576,8 @@ impl Effect {
             Effect::LidarMountOffset
             | Effect::OdometerWheelRadius
             | Effect::LidarWarmupDrift
-            | Effect::LidarIncidenceAngle => 0.0,
+            | Effect::LidarIncidenceAngle
+            | Effect::LidarRangeBias => 0.0,
         };
         (value - absent).abs() >= least
     }
@@ -550,8 +586,9 @@ impl Effect {
 impl Effect {
     /// The quantity the self-test scores a fit of `params` by: the first parameter's departure
     /// from its [`SelfTestRange::scored`](super::SelfTestRange::scored) centre; for the
-    /// warm-up, its range error at 2 m at power-on, `c + k (2 m)²`, and for the incidence at 2 m
-    /// and 45°, `c + κ 2 m`, which either term alone may carry.
+    /// warm-up, its range error at 2 m at power-on, `c + k (2 m)²`, for the incidence at 2 m
+    /// and 45°, `c + κ 2 m`, which either term alone may carry, and for the range bias its
+    /// error at 2 m (its first parameter).
     #[must_use]
     pub fn scored(self, params: &[f64]) -> f64 {
         let p = |i: usize| params.get(i).copied().unwrap_or(0.0);

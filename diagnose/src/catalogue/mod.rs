@@ -14,5 +14,5 @@ mod sentences;
 
 pub use effect::Effect;
 pub use params::{DrawSource, ParamSpec, SelfTestRange};
-pub(crate) use scenario::{mounted, REFERENCE_REFLECTIVITY};
+pub(crate) use scenario::{mounted, range_bias, REFERENCE_REFLECTIVITY};
 pub use sensor::Sensor;

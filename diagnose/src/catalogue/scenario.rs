@@ -10,6 +10,10 @@ use super::{Effect, Sensor};
 /// The reference reflectivity of `[effects.lidar_reflectivity]` (the catalogue's coefficient is
 /// the range walk on a surface of half of it).
 pub(crate) const REFERENCE_REFLECTIVITY: f64 = 0.8;
+/// The range about which the catalogue's range bias is parametrised (its error there, slope and
+/// curvature), metres: the middle of a room's ranges.
+const RANGE_BIAS_ABOUT_M: f64 = 2.0;
+
 /// The temperature the sonar's speed of sound is calibrated at, °C.
 const CALIBRATED_AT_C: f64 = 20.0;
 
@@ -19,6 +23,18 @@ pub(crate) fn mounted(declared: &Mount, params: &[f64]) -> Mount {
     let mut e = Effects::default();
     Effect::LidarMountOffset.apply(params, &mut e);
     real_mount(*declared, e.lidar_mount_offset)
+}
+
+/// A `lidar_range_bias` of `params` (its error at 2 m, slope and curvature there; a missing one
+/// is 0) in the papers' form, `c + s d + q d²`: the scenario's `[effects.lidar_range_bias]`.
+pub(crate) fn range_bias(params: &[f64]) -> scenario::RangeBias {
+    let p = |i: usize| params.get(i).copied().unwrap_or(0.0);
+    let (a, s, q, r) = (p(0), p(1), p(2), RANGE_BIAS_ABOUT_M);
+    scenario::RangeBias {
+        offset_m: a - s * r + q * r * r,
+        scale_error: s - 2.0 * q * r,
+        quadratic_per_m: q,
+    }
 }
 
 impl Effect {
@@ -120,6 +136,9 @@ impl Effect {
                     left_scale: scale(0),
                     right_scale: scale(1),
                 });
+            }
+            Effect::LidarRangeBias => {
+                e.lidar_range_bias = Some(range_bias(params));
             }
             Effect::DriveWheelBase => {
                 e.drive_wheel_base = Some(scenario::DriveWheelBase {

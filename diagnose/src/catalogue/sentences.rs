@@ -1,6 +1,8 @@
 //! The sentence each effect's verdict is told in.
 
-use super::Effect;
+use hilsim_sim::scenario::RangeBias;
+
+use super::{range_bias, Effect};
 
 impl Effect {
     /// One sentence: the physics the simulation left out, with the fitted parameters (and the
@@ -86,8 +88,31 @@ impl Effect {
                 p(0) * 100.0,
                 100.0 / p(0)
             ),
+            Effect::LidarRangeBias => range_bias_sentence(&range_bias(params)),
         }
     }
+}
+
+/// The range bias's sentence: what the real lidar reads more than the scenario declares, as
+/// `c + s·d` (and `q·d²` where the quadratic term is a millimetre or more at 2 m), with its size
+/// at 1 m and 4 m.
+fn range_bias_sentence(bias: &RangeBias) -> String {
+    let [offset_m, scale_error, quadratic_per_m] = bias.coefficients();
+    let at = |d: f64| (offset_m + scale_error * d + quadratic_per_m * d * d) * 1000.0;
+    let quadratic = if (quadratic_per_m * 4.0).abs() >= 0.001 {
+        format!(" {:+.1} mm/m² · d²", quadratic_per_m * 1000.0)
+    } else {
+        String::new()
+    };
+    format!(
+        "The real lidar reads {:+.1} mm {:+.2} % · d{quadratic} more than the scenario's range \
+         bias declares ({:+.1} mm at 1 m, {:+.1} mm at 4 m): its calibration differs from the \
+         declared one.",
+        offset_m * 1000.0,
+        scale_error * 100.0,
+        at(1.0),
+        at(4.0)
+    )
 }
 
 /// How the incidence's error grows past 45°, where its form departs from the catalogue's

@@ -7,7 +7,7 @@ use rand_xoshiro::SplitMix64;
 
 use hilsim_reality::{Concealed, Nuisances, Stream};
 
-use crate::catalogue::{DrawSource, SelfTestRange, Sensor, REFERENCE_REFLECTIVITY};
+use crate::catalogue::{range_bias, DrawSource, SelfTestRange, Sensor, REFERENCE_REFLECTIVITY};
 use crate::Effect;
 
 /// The trial's draws, from (S, i) alone: SplitMix64 started from a mix of the two.
@@ -143,6 +143,17 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
             right_scale: p(1),
         },
         Effect::DriveWheelBase => Concealed::WheelBase { scale: p(0) },
+        // The triangulation geometry whose reading's first orders in d are `c + s d + q d²`:
+        // `d / r` is `(1 + s) d` for `r = 1 / (1 + s)`, and `d / (r + d p)` adds `−p d² / r²`.
+        Effect::LidarRangeBias => {
+            let [c, s, q] = range_bias(values).coefficients();
+            let ratio = 1.0 / (1.0 + s).max(0.1);
+            Concealed::LidarTriangulation {
+                origin_m: c,
+                baseline_ratio: ratio,
+                pointing_per_m: -q * ratio * ratio,
+            }
+        }
     }
 }
 
@@ -175,9 +186,9 @@ pub(crate) struct Classes {
 }
 
 /// Trial `i`'s classes in the independent reality: with probability 1/5 two different
-/// catalogued entries, else one of fifteen classes (none, the thirteen entries, a periodic
-/// range error outside the catalogue), or the `only` one (0 none, 1..=13 the catalogue's
-/// entries, 14 outside).
+/// catalogued entries, else one of sixteen classes (none, the fourteen entries, a periodic
+/// range error outside the catalogue), or the `only` one (0 none, 1..=14 the catalogue's
+/// entries, 15 outside).
 pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize>) -> Classes {
     let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
@@ -253,7 +264,7 @@ pub(crate) fn draw_independent(
 }
 
 /// Draws trial `i`'s effect: none, or one of the catalogue's entries (each with probability
-/// 1/14, or the `only` one: 0 none, 1..=13 the entries in order; `sensor_latency` on a sensor
+/// 1/15, or the `only` one: 0 none, 1..=14 the entries in order; `sensor_latency` on a sensor
 /// drawn among the scenario's), and its parameters from their [`SelfTestRange`]s (the
 /// documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {

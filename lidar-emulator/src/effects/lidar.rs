@@ -1,10 +1,11 @@
 //! The lidar's effects together: which are on, and what one beam ranges with them.
 
-use hilsim_sim::scenario::{Effects, LidarIncidenceAngle, LidarWarmupDrift};
+use hilsim_sim::scenario::{Effects, LidarIncidenceAngle, LidarWarmupDrift, RangeBias};
 use hilsim_sim::{RayHit, World};
 
 use super::incidence::incidence_error_m;
 use super::mixed_pixels::footprint_range_m;
+use super::range_bias::real_bias;
 use super::reflectivity::range_walk_m;
 use super::warmup::warmup_error_m;
 
@@ -29,6 +30,8 @@ pub struct LidarEffects {
     pub mixed_half_width_rad: Option<f64>,
     /// `lidar_warmup_drift`: `(c + k d²) e^{−t/τ}`.
     pub warmup: Option<LidarWarmupDrift>,
+    /// `lidar_range_bias`: `c + s d + q d²` added to the declared bias polynomial.
+    pub range_bias: Option<RangeBias>,
 }
 
 /// What one beam returns before the range model: the centre ray's hit and the range the
@@ -56,6 +59,7 @@ impl LidarEffects {
                 .lidar_mixed_pixels
                 .map(|e| e.half_width_deg.to_radians()),
             warmup: effects.lidar_warmup_drift,
+            range_bias: effects.lidar_range_bias,
         }
     }
 
@@ -63,6 +67,13 @@ impl LidarEffects {
     #[must_use]
     pub fn is_nominal(&self) -> bool {
         *self == Self::default()
+    }
+
+    /// The unit's bias polynomial (eq. 2's alpha) given the `declared` one: with
+    /// `lidar_range_bias`'s difference added when it is on.
+    #[must_use]
+    pub fn bias(&self, declared: &[f64]) -> Vec<f64> {
+        real_bias(declared, self.range_bias.as_ref())
     }
 
     /// The beam along `heading` from `origin`: `None` when its centre ray hits nothing within

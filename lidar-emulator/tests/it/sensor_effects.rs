@@ -115,6 +115,45 @@ fn reflectivity_walks_the_range_by_material() {
     assert_eq!(at(&a, 90).range_m, at(&b, 90).range_m);
 }
 
+/// The real unit reads `c + s d + q d²` more than its declared bias polynomial says, at every
+/// range, whatever that polynomial is (here the landmark paper's XV-11 model, Sec. 4.1).
+#[test]
+fn range_bias_adds_its_polynomial_to_the_declared_one() {
+    let declared =
+        "[sensors.lidar]\nbias = [0.0525, 0.8838, 0.0584]\nnoise = [0.0]\nangle_noise_deg = 0.0\n";
+    let nominal = scenario(
+        "cylinders = [{ center = [1.0, -1.0], radius = 0.2 }]",
+        declared,
+    );
+    let mut biased = nominal.clone();
+    let (c, s, q) = (0.03, -0.02, 0.004);
+    biased.effects.lidar_range_bias = Some(hilsim_sim::scenario::RangeBias {
+        offset_m: c,
+        scale_error: s,
+        quadratic_per_m: q,
+    });
+    let (a, b) = (lidar(&nominal), lidar(&biased));
+    assert_eq!(a.len(), b.len());
+    let mut ranges = Vec::new();
+    for angle in [0u16, 45, 90, 180, 315] {
+        let (ra, rb) = (at(&a, angle), at(&b, angle));
+        let d = ra.true_range_m.unwrap();
+        ranges.push(d);
+        let expected = c + s * d + q * d * d;
+        // Two readings each rounded to the millimetre.
+        assert!(
+            (rb.range_m - ra.range_m - expected).abs() < 2.0 * MM_TOL,
+            "{angle}° at {d:.3} m: {} vs {expected}",
+            rb.range_m - ra.range_m
+        );
+    }
+    // The ranges span the cylinder (~1.2 m) to the room's corner (~4.2 m).
+    let (lo, hi) = ranges
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(l, h), &d| (l.min(d), h.max(d)));
+    assert!(lo < 1.5 && hi > 4.0, "{ranges:?}");
+}
+
 #[test]
 fn warmup_drift_settles_exponentially() {
     let nominal = scenario("", NOISELESS_LIDAR);

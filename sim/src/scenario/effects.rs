@@ -52,6 +52,9 @@ pub struct Effects {
     /// The effective wheel base differs from nominal.
     #[serde(default)]
     pub drive_wheel_base: Option<DriveWheelBase>,
+    /// The real lidar's range bias differs from its declared one (`[sensors.lidar] bias`).
+    #[serde(default)]
+    pub lidar_range_bias: Option<RangeBias>,
 }
 
 impl Effects {
@@ -78,6 +81,7 @@ impl Effects {
                 self.odometer_wheel_radius.is_some(),
             ),
             ("drive_wheel_base", self.drive_wheel_base.is_some()),
+            ("lidar_range_bias", self.lidar_range_bias.is_some()),
         ];
         on.iter().filter(|(_, o)| *o).map(|(n, _)| *n).collect()
     }
@@ -279,4 +283,30 @@ fn one() -> f64 {
 pub struct DriveWheelBase {
     /// The effective wheel base over nominal.
     pub scale: f64,
+}
+
+/// `[effects.lidar_range_bias]`: the real unit reads `offset_m + scale_error · d +
+/// quadratic_per_m · d²` more than its declared bias polynomial (eq. 2 of the papers,
+/// `Σ alpha_i d^i`) says, d the true distance: the difference between the unit's own
+/// calibration and the one the scenario declares, in the papers' polynomial form.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeBias {
+    /// Metres added to every reading (c).
+    #[serde(default)]
+    pub offset_m: f64,
+    /// Added to the bias's linear coefficient (s): the reading is `s · d` longer.
+    #[serde(default)]
+    pub scale_error: f64,
+    /// Per metre, added to the bias's quadratic coefficient.
+    #[serde(default)]
+    pub quadratic_per_m: f64,
+}
+
+impl RangeBias {
+    /// The difference's coefficients, lowest order first, to add to the declared `alpha`.
+    #[must_use]
+    pub fn coefficients(&self) -> [f64; 3] {
+        [self.offset_m, self.scale_error, self.quadratic_per_m]
+    }
 }

@@ -159,5 +159,18 @@ pub(super) fn validate(s: &Scenario) -> Check {
         let p = |k: &'static str| key_path!["effects", "drive_wheel_base", k];
         within(p("scale"), x.scale, 0.5, 1.5, "a scale")?;
     }
+    if let Some(x) = e.lidar_range_bias {
+        let p = |k: &'static str| key_path!["effects", "lidar_range_bias", k];
+        needs(p("offset_m"), lidar.is_some(), "lidar")?;
+        within(p("offset_m"), x.offset_m, -0.5, 0.5, "metres")?;
+        within(p("scale_error"), x.scale_error, -0.5, 0.5, "a scale error")?;
+        within(
+            p("quadratic_per_m"),
+            x.quadratic_per_m,
+            -0.1,
+            0.1,
+            "a coefficient per metre",
+        )?;
+    }
     Ok(())
 }

@@ -4,7 +4,7 @@
 use hilsim_recording::SonarSample;
 use hilsim_sim::{rng, scenario, StepState, World};
 
-use crate::effects::sonar_range_scale;
+use crate::effects::{real_bias, sonar_range_scale};
 use crate::range_model::{ModelError, RangeModel};
 use hilsim_recording::Mount;
 
@@ -38,8 +38,9 @@ impl Sonar {
     }
 
     /// The sonar of a scenario with the scenario's `[effects]` that concern it: the beam width
-    /// (`sonar_beam_width` replaces the declared cone) and the speed of sound (every range
-    /// scaled by `c(calibrated_at_c) / c(air_temperature_c)`, see `effects`).
+    /// (`sonar_beam_width` replaces the declared cone), the speed of sound (every range
+    /// scaled by `c(calibrated_at_c) / c(air_temperature_c)`, see `effects`) and the range bias
+    /// (`sonar_range_bias`'s polynomial added to the declared one).
     ///
     /// # Errors
     /// A range model that makes no sense.
@@ -49,7 +50,7 @@ impl Sonar {
         seed: u64,
     ) -> Result<Self, ModelError> {
         let model = RangeModel::builder()
-            .bias(&config.bias)
+            .bias(real_bias(&config.bias, effects.sonar_range_bias.as_ref()))
             .noise(&config.noise)
             .build()?;
         let half_angle_deg = effects

@@ -56,6 +56,10 @@ pub enum Concealed {
         baseline_ratio: f64,
         pointing_per_m: f64,
     },
+    /// The sonar detects each echo `delay_s` later than its calibration assumes (its threshold
+    /// crossed later in the echo's rise, or a transducer's ring-down), and converts that time
+    /// too with the speed of sound at `calibrated_at_c`: `c(T) · delay / 2` more range.
+    SonarEchoDelay { delay_s: f64, calibrated_at_c: f64 },
     /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
     /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
     /// the sensor, which moves with 1/d; over a room's ranges it reads as a ripple in d).
@@ -81,6 +85,7 @@ impl Concealed {
             Self::WheelRadius { .. } => "odometer_wheel_radius",
             Self::WheelBase { .. } => "drive_wheel_base",
             Self::LidarTriangulation { .. } => "lidar_range_bias",
+            Self::SonarEchoDelay { .. } => "sonar_range_bias",
             Self::LidarPeriodicRange { .. } => "lidar_periodic_range",
         }
     }

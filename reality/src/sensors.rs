@@ -255,6 +255,19 @@ impl Run<'_> {
                 _ => None,
             })
             .unwrap_or(1.0);
+        // The range a late echo detection adds, the round trip's delay at the calibration's
+        // speed of sound.
+        let echo_delay_m: f64 = self
+            .concealed
+            .iter()
+            .map(|c| match *c {
+                Concealed::SonarEchoDelay {
+                    delay_s,
+                    calibrated_at_c,
+                } => speed_of_sound(calibrated_at_c) * delay_s / 2.0,
+                _ => 0.0,
+            })
+            .sum();
         let rate = cfg.rate_hz * n.rate_factor;
         let late_s = delay_s(self.concealed, Stamped::Sonar);
         let mut out = Vec::new();
@@ -291,7 +304,8 @@ impl Run<'_> {
             }
             // The echo time is converted with the calibration temperature's speed of sound;
             // the true echo travels at the air's: the range reads c_cal / c_air too short or long.
-            let reading = (poly(&cfg.bias, nearest) + poly(&cfg.noise, nearest) * e) / scale;
+            let reading =
+                (poly(&cfg.bias, nearest) + poly(&cfg.noise, nearest) * e) / scale + echo_delay_m;
             out.push(SonarSample {
                 t_s: (t + late_s + jitter).max(0.0),
                 range_m: quantise(reading, n.sonar_resolution_m),

@@ -39,12 +39,14 @@ pub enum Effect {
     DriveWheelBase,
     /// `lidar_range_bias`.
     LidarRangeBias,
+    /// `sonar_range_bias`.
+    SonarRangeBias,
 }
 
 impl Effect {
     /// The whole catalogue, in `interfaces.md` order (`sensor_latency` once per sensor it
     /// concerns).
-    pub const ALL: [Effect; 16] = [
+    pub const ALL: [Effect; 17] = [
         Effect::LidarIncidenceAngle,
         Effect::LidarReflectivity,
         Effect::LidarMixedPixels,
@@ -61,13 +63,14 @@ impl Effect {
         Effect::OdometerWheelRadius,
         Effect::DriveWheelBase,
         Effect::LidarRangeBias,
+        Effect::SonarRangeBias,
     ];
 
     /// The catalogue's entries (its names, each once), in `interfaces.md` order.
     ///
     /// ```
     /// use hilsim_diagnose::Effect;
-    /// assert_eq!(Effect::entries().len(), 14);
+    /// assert_eq!(Effect::entries().len(), 15);
     /// assert_eq!(Effect::entries()[10], "sensor_latency");
     /// ```
     #[must_use]
@@ -117,6 +120,7 @@ impl Effect {
             Effect::OdometerWheelRadius => "odometer_wheel_radius",
             Effect::DriveWheelBase => "drive_wheel_base",
             Effect::LidarRangeBias => "lidar_range_bias",
+            Effect::SonarRangeBias => "sonar_range_bias",
         }
     }
 
@@ -157,7 +161,9 @@ impl Effect {
             | Effect::LidarMixedPixels
             | Effect::LidarMotionSkew
             | Effect::LidarWarmupDrift => Sensor::Lidar,
-            Effect::SonarBeamWidth | Effect::SonarSpeedOfSound => Sensor::Sonar,
+            Effect::SonarBeamWidth | Effect::SonarSpeedOfSound | Effect::SonarRangeBias => {
+                Sensor::Sonar
+            }
             Effect::OdometerWheelSlip => Sensor::Odometer,
             Effect::DriveMotorLag => Sensor::Drive,
         }
@@ -192,7 +198,7 @@ impl Effect {
     /// [0.03, 0.1] s (braking alike); motor lag τ [0.1, 0.4] s (at most 10 s); mount yaw ±[1, 3]° and
     /// position ±[0.01, 0.03] m; latency [0.02, 0.08] s; each wheel's radius scale 1 ±
     /// [0.01, 0.03]; wheel-base scale 1 ± [0.03, 0.1]; range bias ±[10, 60] mm at 2 m and scale
-    /// error ±[0.5, 3] % (its quadratic term not drawn).
+    /// error ±[0.5, 3] % (its quadratic term not drawn); the sonar's range offset ±[10, 60] mm.
     #[must_use]
     pub const fn params(self) -> &'static [ParamSpec] {
         use super::params::SelfTestRange as R;
@@ -378,8 +384,20 @@ impl Effect {
             ),
             lin("quadratic_per_m", "1/m", (-0.02, 0.02), 3, R::zero()),
         ];
+        // The sonar's range offset alone, over ±0.2 m on a 5 cm grid: its scale is the speed
+        // of sound's (`sonar_speed_of_sound` scales every range, and an affine sonar's scale
+        // error is that one's parameter), so the two entries together are the EM paper's
+        // affine sonar and neither can pass for the other.
+        const SONAR_RANGE_BIAS: [ParamSpec; 1] = [lin(
+            "offset_m",
+            "m",
+            (-0.2, 0.2),
+            9,
+            R::uniform(0.01, 0.06).signed(),
+        )];
         match self {
             Effect::LidarMountOffset => &MOUNT,
+            Effect::SonarRangeBias => &SONAR_RANGE_BIAS,
             Effect::LidarRangeBias => &RANGE_BIAS,
             Effect::SensorLatency(Sensor::Lidar) => &LIDAR_LATENCY,
             Effect::SensorLatency(Sensor::Sonar) => &SONAR_LATENCY,
@@ -533,7 +551,8 @@ impl Effect {
     ///   under load (0.1 mm of deflection on a 35 mm wheel), and two simulators integrating a
     ///   wheel's arc differ by 0.1 % (an independent reality's faithful runs fit 0.999);
     /// - wheel base: a scale of 0.0005, 1 mm of turn per 2 m of wheel travel;
-    /// - range bias: 1 mm at 2 m, or 1 mm at 0 and 4 m of its scale error or curvature.
+    /// - range bias: 1 mm at 2 m, or 1 mm at 0 and 4 m of its scale error or curvature; the
+    ///   sonar's offset 1 mm.
     ///
     /// An effect of several parameters that all describe its size (the mount, the two
     /// wheels, the warm-up's and the incidence's two terms, the range bias's three) departs when any of them does.
@@ -572,6 +591,7 @@ impl Effect {
             Effect::DriveMotorLag => 0.02,
             Effect::SensorLatency(_) => 0.005,
             Effect::DriveWheelBase => 0.000_5,
+            Effect::SonarRangeBias => 0.001,
             // Returned above.
             Effect::LidarMountOffset
             | Effect::OdometerWheelRadius

@@ -140,6 +140,12 @@ impl Effect {
             Effect::LidarRangeBias => {
                 e.lidar_range_bias = Some(range_bias(params));
             }
+            Effect::SonarRangeBias => {
+                e.sonar_range_bias = Some(scenario::RangeBias {
+                    offset_m: p(0),
+                    ..scenario::RangeBias::default()
+                });
+            }
             Effect::DriveWheelBase => {
                 e.drive_wheel_base = Some(scenario::DriveWheelBase {
                     scale: params.first().copied().unwrap_or(1.0),

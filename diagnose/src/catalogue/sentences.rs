@@ -89,6 +89,11 @@ impl Effect {
                 100.0 / p(0)
             ),
             Effect::LidarRangeBias => range_bias_sentence(&range_bias(params)),
+            Effect::SonarRangeBias => format!(
+                "The real sonar reads {:+.1} mm more than the scenario's range bias declares, at \
+                 every range: its echo is detected that much later than its calibration says.",
+                p(0) * 1000.0
+            ),
         }
     }
 }

@@ -1,5 +1,6 @@
 //! What a trial conceals: an effect (or none) and its parameters, drawn from (S, i) alone.
 
+use hilsim_lidar_emulator::effects::speed_of_sound_mps;
 use hilsim_sim::scenario::Effects;
 use hilsim_sim::Scenario;
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
@@ -145,6 +146,11 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
         Effect::DriveWheelBase => Concealed::WheelBase { scale: p(0) },
         // The triangulation geometry whose reading's first orders in d are `c + s d + q d²`:
         // `d / r` is `(1 + s) d` for `r = 1 / (1 + s)`, and `d / (r + d p)` adds `−p d² / r²`.
+        // The echo detected late by the round trip of the offset at 20 °C's speed of sound.
+        Effect::SonarRangeBias => Concealed::SonarEchoDelay {
+            delay_s: 2.0 * p(0) / speed_of_sound_mps(20.0),
+            calibrated_at_c: 20.0,
+        },
         Effect::LidarRangeBias => {
             let [c, s, q] = range_bias(values).coefficients();
             let ratio = 1.0 / (1.0 + s).max(0.1);
@@ -186,9 +192,9 @@ pub(crate) struct Classes {
 }
 
 /// Trial `i`'s classes in the independent reality: with probability 1/5 two different
-/// catalogued entries, else one of sixteen classes (none, the fourteen entries, a periodic
-/// range error outside the catalogue), or the `only` one (0 none, 1..=14 the catalogue's
-/// entries, 15 outside).
+/// catalogued entries, else one of seventeen classes (none, the fifteen entries, a periodic
+/// range error outside the catalogue), or the `only` one (0 none, 1..=15 the catalogue's
+/// entries, 16 outside).
 pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize>) -> Classes {
     let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
@@ -264,7 +270,7 @@ pub(crate) fn draw_independent(
 }
 
 /// Draws trial `i`'s effect: none, or one of the catalogue's entries (each with probability
-/// 1/15, or the `only` one: 0 none, 1..=14 the entries in order; `sensor_latency` on a sensor
+/// 1/16, or the `only` one: 0 none, 1..=15 the entries in order; `sensor_latency` on a sensor
 /// drawn among the scenario's), and its parameters from their [`SelfTestRange`]s (the
 /// documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {

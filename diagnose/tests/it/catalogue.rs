@@ -265,6 +265,25 @@ fn an_undeclared_range_bias_is_named_not_the_incidence() {
     assert_eq!(names, [Effect::LidarRangeBias], "{names:?}");
 }
 
+/// A sonar reading a constant more than its declared (affine) bias is named `sonar_range_bias`,
+/// and a scale of every range still the speed of sound: the offset and the scale of the EM
+/// paper's affine sonar are the two entries' parameters, neither able to pass for the other.
+#[test]
+fn a_sonar_offset_and_a_sonar_scale_are_each_named_as_theirs() {
+    let d = diagnosed(Effect::SonarRangeBias, &[0.04], 16, &of(Sensor::Sonar));
+    let p = named(&d, Effect::SonarRangeBias);
+    // ~170 pings of 8 mm noise: the offset's standard error is under 1 mm; within 4 mm.
+    assert!((p[0] - 0.04).abs() < 0.004, "{p:?}");
+    let names: Vec<Effect> = d.effects.iter().map(|e| e.fit.effect).collect();
+    assert_eq!(names, [Effect::SonarRangeBias], "{names:?}");
+    let d = diagnosed(Effect::SonarSpeedOfSound, &[0.0], 16, &of(Sensor::Sonar));
+    let p = named(&d, Effect::SonarSpeedOfSound);
+    // 20 °C colder: 3.6 % on ranges up to 4 m; within 3 °C.
+    assert!(p[0].abs() < 3.0, "{p:?}");
+    let names: Vec<Effect> = d.effects.iter().map(|e| e.fit.effect).collect();
+    assert_eq!(names, [Effect::SonarSpeedOfSound], "{names:?}");
+}
+
 /// The mount and the wheels' effects it competes with in the encoders.
 const MOUNT_AND_WHEELS: [Effect; 4] = [
     Effect::LidarMountOffset,

@@ -1,4 +1,5 @@
-//! `lidar_range_bias`: the real unit's range bias differs from the one the scenario declares.
+//! `lidar_range_bias` and `sonar_range_bias`: the real unit's range bias differs from the one
+//! the scenario declares.
 //!
 //! Both papers model a range finder's reading as `Σ alpha_i d^i + noise` (eq. 2), the bias
 //! polynomial being the unit's calibration: a unit's own differs from a datasheet's or
@@ -7,6 +8,8 @@
 //! adds a constant, a baseline or focal length off by a fraction scales every range (`d b'/b`),
 //! and a small laser-angle error δ adds `≈ d² δ / b`. The difference is therefore modelled as
 //! the polynomial `c + s d + q d²` added to the declared one; the noise is the declared one's.
+//! A sonar's is the same polynomial (the EM paper's sonar is affine, `c + s d`): its offset a
+//! threshold detection that fires later or earlier in the echo than calibrated.
 
 use hilsim_sim::scenario::RangeBias;
 

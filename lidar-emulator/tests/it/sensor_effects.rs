@@ -311,6 +311,34 @@ fn cold_air_makes_the_sonar_read_long() {
     assert!((a[0].range_m - 3.0).abs() < MM_TOL);
 }
 
+/// The sonar's range bias adds its polynomial to the declared one (the EM paper's affine sonar):
+/// an offset of 40 mm and a scale error of −2 % at the wall 3 m ahead.
+#[test]
+fn sonar_range_bias_adds_its_polynomial_to_the_declared_one() {
+    let sonar = "[sensors.sonar]\nbias = [0.021, 1.028]\nnoise = [0.0]\n";
+    let nominal = scenario("", sonar);
+    let mut biased = nominal.clone();
+    biased.effects.sonar_range_bias = Some(hilsim_sim::scenario::RangeBias {
+        offset_m: 0.04,
+        scale_error: -0.02,
+        quadratic_per_m: 0.0,
+    });
+    let a = record(&nominal).sonar.unwrap();
+    let b = record(&biased).sonar.unwrap();
+    assert!(
+        (a[0].range_m - (0.021 + 1.028 * 3.0)).abs() < MM_TOL,
+        "{}",
+        a[0].range_m
+    );
+    // 0.04 − 0.02 · 3 m = −20 mm, between two readings rounded each to the millimetre.
+    assert!(
+        (b[0].range_m - a[0].range_m + 0.02).abs() < 2.0 * MM_TOL,
+        "{} vs {}",
+        b[0].range_m,
+        a[0].range_m
+    );
+}
+
 #[test]
 fn accelerating_wheels_slip_and_the_encoders_lead_by_gain_times_speed() {
     let odometer = "[sensors.odometer]\nnoise_m = 0.0\ntick_m = 1e-6\n";

@@ -55,6 +55,9 @@ pub struct Effects {
     /// The real lidar's range bias differs from its declared one (`[sensors.lidar] bias`).
     #[serde(default)]
     pub lidar_range_bias: Option<RangeBias>,
+    /// The real sonar's range bias differs from its declared one (`[sensors.sonar] bias`).
+    #[serde(default)]
+    pub sonar_range_bias: Option<RangeBias>,
 }
 
 impl Effects {
@@ -82,6 +85,7 @@ impl Effects {
             ),
             ("drive_wheel_base", self.drive_wheel_base.is_some()),
             ("lidar_range_bias", self.lidar_range_bias.is_some()),
+            ("sonar_range_bias", self.sonar_range_bias.is_some()),
         ];
         on.iter().filter(|(_, o)| *o).map(|(n, _)| *n).collect()
     }
@@ -285,7 +289,7 @@ pub struct DriveWheelBase {
     pub scale: f64,
 }
 
-/// `[effects.lidar_range_bias]`: the real unit reads `offset_m + scale_error · d +
+/// `[effects.lidar_range_bias]` and `[effects.sonar_range_bias]`: the real unit reads `offset_m + scale_error · d +
 /// quadratic_per_m · d²` more than its declared bias polynomial (eq. 2 of the papers,
 /// `Σ alpha_i d^i`) says, d the true distance: the difference between the unit's own
 /// calibration and the one the scenario declares, in the papers' polynomial form.

@@ -159,9 +159,18 @@ pub(super) fn validate(s: &Scenario) -> Check {
         let p = |k: &'static str| key_path!["effects", "drive_wheel_base", k];
         within(p("scale"), x.scale, 0.5, 1.5, "a scale")?;
     }
-    if let Some(x) = e.lidar_range_bias {
-        let p = |k: &'static str| key_path!["effects", "lidar_range_bias", k];
-        needs(p("offset_m"), lidar.is_some(), "lidar")?;
+    for (table, bias, present, sensor) in [
+        (
+            "lidar_range_bias",
+            e.lidar_range_bias,
+            lidar.is_some(),
+            "lidar",
+        ),
+        ("sonar_range_bias", e.sonar_range_bias, has_sonar, "sonar"),
+    ] {
+        let Some(x) = bias else { continue };
+        let p = |k: &'static str| key_path!["effects", table, k];
+        needs(p("offset_m"), present, sensor)?;
         within(p("offset_m"), x.offset_m, -0.5, 0.5, "metres")?;
         within(p("scale_error"), x.scale_error, -0.5, 0.5, "a scale error")?;
         within(

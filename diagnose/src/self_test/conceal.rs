@@ -443,6 +443,7 @@ mod tests {
                 strength: 0,
                 invalid: false,
                 warning: false,
+                true_range_m: None,
             }]),
             ..Recording::default()
         };

@@ -20,7 +20,7 @@ fn answer_json(a: &Answer) -> Value {
         "verdict": verdict_label(&a.verdict),
         "refusal": a.verdict.as_ref().err(),
         "named": a.named.iter().map(|n| json!({
-            "effect": n.effect.name(),
+            "effect": n.effect.label(),
             "params": n.params.iter().copied().map(finite).collect::<Vec<_>>(),
             "size": finite(n.size),
             "size_sd": finite(n.size_sd),
@@ -42,12 +42,12 @@ fn answer_text(a: &Answer) -> String {
             if n.size_sd.is_finite() {
                 format!(
                     "{} (size {:.4} ± {:.4})",
-                    n.effect.name(),
+                    n.effect.label(),
                     n.size,
                     n.size_sd
                 )
             } else {
-                format!("{} (size {:.4})", n.effect.name(), n.size)
+                format!("{} (size {:.4})", n.effect.label(), n.size)
             }
         })
         .collect();
@@ -72,7 +72,7 @@ fn concealed_text(c: &[Concealment]) -> String {
                 .iter()
                 .map(|(k, v)| format!("{k} = {v:.4}"))
                 .collect();
-            format!("{} ({})", c.effect().name(), params.join(", "))
+            format!("{} ({})", c.effect().label(), params.join(", "))
         })
         .collect::<Vec<_>>()
         .join(" + ")
@@ -88,7 +88,7 @@ impl LogSelfTest {
         json!({
             "command": command,
             "world": self.world,
-            "concealable": self.concealable.iter().map(|e| e.name()).collect::<Vec<_>>(),
+            "concealable": self.concealable.iter().map(|e| e.label()).collect::<Vec<_>>(),
             "not_concealed": NOT_CONCEALED.iter().map(|(e, why)| json!({"effect": e, "why": why})).collect::<Vec<_>>(),
             "untouched": answer_json(&b.whole),
             "halves": b.halves.as_ref().map(|h| h.iter().map(answer_json).collect::<Vec<_>>()),
@@ -96,16 +96,16 @@ impl LogSelfTest {
             "trials": self.outcomes.iter().map(|o| json!({
                 "trial": o.index,
                 "concealed": o.concealed.iter().map(|c| json!({
-                    "effect": c.effect().name(),
+                    "effect": c.effect().label(),
                     "params": c.named_params().iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
                     "size": c.scored(),
                 })).collect::<Vec<_>>(),
                 "answer": answer_json(&o.answer),
-                "names_absent": o.names_absent(&b.whole).iter().map(|e| e.name()).collect::<Vec<_>>(),
-                "param_errors": o.param_errors.iter().map(|(e, v)| (e.name().to_string(), json!(finite(*v)))).collect::<serde_json::Map<_, _>>(),
+                "names_absent": o.names_absent(&b.whole).iter().map(|e| e.label()).collect::<Vec<_>>(),
+                "param_errors": o.param_errors.iter().map(|(e, v)| (e.label(), json!(finite(*v)))).collect::<serde_json::Map<_, _>>(),
                 "seconds": o.seconds,
             })).collect::<Vec<_>>(),
-            "per_effect": s.per_effect.iter().map(|(e, c, n)| json!({"effect": e.name(), "concealed": c, "named": n})).collect::<Vec<_>>(),
+            "per_effect": s.per_effect.iter().map(|(e, c, n)| json!({"effect": e.label(), "concealed": c, "named": n})).collect::<Vec<_>>(),
             "concealed": s.concealed, "named": s.named,
             "false_alarms": s.false_alarms, "refused": s.refused,
             "param_within_20pct": s.param_within, "param_scored": s.param_scored,
@@ -150,7 +150,7 @@ impl LogSelfTest {
         }
         writeln!(out, "concealed (exactly, in the log's own data), named:")?;
         for (e, concealed, named) in &s.per_effect {
-            writeln!(out, "  {:<28} {named:>3}/{concealed:<3}", e.to_string())?;
+            writeln!(out, "  {:<30} {named:>3}/{concealed}", e.label())?;
         }
         writeln!(out, "not concealed:")?;
         for (e, why) in NOT_CONCEALED {
@@ -199,18 +199,18 @@ impl LogSelfTest {
             writeln!(out, "refused: {} trials", s.refused)?;
         }
         for o in &self.outcomes {
-            let missed: Vec<&str> = o
+            let missed: Vec<String> = o
                 .concealed
                 .iter()
                 .filter(|c| o.answer.get(c.effect()).is_none())
-                .map(|c| c.effect().name())
+                .map(|c| c.effect().label())
                 .collect();
             let absent = o.names_absent(&b.whole);
             let off: Vec<String> = o
                 .param_errors
                 .iter()
                 .filter(|(_, e)| e.is_nan() || *e > GOAL_PARAM_ERROR)
-                .map(|(e, err)| format!("{} off by {:.0} %", e.name(), 100.0 * err))
+                .map(|(e, err)| format!("{} off by {:.0} %", e.label(), 100.0 * err))
                 .collect();
             if missed.is_empty() && absent.is_empty() && off.is_empty() {
                 continue;

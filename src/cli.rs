@@ -330,6 +330,17 @@ pub struct DiagnoseArgs {
     /// log without motion capture (the trajectory is then estimated from the lidar).
     #[arg(long, requires = "self_test")]
     pub without_truth: bool,
+    /// Self-test on a real log: conceal none, one or two mechanisms in the recording at this
+    /// directory itself in each trial, build the trial's world from it as `hilsim world` does
+    /// (or take `--sim`'s), diagnose it blind and score it against the untouched log's own
+    /// diagnosis and its halves'.
+    #[arg(
+        long,
+        value_name = "RECORDING",
+        requires = "self_test",
+        conflicts_with = "only"
+    )]
+    pub on: Option<PathBuf>,
     /// Exit 1 when the verdict is not `none` (a mismatch was found), for CI jobs; the result is
     /// still printed.
     #[arg(long, conflicts_with = "self_test")]

@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{anyhow, bail, Context, Result};
-use hilsim_diagnose::self_test::{self, Plan};
+use hilsim_diagnose::self_test::{self, on_log, Plan};
 use hilsim_diagnose::{show, Floors, Options, SimPhysics};
 use hilsim_recording::Recording;
 use hilsim_report::check_report_dir;
@@ -90,6 +90,9 @@ fn self_test_plan(args: &DiagnoseArgs, n: i128) -> Result<(Scenario, Plan)> {
 
 /// `--self-test N`: the whole self-test, or with `--trial I` one trial's diagnosis.
 fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCode> {
+    if let Some(log) = &args.on {
+        return self_test_on_log(args, n, log, out);
+    }
     let (scenario, plan) = self_test_plan(args, n)?;
     let n = plan.trials;
     if let Some(i) = args.trial {
@@ -124,6 +127,106 @@ fn self_test(args: &DiagnoseArgs, n: i128, out: &mut dyn Write) -> Result<ExitCo
     drop(bar);
     let wall_s = started.elapsed().as_secs_f64();
     let command = plan.command(args.sim.as_deref());
+    if args.json {
+        writeln!(out, "{}", result.to_json(&command, wall_s))?;
+    } else {
+        out.write_all(result.to_text(&command, wall_s).as_bytes())?;
+    }
+    Ok(super::exit_code(result.passed()))
+}
+
+/// `--self-test N --on REC`: blind trials on a real log, or with `--trial I` one trial's
+/// diagnosis.
+fn self_test_on_log(
+    args: &DiagnoseArgs,
+    n: i128,
+    log: &Path,
+    out: &mut dyn Write,
+) -> Result<ExitCode> {
+    let plan = Plan::from_flags(&self_test::Flags {
+        trials: n,
+        seed: args.seed,
+        strength: args.strength,
+        only: None,
+        reality: "hilsim",
+        without_truth: args.without_truth,
+        trial: args.trial,
+        report: args.report.is_some(),
+    })?;
+    let plan = on_log::LogPlan {
+        trials: plan.trials,
+        seed: plan.seed,
+        strength: plan.strength,
+        options: Options::default(),
+    };
+    let mut recording = Recording::read_dir(log)?;
+    if args.without_truth {
+        recording.truth = None;
+    }
+    let world: Box<dyn on_log::TrialWorld> = match &args.sim {
+        Some(path) => Box::new(on_log::GivenWorld(Scenario::load(path)?)),
+        None => Box::new(on_log::BuiltWorld::default()),
+    };
+    if let Some(i) = args.trial {
+        let (concealed, real, diagnosis) = on_log::trial_run(&recording, world.as_ref(), &plan, i)
+            .map_err(|e| anyhow!("{}: {e}", log.display()))?;
+        if let Some(dir) = args.report.as_deref() {
+            let rec_dir = dir.join("recording");
+            real.write_dir(&rec_dir)?;
+            let scenario = world
+                .scenario(&real, "the report")
+                .map_err(|e| anyhow!("{}: {e}", log.display()))?;
+            let sim = (
+                args.sim
+                    .as_deref()
+                    .unwrap_or(Path::new("<built from the log>")),
+                &scenario,
+            );
+            let files = show::report_files_of(&diagnosis, sim, (&rec_dir, &real));
+            hilsim_report::write_report_files(dir, &files)?;
+        }
+        if args.json {
+            let mut j = show::to_json(&diagnosis);
+            j["trial"] = serde_json::json!({
+                "index": i,
+                "concealed": concealed.iter().map(|c| c.effect().name()).collect::<Vec<_>>(),
+            });
+            writeln!(out, "{j}")?;
+        } else {
+            let text = self_test::trial_text(i, plan.seed, &concealed, &show::summary(&diagnosis));
+            out.write_all(text.as_bytes())?;
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let started = std::time::Instant::now();
+    let n = plan.trials;
+    let bar = Progress::on_stderr(true, Some(n), "{bar:40} {pos}/{len} trials  eta {eta}");
+    let lines = !bar.is_shown() && !args.json;
+    let done = AtomicU64::new(0);
+    let result = on_log::run_on_log(&recording, world.as_ref(), &plan, &|| {
+        bar.inc();
+        let done = done.fetch_add(1, Ordering::Relaxed) + 1;
+        if lines && (done % (n / 10).max(1) == 0 || done == n) {
+            eprintln!("self-test: {done}/{n} trials");
+        }
+    })
+    .with_context(|| log.display().to_string())?;
+    drop(bar);
+    let wall_s = started.elapsed().as_secs_f64();
+    let mut command = format!(
+        "hilsim diagnose --self-test {n} --seed {} --on {}",
+        plan.seed,
+        log.display()
+    );
+    if let Some(sim) = &args.sim {
+        command += &format!(" --sim {}", sim.display());
+    }
+    if plan.strength != 1.0 {
+        command += &format!(" --strength {}", plan.strength);
+    }
+    if args.without_truth {
+        command += " --without-truth";
+    }
     if args.json {
         writeln!(out, "{}", result.to_json(&command, wall_s))?;
     } else {

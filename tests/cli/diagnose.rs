@@ -475,3 +475,32 @@ fn the_self_test_on_the_independent_reality_names_and_leaves_unexplained() {
         );
     }
 }
+
+/// The self-test on a log: one trial in full on a run of the room, held against the room's own
+/// world (a world built from the log is the library's tests'); a log that is not there is
+/// refused with one line naming it.
+#[test]
+fn a_trial_on_a_log_conceals_in_it_and_diagnoses_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    record(tmp.path(), &nominal, "rec");
+    let args = [
+        "diagnose",
+        "--self-test",
+        "4",
+        "--on",
+        "rec",
+        "--sim",
+        &nominal,
+    ];
+    let out = hilsim(tmp.path(), &[&args[..], &["--trial", "2"]].concat());
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    assert!(text.starts_with("trial 2 (seed 1): concealed "), "{text}");
+    assert!(text.contains("verdict: "), "{text}");
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--self-test", "2", "--on", "gone"],
+    ));
+    assert!(err.contains("gone"), "{err}");
+}

@@ -24,13 +24,13 @@ impl Draws {
         self.0.next_u64()
     }
     /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
+    pub(super) fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
-    fn between(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(super) fn between(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
-    fn sign(&mut self) -> f64 {
+    pub(super) fn sign(&mut self) -> f64 {
         if self.next() & 1 == 0 {
             1.0
         } else {

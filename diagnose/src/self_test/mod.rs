@@ -5,7 +5,10 @@
 //! told, and scores the answer. Trial `i` is a function of (S, i) alone.
 
 mod command;
+mod conceal;
 mod draw;
+mod log_report;
+pub mod on_log;
 mod plan;
 mod report;
 mod run;
@@ -18,8 +21,10 @@ mod trial;
 pub const MAX_TRIALS: u64 = 100_000;
 
 pub use command::Flags;
+pub use conceal::{Concealment, NOT_CONCEALED};
 pub use draw::Drawn;
 pub use draw::OUTSIDE;
+pub use log_report::trial_text;
 pub use plan::{Plan, Reality};
 pub use run::{one, run, run_with_progress, SelfTest, TrialRun};
 pub use score::{

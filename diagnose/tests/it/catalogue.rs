@@ -58,7 +58,7 @@ slip = 0.01
 noise_m = 0.002
 "#;
 
-fn room() -> Scenario {
+pub(crate) fn room() -> Scenario {
     let text = format!("name = \"catalogue-room\"\nseed = 5\n\n{ROOM_4X3}{FURNISHED}");
     Scenario::from_toml(&text, Path::new("catalogue-room.toml")).expect("the test's scenario")
 }
@@ -109,7 +109,7 @@ fn named(d: &Diagnosis, effect: Effect) -> Vec<f64> {
 }
 
 /// The catalogue's effects fitted in `sensor`.
-fn of(sensor: Sensor) -> Vec<Effect> {
+pub(crate) fn of(sensor: Sensor) -> Vec<Effect> {
     Effect::ALL
         .into_iter()
         .filter(|e| e.sensor() == sensor)

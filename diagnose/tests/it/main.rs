@@ -5,3 +5,4 @@ mod catalogue;
 mod dead_sensors;
 mod estimated_path;
 mod mismatch;
+mod on_log;

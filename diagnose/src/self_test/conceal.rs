@@ -1,0 +1,468 @@
+//! Mechanisms concealed in a real log: each one a rewrite of the recorded data that adds one
+//! known piece of physics to whatever the log already holds (people walking through, glass, a
+//! map that is only approximately right, encoders with backlash).
+//!
+//! Only what can be concealed *exactly* in a log is: a sensor's stamps (a late driver), the
+//! encoders' travel (the wheels' radii and base, slip driven by the log's own changes of speed),
+//! the lidar's ranges (a warm-up drift, which needs only each reading's range and time) and its
+//! beams' angles (a turned mount). [`NOT_CONCEALED`] lists the rest and why.
+
+use hilsim_recording::{LidarSample, OdometrySample, Recording};
+
+use super::draw::Draws;
+use crate::{Effect, Sensor};
+
+/// One mechanism concealed in a log, with its true values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Concealment {
+    /// The sensor's samples stamped `delay_s` after they were taken, as a driver that stamps on
+    /// arrival does.
+    Restamp {
+        /// The lidar or the odometer.
+        sensor: Sensor,
+        /// Seconds.
+        delay_s: f64,
+    },
+    /// Each wheel's real radius over its nominal one: the encoders count turns, so they report
+    /// the true travel divided by it.
+    WheelRadius { left_scale: f64, right_scale: f64 },
+    /// The real wheel base over the nominal one: a turn of the robot moves the wheels apart by
+    /// that much more, and the encoders report it.
+    WheelBase { scale: f64 },
+    /// The wheels slip in proportion to their acceleration (the traction force needs a slip:
+    /// Wong, *Theory of Ground Vehicles*, ch. 1): each change of a wheel's speed `Δv` adds
+    /// `g Δv` to what its encoder reports beyond the travel, `g` the driving gain while the
+    /// speed's magnitude grows and the braking gain while it falls.
+    WheelSlip {
+        driving_gain_s: f64,
+        braking_gain_s: f64,
+    },
+    /// The lidar reads `(c + k d²) e^{−t/τ}` long, `t` from the log's start (its power-on).
+    LidarWarmup {
+        offset_m: f64,
+        coefficient_per_m: f64,
+        time_constant_s: f64,
+    },
+    /// The lidar turned on its mount by `yaw_deg` (counter-clockwise, seen from above): a wall
+    /// the robot sees at bearing φ is read at the unit's angle φ − yaw.
+    MountYaw { yaw_deg: f64 },
+}
+
+/// The catalogue's mechanisms that are not concealed in a real log, and why: each would need
+/// the world's true geometry or a sensor the log does not have.
+pub const NOT_CONCEALED: [(&str, &str); 6] = [
+    (
+        "lidar_incidence_angle",
+        "the surface's angle to each beam comes from a map built from the same scans",
+    ),
+    (
+        "lidar_reflectivity",
+        "a log has no surface's reflectivity to scale the ranges by",
+    ),
+    (
+        "lidar_mixed_pixels",
+        "a blend of two surfaces needs the range behind each edge, which a log never saw",
+    ),
+    (
+        "lidar_motion_skew",
+        "a revolution's skew needs each beam's time within it, which the logs do not stamp",
+    ),
+    (
+        "drive_motor_lag",
+        "it shows only against commands, and the real logs have none to rewrite",
+    ),
+    ("sonar_*", "the real logs have no sonar"),
+];
+
+impl Concealment {
+    /// The catalogue's entry it is.
+    #[must_use]
+    pub fn effect(&self) -> Effect {
+        match *self {
+            Self::Restamp { sensor, .. } => Effect::SensorLatency(sensor),
+            Self::WheelRadius { .. } => Effect::OdometerWheelRadius,
+            Self::WheelBase { .. } => Effect::DriveWheelBase,
+            Self::WheelSlip { .. } => Effect::OdometerWheelSlip,
+            Self::LidarWarmup { .. } => Effect::LidarWarmupDrift,
+            Self::MountYaw { .. } => Effect::LidarMountOffset,
+        }
+    }
+
+    /// Its values in the catalogue's parameters, in [`Effect::params`]' order.
+    #[must_use]
+    pub fn catalogue_params(&self) -> Vec<f64> {
+        match *self {
+            Self::Restamp { delay_s, .. } => vec![delay_s],
+            Self::WheelRadius {
+                left_scale,
+                right_scale,
+            } => vec![left_scale, right_scale],
+            Self::WheelBase { scale } => vec![scale],
+            Self::WheelSlip {
+                driving_gain_s,
+                braking_gain_s,
+            } => vec![driving_gain_s, braking_gain_s / driving_gain_s],
+            Self::LidarWarmup {
+                offset_m,
+                coefficient_per_m,
+                time_constant_s,
+            } => vec![coefficient_per_m, time_constant_s, offset_m],
+            Self::MountYaw { yaw_deg } => vec![yaw_deg, 0.0, 0.0],
+        }
+    }
+
+    /// The scored parameter's true value ([`Effect::scored`]).
+    #[must_use]
+    pub fn scored(&self) -> f64 {
+        self.effect().scored(&self.catalogue_params())
+    }
+
+    /// Its values by the catalogue's names, for the report.
+    #[must_use]
+    pub fn named_params(&self) -> Vec<(String, f64)> {
+        self.effect()
+            .params()
+            .iter()
+            .zip(self.catalogue_params())
+            .map(|(spec, v)| (spec.name.to_string(), v))
+            .collect()
+    }
+
+    /// Rewrites `recording` with it.
+    pub fn apply(&self, recording: &mut Recording) {
+        match *self {
+            Self::Restamp { sensor, delay_s } => match sensor {
+                Sensor::Lidar => {
+                    for s in recording.lidar.iter_mut().flatten() {
+                        s.t_s += delay_s;
+                    }
+                }
+                _ => {
+                    for s in recording.odometry.iter_mut().flatten() {
+                        s.t_s += delay_s;
+                    }
+                }
+            },
+            Self::WheelRadius {
+                left_scale,
+                right_scale,
+            } => rewrite_travel(recording, |_, travel| {
+                [travel[0] / left_scale, travel[1] / right_scale]
+            }),
+            Self::WheelBase { scale } => rewrite_travel(recording, |_, [left, right]| {
+                let centre = 0.5 * (left + right);
+                let apart = 0.5 * scale * (right - left);
+                [centre - apart, centre + apart]
+            }),
+            Self::WheelSlip {
+                driving_gain_s,
+                braking_gain_s,
+            } => {
+                let Some(odometry) = recording.odometry.as_mut() else {
+                    return;
+                };
+                let leads = slip_leads(odometry, driving_gain_s, braking_gain_s);
+                for (s, lead) in odometry.iter_mut().zip(leads) {
+                    s.left_m += lead[0];
+                    s.right_m += lead[1];
+                }
+            }
+            Self::LidarWarmup {
+                offset_m,
+                coefficient_per_m,
+                time_constant_s,
+            } => {
+                for s in recording.lidar.iter_mut().flatten().filter(|s| reads(s)) {
+                    let d = s.range_m;
+                    s.range_m += (offset_m + coefficient_per_m * d * d)
+                        * (-s.t_s.max(0.0) / time_constant_s).exp();
+                }
+            }
+            Self::MountYaw { yaw_deg } => {
+                for s in recording.lidar.iter_mut().flatten() {
+                    s.angle_deg = (s.angle_deg - yaw_deg).rem_euclid(360.0);
+                }
+            }
+        }
+    }
+}
+
+/// Whether a lidar sample is a reading (a range the unit returned).
+fn reads(s: &LidarSample) -> bool {
+    !s.invalid && s.range_m > 0.0 && s.range_m.is_finite()
+}
+
+/// Rewrites every odometry sample's cumulative travel `[left, right]` by `f`, which is linear in
+/// the travel so that the rewrite of the cumulative travel is the rewrite of every step.
+fn rewrite_travel(recording: &mut Recording, f: impl Fn(f64, [f64; 2]) -> [f64; 2]) {
+    for s in recording.odometry.iter_mut().flatten() {
+        [s.left_m, s.right_m] = f(s.t_s, [s.left_m, s.right_m]);
+    }
+}
+
+/// Over how long a wheel's speed is measured from its encoder: a few of a log's odometry
+/// samples (5–50 Hz), so that its counts' quantum does not read as changes of speed.
+const SPEED_SPAN_S: f64 = 0.5;
+
+/// Each odometry sample's slip lead `[left, right]`: the wheel's changes of speed (from its own
+/// encoder, over [`SPEED_SPAN_S`]) summed, each weighted by the driving gain while the speed's
+/// magnitude grows and by the braking gain while it falls (a reversal brakes to rest, then
+/// drives).
+fn slip_leads(odometry: &[OdometrySample], driving_s: f64, braking_s: f64) -> Vec<[f64; 2]> {
+    let speeds: Vec<[f64; 2]> = (0..odometry.len())
+        .map(|i| wheel_speed(odometry, i))
+        .collect();
+    let mut lead = [0.0_f64; 2];
+    let mut last = [0.0_f64; 2];
+    speeds
+        .iter()
+        .map(|v| {
+            for w in 0..2 {
+                let (from, to) = (last[w], v[w]);
+                let (braked, driven) = if from * to < 0.0 {
+                    (-from, to)
+                } else if to.abs() < from.abs() {
+                    (to - from, 0.0)
+                } else {
+                    (0.0, to - from)
+                };
+                lead[w] += braking_s * braked + driving_s * driven;
+                last[w] = to;
+            }
+            lead
+        })
+        .collect()
+}
+
+/// Wheel speeds at sample `i`, m/s: the travel across the samples within ±half
+/// [`SPEED_SPAN_S`] of it over their time apart; 0 for a lone sample.
+fn wheel_speed(odometry: &[OdometrySample], i: usize) -> [f64; 2] {
+    let t = odometry[i].t_s;
+    let half = 0.5 * SPEED_SPAN_S;
+    let first = odometry[..i]
+        .iter()
+        .rposition(|s| s.t_s < t - half)
+        .map_or(0, |j| j + 1);
+    let last = odometry[i..]
+        .iter()
+        .position(|s| s.t_s > t + half)
+        .map_or(odometry.len() - 1, |j| i + j - 1);
+    let (a, b) = (odometry[first], odometry[last]);
+    let dt = b.t_s - a.t_s;
+    if dt <= 0.0 {
+        return [0.0; 2];
+    }
+    [(b.left_m - a.left_m) / dt, (b.right_m - a.right_m) / dt]
+}
+
+/// The mechanisms that can be concealed in `recording`: the lidar's with a lidar; the wheels'
+/// with encoders judged against a truth (without one, the only path to judge the encoders
+/// against is estimated from the encoders themselves).
+#[must_use]
+pub fn concealable(recording: &Recording) -> Vec<Effect> {
+    let mut effects = Vec::new();
+    if recording.lidar.as_ref().is_some_and(|l| !l.is_empty()) {
+        effects.extend([
+            Effect::LidarWarmupDrift,
+            Effect::LidarMountOffset,
+            Effect::SensorLatency(Sensor::Lidar),
+        ]);
+    }
+    let has_truth = recording.truth.as_ref().is_some_and(|t| !t.is_empty());
+    if has_truth && recording.odometry.as_ref().is_some_and(|o| !o.is_empty()) {
+        effects.extend([
+            Effect::OdometerWheelRadius,
+            Effect::DriveWheelBase,
+            Effect::OdometerWheelSlip,
+            Effect::SensorLatency(Sensor::Odometer),
+        ]);
+    }
+    effects
+}
+
+/// The lidar's first and last stamps in `recording`, seconds.
+fn lidar_span_s(recording: &Recording) -> (f64, f64) {
+    let lidar = recording.lidar.as_deref().unwrap_or_default();
+    match (lidar.first(), lidar.last()) {
+        (Some(a), Some(b)) => (a.t_s, b.t_s),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// `effect` concealed in `recording` at a strength drawn from `d`, scaled by `strength`: the
+/// self-test's moderate ranges (`docs/diagnose.md`), each in a form drawn among those the
+/// mechanism takes.
+pub(crate) fn draw(
+    d: &mut Draws,
+    effect: Effect,
+    strength: f64,
+    recording: &Recording,
+) -> Concealment {
+    let signed = |d: &mut Draws, lo: f64, hi: f64| d.sign() * d.between(lo, hi) * strength;
+    match effect {
+        Effect::SensorLatency(sensor) => Concealment::Restamp {
+            sensor,
+            delay_s: d.between(0.02, 0.08) * strength,
+        },
+        Effect::OdometerWheelRadius => Concealment::WheelRadius {
+            left_scale: 1.0 + signed(d, 0.01, 0.03),
+            right_scale: 1.0 + signed(d, 0.01, 0.03),
+        },
+        Effect::DriveWheelBase => Concealment::WheelBase {
+            scale: 1.0 + signed(d, 0.03, 0.1),
+        },
+        Effect::OdometerWheelSlip => {
+            let driving_gain_s = d.between(0.03, 0.1) * strength;
+            // Braking gives back what speeding up led, or slips only while speeding up, or
+            // skids a share of it: the forms a tyre's traction–slip curve takes on its two
+            // sides (Wong, ch. 1).
+            let share = match d.next() % 3 {
+                0 => 1.0,
+                1 => 0.0,
+                _ => d.between(-1.0, 1.0),
+            };
+            Concealment::WheelSlip {
+                driving_gain_s,
+                braking_gain_s: share * driving_gain_s,
+            }
+        }
+        Effect::LidarWarmupDrift => {
+            // The range error at 2 m at power-on, all in the constant or all in the quadratic
+            // term (a unit's pointing, or its optics' focal length, drifting); the time
+            // constant a share of the log's lidar span, so that the drift settles within it
+            // whatever the log's length.
+            let size_m = signed(d, 0.016, 0.04);
+            let (_, end_s) = lidar_span_s(recording);
+            let time_constant_s = d.between(0.05, 0.25) * end_s.max(20.0);
+            let (offset_m, coefficient_per_m) = if d.next() & 1 == 0 {
+                (size_m, 0.0)
+            } else {
+                (0.0, size_m / 4.0)
+            };
+            Concealment::LidarWarmup {
+                offset_m,
+                coefficient_per_m,
+                time_constant_s,
+            }
+        }
+        _ => Concealment::MountYaw {
+            yaw_deg: signed(d, 1.0, 3.0),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn odometry(travel: &[(f64, f64, f64)]) -> Recording {
+        Recording {
+            odometry: Some(
+                travel
+                    .iter()
+                    .map(|&(t_s, left_m, right_m)| OdometrySample {
+                        t_s,
+                        left_m,
+                        right_m,
+                    })
+                    .collect(),
+            ),
+            ..Recording::default()
+        }
+    }
+
+    #[test]
+    fn a_wider_base_moves_the_wheels_apart_and_keeps_the_centre() {
+        let mut r = odometry(&[(0.0, 0.0, 0.0), (1.0, 0.9, 1.1)]);
+        Concealment::WheelBase { scale: 1.5 }.apply(&mut r);
+        let s = r.odometry.unwrap()[1];
+        assert!((s.left_m - 0.85).abs() < 1e-12 && (s.right_m - 1.15).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_larger_wheel_is_reported_short() {
+        let mut r = odometry(&[(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]);
+        Concealment::WheelRadius {
+            left_scale: 1.25,
+            right_scale: 0.5,
+        }
+        .apply(&mut r);
+        let s = r.odometry.unwrap()[1];
+        assert!((s.left_m - 0.8).abs() < 1e-12 && (s.right_m - 2.0).abs() < 1e-12);
+    }
+
+    /// A wheel that speeds up from rest to 0.4 m/s, cruises, brakes to rest: even gains give the
+    /// lead back at rest; slipping only while speeding up keeps `g × 0.4 m/s`.
+    #[test]
+    fn slip_leads_while_moving_and_keeps_what_braking_does_not_give_back() {
+        let mut travel = Vec::new();
+        let mut x = 0.0;
+        for i in 0..=400 {
+            let t = f64::from(i) * 0.05;
+            let v = if t < 2.0 {
+                0.0
+            } else if t < 3.0 {
+                0.4 * (t - 2.0)
+            } else if t < 12.0 {
+                0.4
+            } else if t < 13.0 {
+                0.4 * (13.0 - t)
+            } else {
+                0.0
+            };
+            x += v * 0.05;
+            travel.push((t, x, x));
+        }
+        let lead_at = |share: f64, t: f64| {
+            let mut r = odometry(&travel);
+            let before = r.odometry.clone().unwrap();
+            Concealment::WheelSlip {
+                driving_gain_s: 0.05,
+                braking_gain_s: share * 0.05,
+            }
+            .apply(&mut r);
+            let after = r.odometry.unwrap();
+            let i = after.iter().position(|s| s.t_s >= t).unwrap();
+            after[i].left_m - before[i].left_m
+        };
+        // Cruising at 0.4 m/s: the lead is g v, 20 mm, within the speed's measurement.
+        assert!((lead_at(1.0, 8.0) - 0.02).abs() < 1e-3);
+        // At rest again: given back, or kept whole.
+        assert!(lead_at(1.0, 18.0).abs() < 1e-3);
+        assert!((lead_at(0.0, 18.0) - 0.02).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_turned_mount_reads_a_wall_at_the_angle_less_the_yaw() {
+        let mut r = Recording {
+            lidar: Some(vec![LidarSample {
+                t_s: 1.0,
+                rev: 0,
+                angle_deg: 1.0,
+                range_m: 2.0,
+                strength: 0,
+                invalid: false,
+                warning: false,
+                true_range_m: None,
+            }]),
+            ..Recording::default()
+        };
+        Concealment::MountYaw { yaw_deg: 2.5 }.apply(&mut r);
+        assert!((r.lidar.unwrap()[0].angle_deg - 358.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_scored_value_is_the_catalogues() {
+        let c = Concealment::LidarWarmup {
+            offset_m: 0.0,
+            coefficient_per_m: 0.005,
+            time_constant_s: 30.0,
+        };
+        assert!((c.scored() - 0.02).abs() < 1e-12);
+        let c = Concealment::WheelSlip {
+            driving_gain_s: 0.05,
+            braking_gain_s: 0.0,
+        };
+        assert_eq!(c.catalogue_params(), vec![0.05, 0.0]);
+    }
+}

@@ -1,0 +1,546 @@
+//! `hilsim diagnose --self-test N --on REC`: the proof on a real log. Each trial conceals none,
+//! one or two mechanisms in the log itself ([`Concealment`]), builds the world from the
+//! concealed log as a user would (or takes the given scenario's), diagnoses it without being
+//! told, and is scored against the untouched log's own diagnosis: whatever the untouched log
+//! names is its baseline (real physics, or the map's error); a trial must name what it concealed,
+//! and nothing the untouched log does not name.
+
+use std::path::Path;
+use std::time::Instant;
+
+use hilsim_recording::Recording;
+use hilsim_sim::Scenario;
+use rayon::prelude::*;
+
+use super::conceal::{concealable, draw, Concealment};
+use super::draw::Draws;
+use crate::{Diagnosis, Effect, MismatchError, Options, SimPhysics, Verdict};
+
+/// Share of concealed mechanisms a self-test on a log must name.
+pub const GOAL_NAMED_ON_LOG: f64 = 0.90;
+/// Share of trials that may name a mechanism neither concealed nor named on the untouched log.
+pub const GOAL_FALSE_ON_LOG: f64 = 0.05;
+/// Share of named concealments whose parameter must come within
+/// [`super::GOAL_PARAM_ERROR`].
+pub const GOAL_PARAMS_ON_LOG: f64 = 0.90;
+/// How many combined standard errors apart the halves' sizes of one effect may be and still be
+/// the same answer: 3, a two-sided test at 0.3 %, so that an effect's several parameters and a
+/// log's few effects rarely fail it by chance.
+pub const HALVES_WITHIN_SD: f64 = 3.0;
+/// Share of trials that conceal two mechanisms, as the independent reality's.
+const TWO_MECHANISMS: f64 = 0.2;
+
+/// Where each diagnosis's world comes from.
+pub trait TrialWorld: Sync {
+    /// The scenario `recording` (named `label`: `untouched`, `first half`, `trial 7`) is
+    /// diagnosed against.
+    ///
+    /// # Errors
+    /// The world cannot be made, in one line.
+    fn scenario(&self, recording: &Recording, label: &str) -> Result<Scenario, String>;
+    /// How the world is made, for the report.
+    fn describe(&self) -> String;
+    /// Whether a part of a log is a run in this world: a world built from each recording is
+    /// built for its part too; a scenario's scripted drive starts where it starts.
+    fn takes_parts(&self) -> bool {
+        true
+    }
+}
+
+/// The user's scenario, the same for every trial.
+#[derive(Debug, Clone)]
+pub struct GivenWorld(pub Scenario);
+
+impl TrialWorld for GivenWorld {
+    fn scenario(&self, _: &Recording, _: &str) -> Result<Scenario, String> {
+        Ok(self.0.clone())
+    }
+    fn describe(&self) -> String {
+        format!("the world of scenario {}", self.0.name)
+    }
+    fn takes_parts(&self) -> bool {
+        self.0.files.path.is_some()
+    }
+}
+
+/// The world built from each recording as `hilsim world` builds it (the map from its scans at
+/// its path, the lidar's noise measured against it), in a scratch directory removed afterwards.
+#[derive(Debug, Clone, Default)]
+pub struct BuiltWorld {
+    /// How the world is built.
+    pub options: hilsim_twin::WorldOptions,
+}
+
+impl TrialWorld for BuiltWorld {
+    fn scenario(&self, recording: &Recording, label: &str) -> Result<Scenario, String> {
+        let scratch = tempfile::Builder::new()
+            .prefix("hilsim-self-test-")
+            .tempdir()
+            .map_err(|e| format!("{label}: a scratch directory: {e}"))?;
+        let built = (|| -> Result<Scenario, String> {
+            let dir = scratch.path().join("recording");
+            recording.write_dir(&dir).map_err(|e| e.to_string())?;
+            let world = hilsim_twin::build_world(&dir, &self.options).map_err(|e| e.to_string())?;
+            let files = hilsim_twin::TwinFiles::beside(&scratch.path().join("world.toml"), None);
+            world
+                .write_measured(&files, world.declared(), false)
+                .map_err(|e| e.to_string())?;
+            Scenario::load(&files.scenario).map_err(|e| e.to_string())
+        })();
+        built.map_err(|e| format!("{label}: the world: {e}"))
+    }
+    fn describe(&self) -> String {
+        "the world built from each recording's own scans".to_string()
+    }
+}
+
+/// What a diagnosis named, each effect with its scored size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Answer {
+    /// The verdict, or why the diagnosis refused.
+    pub verdict: Result<Verdict, String>,
+    /// Every effect named.
+    pub named: Vec<NamedSize>,
+    /// Located mismatches no named effect explains.
+    pub unexplained: usize,
+}
+
+/// A named effect's fitted parameters and its scored size ([`Effect::scored`]) with its
+/// standard error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedSize {
+    pub effect: Effect,
+    pub params: Vec<f64>,
+    pub size: f64,
+    pub size_sd: f64,
+}
+
+impl Answer {
+    fn of(diagnosis: &Result<Diagnosis, String>) -> Self {
+        match diagnosis {
+            Err(e) => Self {
+                verdict: Err(e.clone()),
+                named: Vec::new(),
+                unexplained: 0,
+            },
+            Ok(d) => Self {
+                verdict: Ok(d.verdict),
+                named: d
+                    .effects
+                    .iter()
+                    .map(|n| {
+                        let e = n.fit.effect;
+                        let sd = |i: usize| n.fit.param_sd.get(i).copied().unwrap_or(f64::NAN);
+                        let size_sd = e
+                            .size_terms()
+                            .iter()
+                            .map(|&(i, w)| (w * sd(i)).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        NamedSize {
+                            effect: e,
+                            params: n.fit.params.clone(),
+                            size: e.scored(&n.fit.params),
+                            size_sd,
+                        }
+                    })
+                    .collect(),
+                unexplained: d.unexplained.len(),
+            },
+        }
+    }
+
+    /// The named effect `e`, if named.
+    #[must_use]
+    pub fn get(&self, e: Effect) -> Option<&NamedSize> {
+        self.named.iter().find(|n| n.effect == e)
+    }
+
+    /// The effects named, in order.
+    #[must_use]
+    pub fn effects(&self) -> Vec<Effect> {
+        self.named.iter().map(|n| n.effect).collect()
+    }
+}
+
+/// The untouched log's own answer, and whether its halves give the same.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Baseline {
+    /// The whole log.
+    pub whole: Answer,
+    /// Its first and second halves in time (`None`: the world takes no part of the log).
+    pub halves: Option<[Answer; 2]>,
+}
+
+impl Baseline {
+    /// Whether the halves agree: both diagnosed, the same effects named, and each named
+    /// effect's sizes within [`HALVES_WITHIN_SD`] combined standard errors.
+    #[must_use]
+    pub fn stable(&self) -> bool {
+        let Some([a, b]) = &self.halves else {
+            return true;
+        };
+        let (Ok(_), Ok(_)) = (&a.verdict, &b.verdict) else {
+            return false;
+        };
+        let mut ea = a.effects();
+        let mut eb = b.effects();
+        ea.sort_by_key(|e| e.name());
+        eb.sort_by_key(|e| e.name());
+        ea == eb
+            && a.named.iter().all(|x| {
+                b.get(x.effect).is_some_and(|y| {
+                    let sd = x.size_sd.hypot(y.size_sd);
+                    // A size without a standard error (a form the data did not determine) is
+                    // compared by the effect alone.
+                    !sd.is_finite() || (x.size - y.size).abs() <= HALVES_WITHIN_SD * sd
+                })
+            })
+    }
+}
+
+/// One trial on a log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogOutcome {
+    pub index: u64,
+    /// What was concealed.
+    pub concealed: Vec<Concealment>,
+    /// The diagnosis of the concealed log.
+    pub answer: Answer,
+    /// For each concealed mechanism named, |fitted − true| / |true| of its scored size, the
+    /// fitted size taken less the untouched log's when that names it too.
+    pub param_errors: Vec<(Effect, f64)>,
+    pub seconds: f64,
+}
+
+impl LogOutcome {
+    /// Effects named that were neither concealed nor named on the untouched log.
+    #[must_use]
+    pub fn names_absent(&self, baseline: &Answer) -> Vec<Effect> {
+        self.answer
+            .effects()
+            .into_iter()
+            .filter(|e| {
+                self.concealed.iter().all(|c| c.effect() != *e) && baseline.get(*e).is_none()
+            })
+            .collect()
+    }
+}
+
+/// What a self-test on a log is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogPlan {
+    pub trials: u64,
+    pub seed: u64,
+    /// The drawn strengths' scale (1: the moderate ranges).
+    pub strength: f64,
+    /// How each recording is diagnosed.
+    pub options: Options,
+}
+
+/// A finished self-test on a log.
+#[derive(Debug, Clone)]
+pub struct LogSelfTest {
+    pub plan: LogPlan,
+    /// How each world was made.
+    pub world: String,
+    /// The mechanisms this log allows to be concealed.
+    pub concealable: Vec<Effect>,
+    pub baseline: Baseline,
+    pub outcomes: Vec<LogOutcome>,
+}
+
+/// The recording's samples stamped within `[from_s, to_s)`.
+fn window(recording: &Recording, from_s: f64, to_s: f64) -> Recording {
+    let inside = |t: f64| t >= from_s && t < to_s;
+    let mut r = recording.clone();
+    r.commands.retain(|s| inside(s.t_s));
+    for l in r.lidar.iter_mut() {
+        l.retain(|s| inside(s.t_s));
+    }
+    for o in r.odometry.iter_mut() {
+        o.retain(|s| inside(s.t_s));
+    }
+    for s in r.sonar.iter_mut() {
+        s.retain(|s| inside(s.t_s));
+    }
+    for t in r.truth.iter_mut() {
+        t.retain(|s| inside(s.t_s));
+    }
+    r
+}
+
+/// The log's two halves, split at the middle of its lidar's span (of its whole span without
+/// one).
+fn halves(recording: &Recording) -> [Recording; 2] {
+    let times = recording
+        .lidar
+        .as_deref()
+        .filter(|l| !l.is_empty())
+        .map(|l| (l[0].t_s, l[l.len() - 1].t_s))
+        .unwrap_or((0.0, recording.duration_s()));
+    let middle = 0.5 * (times.0 + times.1);
+    [
+        window(recording, f64::NEG_INFINITY, middle),
+        window(recording, middle, f64::INFINITY),
+    ]
+}
+
+fn diagnosed(
+    world: &dyn TrialWorld,
+    recording: &Recording,
+    label: &str,
+    options: &Options,
+) -> Result<Diagnosis, String> {
+    let scenario = world.scenario(recording, label)?;
+    let physics = SimPhysics::new(&scenario).map_err(|e| format!("{label}: {e:#}"))?;
+    crate::diagnose(&physics, recording, options).map_err(|e| format!("{label}: {e}"))
+}
+
+/// The untouched log's answer, whole and by halves.
+///
+/// # Errors
+/// [`MismatchError::Input`] when the whole log cannot be diagnosed: a self-test on it would
+/// have nothing to score against.
+pub fn baseline(
+    recording: &Recording,
+    world: &dyn TrialWorld,
+    options: &Options,
+) -> Result<Baseline, MismatchError> {
+    let [first, second] = halves(recording);
+    let mut parts = vec![(recording, "untouched")];
+    if world.takes_parts() {
+        parts.extend([(&first, "the first half"), (&second, "the second half")]);
+    }
+    let answers: Vec<Result<Diagnosis, String>> = parts
+        .par_iter()
+        .map(|(r, label)| diagnosed(world, r, label, options))
+        .collect();
+    if let Err(e) = &answers[0] {
+        return Err(MismatchError::Input(e.clone()));
+    }
+    Ok(Baseline {
+        whole: Answer::of(&answers[0]),
+        halves: (answers.len() == 3).then(|| [Answer::of(&answers[1]), Answer::of(&answers[2])]),
+    })
+}
+
+/// Trial `index`'s concealments in `recording`, from (seed, index) alone.
+#[must_use]
+pub fn concealments(recording: &Recording, plan: &LogPlan, index: u64) -> Vec<Concealment> {
+    let mut d = Draws::new(plan.seed, index);
+    let mut pool = concealable(recording);
+    if pool.is_empty() {
+        return Vec::new();
+    }
+    let two = d.unit() < TWO_MECHANISMS && pool.len() > 1;
+    // None, or one of the concealable mechanisms, alike.
+    let k = (d.unit() * (pool.len() + 1) as f64).floor() as usize;
+    if k >= pool.len() && !two {
+        return Vec::new();
+    }
+    let mut picked = vec![pool.swap_remove(k.min(pool.len() - 1))];
+    if two {
+        let j = (d.unit() * pool.len() as f64).floor() as usize;
+        picked.push(pool[j.min(pool.len() - 1)]);
+    }
+    picked
+        .into_iter()
+        .map(|e| draw(&mut d, e, plan.strength, recording))
+        .collect()
+}
+
+/// Trial `index` in full: the concealed recording and its diagnosis.
+///
+/// # Errors
+/// The world cannot be made or the diagnosis refuses the recording, in one line.
+pub fn trial_run(
+    recording: &Recording,
+    world: &dyn TrialWorld,
+    plan: &LogPlan,
+    index: u64,
+) -> Result<(Vec<Concealment>, Recording, Diagnosis), String> {
+    let concealed = concealments(recording, plan, index);
+    let label = format!("trial {index}");
+    let (real, diagnosis) =
+        conceal_and_diagnose(recording, world, &concealed, &plan.options, &label)?;
+    Ok((concealed, real, diagnosis))
+}
+
+/// `recording` with `concealed` in it, and its diagnosis against `world`'s scenario for it
+/// (`label` names it in an error).
+///
+/// # Errors
+/// The world cannot be made or the diagnosis refuses the recording, in one line.
+pub fn conceal_and_diagnose(
+    recording: &Recording,
+    world: &dyn TrialWorld,
+    concealed: &[Concealment],
+    options: &Options,
+    label: &str,
+) -> Result<(Recording, Diagnosis), String> {
+    let mut real = recording.clone();
+    for c in concealed {
+        c.apply(&mut real);
+    }
+    let diagnosis = diagnosed(world, &real, label, options)?;
+    Ok((real, diagnosis))
+}
+
+fn trial(
+    recording: &Recording,
+    world: &dyn TrialWorld,
+    plan: &LogPlan,
+    baseline: &Answer,
+    index: u64,
+) -> LogOutcome {
+    let started = Instant::now();
+    let result = trial_run(recording, world, plan, index);
+    let concealed = match &result {
+        Ok((c, ..)) => c.clone(),
+        Err(_) => concealments(recording, plan, index),
+    };
+    let answer = Answer::of(&result.map(|(_, _, d)| d));
+    let param_errors = concealed
+        .iter()
+        .filter_map(|c| {
+            let e = c.effect();
+            let got = answer.get(e)?.size - baseline.get(e).map_or(0.0, |b| b.size);
+            Some((e, (got - c.scored()).abs() / c.scored().abs()))
+        })
+        .collect();
+    LogOutcome {
+        index,
+        concealed,
+        answer,
+        param_errors,
+        seconds: started.elapsed().as_secs_f64(),
+    }
+}
+
+/// Runs `plan`'s trials on `recording` in parallel, after its untouched diagnosis.
+///
+/// # Errors
+/// [`MismatchError::Input`] when more than [`super::MAX_TRIALS`] are asked for, the log allows
+/// no mechanism to be concealed, or the untouched log cannot be diagnosed.
+pub fn run_on_log(
+    recording: &Recording,
+    world: &dyn TrialWorld,
+    plan: &LogPlan,
+    trial_done: &(dyn Fn() + Sync),
+) -> Result<LogSelfTest, MismatchError> {
+    if plan.trials > super::MAX_TRIALS {
+        return Err(MismatchError::Input(format!(
+            "at most {} trials, asked for {}",
+            super::MAX_TRIALS,
+            plan.trials
+        )));
+    }
+    let pool = concealable(recording);
+    if pool.is_empty() {
+        return Err(MismatchError::Input(
+            "nothing to conceal: the recording has no lidar, and no encoders with a truth".into(),
+        ));
+    }
+    let baseline = baseline(recording, world, &plan.options)?;
+    let outcomes = (0..plan.trials)
+        .into_par_iter()
+        .map(|i| {
+            let o = trial(recording, world, plan, &baseline.whole, i);
+            trial_done();
+            o
+        })
+        .collect();
+    Ok(LogSelfTest {
+        plan: plan.clone(),
+        world: world.describe(),
+        concealable: pool,
+        baseline,
+        outcomes,
+    })
+}
+
+/// A self-test on a log's score.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogScore {
+    /// Per mechanism concealed: (effect, concealed, named).
+    pub per_effect: Vec<(Effect, usize, usize)>,
+    pub concealed: usize,
+    pub named: usize,
+    /// Trials that named a mechanism neither concealed nor named untouched.
+    pub false_alarms: usize,
+    pub trials: usize,
+    /// Trials the diagnosis refused.
+    pub refused: usize,
+    pub param_within: usize,
+    pub param_scored: usize,
+}
+
+impl LogSelfTest {
+    /// The score.
+    #[must_use]
+    pub fn score(&self) -> LogScore {
+        let mut per_effect: Vec<(Effect, usize, usize)> =
+            self.concealable.iter().map(|e| (*e, 0, 0)).collect();
+        for o in &self.outcomes {
+            for c in &o.concealed {
+                if let Some(row) = per_effect.iter_mut().find(|r| r.0 == c.effect()) {
+                    row.1 += 1;
+                    row.2 += usize::from(o.answer.get(c.effect()).is_some());
+                }
+            }
+        }
+        let errors: Vec<f64> = self
+            .outcomes
+            .iter()
+            .flat_map(|o| o.param_errors.iter().map(|(_, e)| *e))
+            .collect();
+        LogScore {
+            concealed: per_effect.iter().map(|r| r.1).sum(),
+            named: per_effect.iter().map(|r| r.2).sum(),
+            per_effect,
+            false_alarms: self
+                .outcomes
+                .iter()
+                .filter(|o| !o.names_absent(&self.baseline.whole).is_empty())
+                .count(),
+            trials: self.outcomes.len(),
+            refused: self
+                .outcomes
+                .iter()
+                .filter(|o| o.answer.verdict.is_err())
+                .count(),
+            param_within: errors
+                .iter()
+                .filter(|e| **e <= super::GOAL_PARAM_ERROR)
+                .count(),
+            param_scored: errors.len(),
+        }
+    }
+
+    /// Whether every goal was met: the concealed mechanisms named, few false alarms, the
+    /// parameters recovered and the untouched log's answer stable across its halves.
+    #[must_use]
+    pub fn passed(&self) -> bool {
+        let s = self.score();
+        let share = |a: usize, b: usize| {
+            if b == 0 {
+                f64::NAN
+            } else {
+                a as f64 / b as f64
+            }
+        };
+        (s.concealed == 0 || share(s.named, s.concealed) >= GOAL_NAMED_ON_LOG)
+            && share(s.false_alarms, s.trials) <= GOAL_FALSE_ON_LOG
+            && (s.param_scored == 0 || share(s.param_within, s.param_scored) >= GOAL_PARAMS_ON_LOG)
+            && self.baseline.stable()
+    }
+}
+
+/// The recording at `dir` for a self-test on it.
+///
+/// # Errors
+/// The recording cannot be read, naming its directory.
+pub fn read_log(dir: &Path) -> Result<Recording, MismatchError> {
+    Recording::read_dir(dir).map_err(|e| MismatchError::Input(e.to_string()))
+}

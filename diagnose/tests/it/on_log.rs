@@ -1,0 +1,119 @@
+//! The self-test on a log: mechanisms concealed in a recording's own data are named with their
+//! sizes, the untouched log's halves agree, and a trial's draws are its own. The "log" here is a
+//! run `hilsim` makes of a short room scenario, diagnosed against that scenario (a real log's
+//! figures are in docs/diagnose.md, with the commands that make them); each diagnosis tries the
+//! concealed mechanism's sensor's effects, which keeps a debug build's test time to a minute.
+
+use hilsim_diagnose::self_test::on_log::{
+    baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan,
+};
+use hilsim_diagnose::self_test::Concealment;
+use hilsim_diagnose::{Options, Sensor};
+use hilsim_lidar_emulator::Emulation;
+use hilsim_recording::Recording;
+use hilsim_sim::Scenario;
+
+use crate::catalogue::{of, room};
+
+/// A faithful run of the room, with truth, its encoders without the scenario's systematic
+/// slip (a twin built from a log declares ideal encoders, and names that slip as radii).
+fn log() -> (Scenario, Recording) {
+    let mut room = room();
+    if let Some(odometer) = room.sensors.odometer.as_mut() {
+        odometer.slip = 0.0;
+    }
+    let recording = Emulation::new(&room, 11)
+        .expect("the emulation")
+        .run()
+        .recording;
+    (room, recording)
+}
+
+fn trying(sensor: Sensor) -> Options {
+    Options {
+        effects: of(sensor),
+        ..Options::default()
+    }
+}
+
+/// In the worlds built from the log and from each of its halves (as `hilsim world` builds
+/// them), the faithful run names nothing in its encoders, and its halves agree.
+#[test]
+fn a_faithful_logs_halves_agree_and_name_nothing() {
+    let (_, recording) = log();
+    let b = baseline(
+        &recording,
+        &BuiltWorld::default(),
+        &trying(Sensor::Odometer),
+    )
+    .expect("a baseline");
+    assert!(b.whole.named.is_empty(), "{:?}", b.whole);
+    assert!(b.halves.is_some() && b.stable(), "{b:?}");
+}
+
+/// Encoders rewritten for wheels 2.5 % large on the left and 2 % small on the right, and the
+/// lidar stamped 50 ms late: each named with its size within the self-test's 20 %.
+#[test]
+fn wheels_and_a_late_lidar_concealed_in_the_log_are_named_with_their_sizes() {
+    let (room, recording) = log();
+    let world = GivenWorld(room);
+    for (concealed, sensor) in [
+        (
+            Concealment::WheelRadius {
+                left_scale: 1.025,
+                right_scale: 0.98,
+            },
+            Sensor::Odometer,
+        ),
+        (
+            Concealment::Restamp {
+                sensor: Sensor::Lidar,
+                delay_s: 0.05,
+            },
+            Sensor::Lidar,
+        ),
+    ] {
+        let (_, d) = conceal_and_diagnose(&recording, &world, &[concealed], &trying(sensor), "t")
+            .expect("a diagnosis");
+        let effect = concealed.effect();
+        let named = d
+            .effects
+            .iter()
+            .find(|e| e.fit.effect == effect)
+            .unwrap_or_else(|| panic!("{effect} not named: {}", d.explanation));
+        let got = effect.scored(&named.fit.params);
+        let error = (got - concealed.scored()).abs() / concealed.scored().abs();
+        assert!(
+            error < 0.2,
+            "{effect}: {got} against {}",
+            concealed.scored()
+        );
+    }
+}
+
+#[test]
+fn a_trials_draws_are_its_own_and_only_what_the_log_allows() {
+    let (_, mut recording) = log();
+    let plan = LogPlan {
+        trials: 50,
+        seed: 3,
+        strength: 1.0,
+        options: Options::default(),
+    };
+    let drawn: Vec<Vec<Concealment>> = (0..50)
+        .map(|i| concealments(&recording, &plan, i))
+        .collect();
+    assert_eq!(drawn[17], concealments(&recording, &plan, 17));
+    assert!(
+        drawn.iter().any(Vec::is_empty),
+        "some trials conceal nothing"
+    );
+    assert!(drawn.iter().any(|c| c.len() == 2), "some conceal two");
+    // Without truth the encoders have nothing to be judged against: only the lidar's.
+    recording.truth = None;
+    for i in 0..50 {
+        for c in concealments(&recording, &plan, i) {
+            assert_eq!(c.effect().sensor(), Sensor::Lidar, "{c:?}");
+        }
+    }
+}

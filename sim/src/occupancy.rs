@@ -28,6 +28,7 @@ mod map;
 mod pgm;
 mod pixels;
 mod png_image;
+mod surfaces;
 mod traverse;
 mod yaml;
 

@@ -22,13 +22,13 @@
 
 mod builder;
 mod cast;
+mod cast_tables;
 mod error;
 mod files;
 mod map;
 mod pgm;
 mod pixels;
 mod png_image;
-mod surfaces;
 mod traverse;
 mod yaml;
 

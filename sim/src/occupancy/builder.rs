@@ -4,8 +4,8 @@
 //! Burgard & Thrun, "Learning compact 3D models of indoor and outdoor environments with a
 //! mobile robot", Robotics and Autonomous Systems 44, 2003).
 
+use super::cast_tables::CastTables;
 use super::map::{check_geometry, MAX_CELLS};
-use super::surfaces::SurfaceFits;
 use super::traverse::Traversal;
 use super::{Cell, MapError, OccupancyMap};
 
@@ -180,7 +180,7 @@ impl MapBuilder {
             width: 0,
             height: 0,
             cells: Vec::new(),
-            surfaces: SurfaceFits::default(),
+            tables: CastTables::default(),
         };
         if lo[0] > hi[0] {
             return empty();
@@ -193,7 +193,7 @@ impl MapBuilder {
             width,
             height,
             cells: vec![Cell::Unknown; width * height],
-            surfaces: SurfaceFits::default(),
+            tables: CastTables::default(),
         };
         for (tile, cells) in self.tile_cells.iter().zip(self.counts.chunks(TILE_CELLS)) {
             for (i, c) in cells.iter().enumerate().filter(|(_, c)| touched(c)) {

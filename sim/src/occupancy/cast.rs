@@ -98,6 +98,27 @@ impl OccupancyMap {
             } else {
                 skipping = false;
             }
+            // Open cells all around: cross them in one leap (the cells, corners and distances
+            // the steps below would give).
+            let open = if skipping {
+                0
+            } else {
+                self.tables.open_radius(self, tr.cell)
+            };
+            if open >= 2 {
+                let (last, axis, corner) = tr.leap(open);
+                let exit = t0 + last;
+                if exit > max_m {
+                    return None;
+                }
+                face = Some(if corner {
+                    usize::from(d[1].abs() > d[0].abs())
+                } else {
+                    axis
+                });
+                t = exit;
+                continue;
+            }
             let (exit, axis, corner) = tr.exit();
             let exit = t0 + exit;
             if exit > max_m {
@@ -154,7 +175,7 @@ impl OccupancyMap {
         let at = |offset: [f64; 2]| {
             [0, 1].map(|a| self.origin[a] + (cell[a] as f64 + 0.5 + offset[a]) * r - origin[a])
         };
-        let fit = self.surfaces.fit(self, cell, from);
+        let fit = self.tables.fit(self, cell, from);
         let (normal, surface) = match fit.map(|(axis, faces)| (facing(axis, d), faces)) {
             Some((n, faces)) => {
                 // The faces' line moved into the cells: by half a cell across an axis-aligned

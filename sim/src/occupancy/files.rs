@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use hilsim_recording::{check_output_file, read_small_text, write_file_atomically, FileKind};
 
+use super::cast_tables::CastTables;
 use super::map::check_geometry;
-use super::surfaces::SurfaceFits;
 use super::{pgm, png_image, yaml, MapError, OccupancyMap};
 
 /// The largest map YAML read: 64 KiB; map_saver's is seven lines.
@@ -84,7 +84,7 @@ impl OccupancyMap {
             width: decoded.width,
             height: decoded.height,
             cells: decoded.cells,
-            surfaces: SurfaceFits::default(),
+            tables: CastTables::default(),
         })
     }
 

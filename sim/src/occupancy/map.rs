@@ -1,6 +1,6 @@
 //! The grid itself: cells, their place in the world, and looking one up.
 
-use super::surfaces::SurfaceFits;
+use super::cast_tables::CastTables;
 use super::MapError;
 
 /// The most cells a map may have: 100 M cells, one byte each (100 MB). That is 0.25 km² at
@@ -29,8 +29,8 @@ pub struct OccupancyMap {
     pub(super) height: usize,
     /// Row-major, row 0 the bottom (lowest `y`).
     pub(super) cells: Vec<Cell>,
-    /// The surfaces rays hit, fitted once the cells are settled.
-    pub(super) surfaces: SurfaceFits,
+    /// What casting rays derives from the cells, made once they are settled.
+    pub(super) tables: CastTables,
 }
 
 impl OccupancyMap {
@@ -52,7 +52,7 @@ impl OccupancyMap {
             width,
             height,
             cells: vec![Cell::Unknown; width * height],
-            surfaces: SurfaceFits::default(),
+            tables: CastTables::default(),
         })
     }
 
@@ -97,7 +97,7 @@ impl OccupancyMap {
         match self.cells.get_mut(iy * self.width + ix) {
             Some(slot) => {
                 *slot = cell;
-                self.surfaces = SurfaceFits::default();
+                self.tables = CastTables::default();
                 true
             }
             None => false,

@@ -88,8 +88,8 @@ impl Traversal {
         let axis = usize::from(reach[1] < reach[0]);
         let until = reach[axis];
         let mut last = [f64::NEG_INFINITY; 2];
-        for a in 0..2 {
-            if !(self.next[a] <= until) {
+        for (a, last_a) in last.iter_mut().enumerate() {
+            if self.next[a] > until || self.next[a].is_nan() {
                 continue;
             }
             let most = self.crossed[a] + ahead;
@@ -103,7 +103,7 @@ impl Traversal {
             while j > self.crossed[a] && at(a, j) > until {
                 j -= 1.0;
             }
-            last[a] = at(a, j);
+            *last_a = at(a, j);
             let crossings = j - self.crossed[a] + 1.0;
             self.cell[a] += self.step[a] * crossings as i64;
             self.crossed[a] = j + 1.0;

@@ -3,9 +3,11 @@
 //! estimated from the recording (`estimate.rs`). Either way the recording must be a run of the
 //! scenario: long enough, with a sensor in common, starting where the scenario starts.
 
+use std::sync::Mutex;
+
 use hilsim_recording::Recording;
 
-use crate::catalogue::Sensor;
+use crate::catalogue::{Effect, Sensor};
 use crate::error::MismatchError;
 use crate::estimate::{estimate_trajectory, DeadReckoning, Uncertainty};
 use crate::physics::{Hypothesis, Physics};
@@ -178,6 +180,56 @@ pub(crate) fn align(
     })
 }
 
+/// The trajectories a diagnosis has estimated again ([`realign`]), by the effects they were
+/// estimated under (in any order) and what they followed: its rounds ask again for a path
+/// under effects already tried (the same effects named in another order), and each estimate
+/// matches every revolution of the lidar anew. One recording's: a diagnosis holds one.
+#[derive(Default)]
+pub(crate) struct Estimates(Mutex<Vec<(EstimateKey, Estimate)>>);
+
+/// The effects (sorted, parameters bit for bit) and the dead reckoning followed.
+type EstimateKey = (Vec<(Effect, Vec<u64>)>, DeadReckoning);
+type Estimate = (Trajectory, Uncertainty, DeadReckoning);
+
+/// Estimates kept at most (each a trajectory of the recording's length).
+const MAX_ESTIMATES: usize = 16;
+
+impl Estimates {
+    /// [`estimate_trajectory`] of `recording` (the one this cache is for), made once.
+    fn get_or_estimate(
+        &self,
+        physics: &dyn Physics,
+        recording: &Recording,
+        end_s: f64,
+        hypothesis: &Hypothesis,
+        preferred: DeadReckoning,
+    ) -> Result<Estimate, MismatchError> {
+        let mut effects: Vec<(Effect, Vec<u64>)> = hypothesis
+            .effects
+            .iter()
+            .map(|(e, p)| (*e, p.iter().map(|v| v.to_bits()).collect()))
+            .collect();
+        effects.sort();
+        let key = (effects, preferred);
+        let found = self
+            .0
+            .lock()
+            .ok()
+            .and_then(|done| done.iter().find(|(k, _)| *k == key).map(|(_, e)| e.clone()));
+        if let Some(estimate) = found {
+            return Ok(estimate);
+        }
+        let estimate = estimate_trajectory(physics, recording, end_s, hypothesis, preferred)?;
+        if let Ok(mut done) = self.0.lock() {
+            if done.len() >= MAX_ESTIMATES {
+                done.remove(0);
+            }
+            done.push((key, estimate.clone()));
+        }
+        Ok(estimate)
+    }
+}
+
 /// `aligned` (an estimated trajectory) estimated again with the lidar predicted and the
 /// commands replayed under `hypothesis` (and the drive effects `aligned` was replayed under): a
 /// lidar effect that the nominal model cannot take is partly absorbed into the scan matching's
@@ -190,6 +242,7 @@ pub(crate) fn align(
 pub(crate) fn realign(
     physics: &dyn Physics,
     recording: &Recording,
+    estimates: &Estimates,
     aligned: &Aligned,
     hypothesis: &Hypothesis,
 ) -> Result<Aligned, MismatchError> {
@@ -206,7 +259,7 @@ pub(crate) fn realign(
         .fold(Hypothesis::nominal(), |h, (e, p)| h.and(*e, p.clone()));
     let preferred = aligned.reckoned.unwrap_or(DeadReckoning::Commands);
     let (trajectory, sd, reckoned) =
-        estimate_trajectory(physics, recording, aligned.end_s, &full, preferred)?;
+        estimates.get_or_estimate(physics, recording, aligned.end_s, &full, preferred)?;
     Ok(aligned.estimated_again(trajectory, sd, reckoned, replayed))
 }
 

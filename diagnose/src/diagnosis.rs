@@ -3,7 +3,7 @@
 
 use hilsim_recording::Recording;
 
-use crate::align::{self, Aligned, Alignment};
+use crate::align::{self, Aligned, Alignment, Estimates};
 use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
@@ -96,14 +96,16 @@ pub fn diagnose_with_progress(
         Some(DeadReckoning::Commands) => align::along_encoders(physics, recording, &aligned)?,
         _ => None,
     };
+    let estimates = Estimates::default();
     let aligned = replayed_under_drive(
         physics,
         recording,
+        &estimates,
         aligned,
         along_encoders.as_ref(),
         options,
     )?;
-    let ctx = context(physics, recording, &aligned, options);
+    let ctx = context(physics, recording, &estimates, &aligned, options);
     let mut notes = aligned.notes.clone();
     let drive_ctx = along_encoders.as_ref().map(|a| along(&ctx, a));
     progress(Stage::Gathering);
@@ -457,6 +459,7 @@ fn replace_effects(
 fn context<'a>(
     physics: &'a dyn Physics,
     recording: &'a Recording,
+    estimates: &'a Estimates,
     aligned: &'a Aligned,
     options: &Options,
 ) -> Context<'a> {
@@ -464,6 +467,7 @@ fn context<'a>(
         physics,
         trajectory: &aligned.trajectory,
         recording,
+        estimates,
         end_s: aligned.end_s,
         position_sd_m: aligned.position_sd_m,
         yaw_sd_rad: aligned.yaw_sd_rad,
@@ -501,6 +505,7 @@ fn drive_along(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
 fn replayed_under_drive(
     physics: &dyn Physics,
     recording: &Recording,
+    estimates: &Estimates,
     aligned: Aligned,
     along: Option<&Aligned>,
     options: &Options,
@@ -508,7 +513,7 @@ fn replayed_under_drive(
     let Some(along) = along else {
         return Ok(aligned);
     };
-    let ctx = context(physics, recording, along, options);
+    let ctx = context(physics, recording, estimates, along, options);
     let Some(drive) = drive_along(&ctx)? else {
         return Ok(aligned);
     };
@@ -520,7 +525,13 @@ fn replayed_under_drive(
     if own.is_empty() {
         return Ok(aligned);
     }
-    align::realign(physics, recording, &aligned, &hypothesis_of(&own))
+    align::realign(
+        physics,
+        recording,
+        estimates,
+        &aligned,
+        &hypothesis_of(&own),
+    )
 }
 
 /// Readings a sensor needs to be tested.
@@ -843,7 +854,13 @@ fn through_path(
                 .cloned()
                 .collect();
             let hypothesis = hypothesis_of(&lidar_named).and(effect, best.params.clone());
-            align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?
+            align::realign(
+                ctx.physics,
+                ctx.recording,
+                ctx.estimates,
+                aligned,
+                &hypothesis,
+            )?
         }
     };
     if let Some(c) = candidates.iter_mut().find(|c| c.effect == effect) {
@@ -970,7 +987,13 @@ fn settle(
     let mut last_gain = first.heldout_gain;
     for _ in 0..REALIGN_ROUNDS {
         let hypothesis = base.and(effect, proposal.clone());
-        let again = align::realign(ctx.physics, ctx.recording, aligned, &hypothesis)?;
+        let again = align::realign(
+            ctx.physics,
+            ctx.recording,
+            ctx.estimates,
+            aligned,
+            &hypothesis,
+        )?;
         let ctx2 = along(ctx, &again);
         let Some(mut lidar) = residuals::lidar(&ctx2)? else {
             break;

@@ -309,8 +309,13 @@ impl Matcher<'_> {
         );
         let scan = Scan { queries, y, t0, t1 };
         let mut info = [[0.0; 3]; 3];
+        // The residuals at `correction`, once the last step's descent has found them.
+        let mut known = None;
         for _ in 0..ITERATIONS {
-            let (a, g, here) = self.normal_equations(&scan, *correction);
+            let here = known
+                .take()
+                .unwrap_or_else(|| self.scan_residuals(&scan, *correction));
+            let (a, g) = self.normal_equations(&scan, *correction, &here);
             info = a;
             let Some(delta) = solve3(a, g) else {
                 break;
@@ -320,10 +325,11 @@ impl Matcher<'_> {
                 .max(delta[2].abs() / 0.05)
                 .max(1.0);
             let step = delta.map(|d| d / scale);
-            let Some(next) = self.descent(&scan, *correction, &here, step) else {
+            let Some((next, there)) = self.descent(&scan, *correction, &here, step) else {
                 break;
             };
             *correction = next;
+            known = Some(there);
             if delta[0].hypot(delta[1]) < 1e-5 && delta[2].abs() < 1e-5 {
                 break;
             }
@@ -353,7 +359,7 @@ impl Matcher<'_> {
 
     /// `correction` (where the residuals are `here`) moved along `step`, halved until the move
     /// lowers the Huber loss of the readings predicted at both ends (at most [`HALVINGS`]
-    /// times); `None` when no such move lowers it. The nearest component of a reading's prediction switches as the pose moves
+    /// times), with the residuals there; `None` when no such move lowers it. The nearest component of a reading's prediction switches as the pose moves
     /// (a board's edge, the wall behind it), so the loss is rugged and a Gauss–Newton step on
     /// differences taken at one point can climb it: measured on the other simulator's
     /// `board-d` run, unchecked steps slid the path 0.69 m sideways within 3 s.
@@ -363,7 +369,7 @@ impl Matcher<'_> {
         correction: [f64; 3],
         here: &[Option<f64>],
         step: [f64; 3],
-    ) -> Option<[f64; 3]> {
+    ) -> Option<([f64; 3], Vec<Option<f64>>)> {
         let mut size = 1.0;
         for _ in 0..=HALVINGS {
             let next = [0, 1, 2].map(|k| correction[k] + size * step[k]);
@@ -376,25 +382,25 @@ impl Matcher<'_> {
                     (sa + huber(a), sb + huber(b))
                 });
             if after < before {
-                return Some(next);
+                return Some((next, there));
             }
             size /= 2.0;
         }
         None
     }
 
-    /// The Huber-weighted normal equations `J'WJ δ = −J'W r` of `scan` at `correction`: the
-    /// matrix `J'WJ` and the right-hand side, the Jacobian by central differences; and the
-    /// residuals `r` there.
+    /// The Huber-weighted normal equations `J'WJ δ = −J'W r` of `scan` at `correction`, where
+    /// the residuals are `r0`: the matrix `J'WJ` and the right-hand side, the Jacobian by
+    /// central differences.
     fn normal_equations(
         &self,
         scan: &Scan,
         correction: [f64; 3],
-    ) -> ([[f64; 3]; 3], [f64; 3], Vec<Option<f64>>) {
+        r0: &[Option<f64>],
+    ) -> ([[f64; 3]; 3], [f64; 3]) {
         let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
         let n = scan.y.len();
         let steps = [0.001, 0.001, 0.001];
-        let r0 = residuals_at(correction);
         // Central differences of the residuals along each coordinate.
         let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; n];
         let mut usable = vec![true; n];
@@ -431,7 +437,7 @@ impl Matcher<'_> {
                 }
             }
         }
-        (a, g, r0)
+        (a, g)
     }
 }
 

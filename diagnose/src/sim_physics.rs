@@ -18,8 +18,11 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Arc, RwLock};
 
-/// Readings predicted per parallel task.
+/// Readings predicted per parallel task at most …
 const CHUNK: usize = 2048;
+/// … and at least, when fewer than [`CHUNK`] a thread: a scan matcher's revolution (a few
+/// dozen readings, each several rays) is then shared by the threads too.
+const MIN_CHUNK: usize = 16;
 /// The widest beam the mixed-pixel fit tries (its catalogue range), radians.
 const MAX_HALF_WIDTH_RAD: f64 =
     Effect::LidarMixedPixels.params()[0].hi * std::f64::consts::PI / 180.0;
@@ -268,8 +271,12 @@ impl Physics for SimPhysics {
             };
             stamped - latency_s
         };
+        let chunk = queries
+            .len()
+            .div_ceil(rayon::current_num_threads())
+            .clamp(MIN_CHUNK, CHUNK);
         queries
-            .par_chunks(CHUNK)
+            .par_chunks(chunk)
             .flat_map_iter(|chunk| {
                 chunk.iter().map(|q| {
                     let p = trajectory.pose_at(instant(q));

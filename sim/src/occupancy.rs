@@ -22,6 +22,7 @@
 
 mod builder;
 mod cast;
+mod cast_tables;
 mod error;
 mod files;
 mod map;

@@ -3,6 +3,7 @@
 
 use hilsim_recording::{Mount, Recording};
 
+use crate::align::Estimates;
 use crate::catalogue::{mounted, Effect, Sensor};
 use crate::locate::Floors;
 use crate::physics::{Gaussian, Hypothesis, LidarQuery, Mixture, Physics};
@@ -164,6 +165,8 @@ pub(crate) struct Context<'a> {
     pub physics: &'a dyn Physics,
     pub trajectory: &'a Trajectory,
     pub recording: &'a Recording,
+    /// The recording's trajectories estimated so far under hypotheses.
+    pub estimates: &'a Estimates,
     pub end_s: f64,
     /// The trajectory's position noise, metres (widens the drive's and encoders' residuals,
     /// and those of the lidar and sonar when the trajectory is estimated).

@@ -4,6 +4,7 @@
 //! Burgard & Thrun, "Learning compact 3D models of indoor and outdoor environments with a
 //! mobile robot", Robotics and Autonomous Systems 44, 2003).
 
+use super::cast_tables::CastTables;
 use super::map::{check_geometry, MAX_CELLS};
 use super::traverse::Traversal;
 use super::{Cell, MapError, OccupancyMap};
@@ -179,6 +180,7 @@ impl MapBuilder {
             width: 0,
             height: 0,
             cells: Vec::new(),
+            tables: CastTables::default(),
         };
         if lo[0] > hi[0] {
             return empty();
@@ -191,6 +193,7 @@ impl MapBuilder {
             width,
             height,
             cells: vec![Cell::Unknown; width * height],
+            tables: CastTables::default(),
         };
         for (tile, cells) in self.tile_cells.iter().zip(self.counts.chunks(TILE_CELLS)) {
             for (i, c) in cells.iter().enumerate().filter(|(_, c)| touched(c)) {

@@ -98,6 +98,27 @@ impl OccupancyMap {
             } else {
                 skipping = false;
             }
+            // Open cells all around: cross them in one leap (the cells, corners and distances
+            // the steps below would give).
+            let open = if skipping {
+                0
+            } else {
+                self.tables.open_radius(self, tr.cell)
+            };
+            if open >= 2 {
+                let (last, axis, corner) = tr.leap(open);
+                let exit = t0 + last;
+                if exit > max_m {
+                    return None;
+                }
+                face = Some(if corner {
+                    usize::from(d[1].abs() > d[0].abs())
+                } else {
+                    axis
+                });
+                t = exit;
+                continue;
+            }
             let (exit, axis, corner) = tr.exit();
             let exit = t0 + exit;
             if exit > max_m {
@@ -154,7 +175,8 @@ impl OccupancyMap {
         let at = |offset: [f64; 2]| {
             [0, 1].map(|a| self.origin[a] + (cell[a] as f64 + 0.5 + offset[a]) * r - origin[a])
         };
-        let (normal, surface) = match self.fitted_normal(cell, from, d) {
+        let fit = self.tables.fit(self, cell, from);
+        let (normal, surface) = match fit.map(|(axis, faces)| (facing(axis, d), faces)) {
             Some((n, faces)) => {
                 // The faces' line moved into the cells: by half a cell across an axis-aligned
                 // wall, by a third of the diagonal's half (0.35 cell) across a 45° staircase.
@@ -181,17 +203,17 @@ impl OccupancyMap {
         }
     }
 
-    /// The normal of the surface the ray hit at `cell`, entered from the open cell `from`: the
+    /// A normal of the surface the ray hit at `cell`, entered from the open cell `from` (either
+    /// of its two signs; [`facing`] turns it towards the ray): the perpendicular of the
     /// principal axis of the midpoints of the faces between occupied cells and the open cells
     /// that `from` reaches (4-connected) within the window around `cell`, which are the ray's
     /// side of the surface (a thick wall's far side is out of reach, and so is a thin diagonal
     /// wall's, which 4-connected open cells cannot cross).
     /// Also the faces' centroid, cells from the hit cell's centre.
-    fn fitted_normal(
+    pub(super) fn fitted_normal(
         &self,
         cell: [i64; 2],
         from: [i64; 2],
-        d: [f64; 2],
     ) -> Option<([f64; 2], [f64; 2])> {
         const SIDE: usize = 2 * NORMAL_RADIUS_CELLS as usize + 1;
         let local = |c: [i64; 2]| -> Option<usize> {
@@ -247,13 +269,16 @@ impl OccupancyMap {
         }
         let along = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
         let (sin, cos) = along.sin_cos();
-        let normal = [-sin, cos];
-        let facing = if normal[0] * d[0] + normal[1] * d[1] > 0.0 {
-            [sin, -cos]
-        } else {
-            normal
-        };
-        Some((facing, [mx, my]))
+        Some(([-sin, cos], [mx, my]))
+    }
+}
+
+/// `normal` or its opposite, whichever faces a ray along `d`.
+fn facing(normal: [f64; 2], d: [f64; 2]) -> [f64; 2] {
+    if normal[0] * d[0] + normal[1] * d[1] > 0.0 {
+        [-normal[0], -normal[1]]
+    } else {
+        normal
     }
 }
 

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use hilsim_recording::{check_output_file, read_small_text, write_file_atomically, FileKind};
 
+use super::cast_tables::CastTables;
 use super::map::check_geometry;
 use super::{pgm, png_image, yaml, MapError, OccupancyMap};
 
@@ -83,6 +84,7 @@ impl OccupancyMap {
             width: decoded.width,
             height: decoded.height,
             cells: decoded.cells,
+            tables: CastTables::default(),
         })
     }
 

@@ -1,5 +1,6 @@
 //! The grid itself: cells, their place in the world, and looking one up.
 
+use super::cast_tables::CastTables;
 use super::MapError;
 
 /// The most cells a map may have: 100 M cells, one byte each (100 MB). That is 0.25 km² at
@@ -28,6 +29,8 @@ pub struct OccupancyMap {
     pub(super) height: usize,
     /// Row-major, row 0 the bottom (lowest `y`).
     pub(super) cells: Vec<Cell>,
+    /// What casting rays derives from the cells, made once they are settled.
+    pub(super) tables: CastTables,
 }
 
 impl OccupancyMap {
@@ -49,6 +52,7 @@ impl OccupancyMap {
             width,
             height,
             cells: vec![Cell::Unknown; width * height],
+            tables: CastTables::default(),
         })
     }
 
@@ -93,6 +97,7 @@ impl OccupancyMap {
         match self.cells.get_mut(iy * self.width + ix) {
             Some(slot) => {
                 *slot = cell;
+                self.tables = CastTables::default();
                 true
             }
             None => false,
@@ -116,6 +121,15 @@ impl OccupancyMap {
         self.cell_index(xy)
             .and_then(|(ix, iy)| self.cell(ix, iy))
             .unwrap_or(Cell::Unknown)
+    }
+
+    /// The place of cell `[ix, iy]` in [`OccupancyMap::cells`]; `None` outside the map.
+    pub(super) fn index(&self, cell: [i64; 2]) -> Option<usize> {
+        let (ix, iy) = (
+            usize::try_from(cell[0]).ok()?,
+            usize::try_from(cell[1]).ok()?,
+        );
+        (ix < self.width && iy < self.height).then(|| iy * self.width + ix)
     }
 
     /// Whether cell `(ix, iy)` stops rays; false outside the map.

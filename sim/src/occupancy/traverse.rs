@@ -5,6 +5,7 @@
 
 /// A ray's walk through a lattice of square cells of side `r` whose cell `(0, 0)` has its
 /// lower-left corner at the frame's origin.
+#[derive(Clone, Debug, PartialEq)]
 pub(super) struct Traversal {
     /// The cell the ray is in.
     pub cell: [i64; 2],
@@ -76,6 +77,41 @@ impl Traversal {
         }
     }
 
+    /// Crosses at once every boundary the ray meets until it has crossed `k` (at least 1)
+    /// along one axis, exactly as crossing them one at a time would (boundaries at the same
+    /// distance together); the ray then has moved at most `k` cells along each axis. Returns
+    /// where it crossed the last, across which axis's boundary, and whether that was a corner.
+    pub fn leap(&mut self, k: u32) -> (f64, usize, bool) {
+        let ahead = f64::from(k.max(1) - 1);
+        let at = |a: usize, j: f64| self.first[a] + j * self.delta[a];
+        let reach = [0, 1].map(|a| at(a, self.crossed[a] + ahead));
+        let axis = usize::from(reach[1] < reach[0]);
+        let until = reach[axis];
+        let mut last = [f64::NEG_INFINITY; 2];
+        for (a, last_a) in last.iter_mut().enumerate() {
+            if self.next[a] > until || self.next[a].is_nan() {
+                continue;
+            }
+            let most = self.crossed[a] + ahead;
+            // The last boundary at or before `until`: guessed, then settled on the same
+            // arithmetic as `cross`.
+            let mut j = (self.crossed[a] + ((until - self.next[a]) / self.delta[a]).floor())
+                .clamp(self.crossed[a], most);
+            while j < most && at(a, j + 1.0) <= until {
+                j += 1.0;
+            }
+            while j > self.crossed[a] && at(a, j) > until {
+                j -= 1.0;
+            }
+            *last_a = at(a, j);
+            let crossings = j - self.crossed[a] + 1.0;
+            self.cell[a] += self.step[a] * crossings as i64;
+            self.crossed[a] = j + 1.0;
+            self.next[a] = at(a, self.crossed[a]);
+        }
+        (until, axis, last[0] == last[1])
+    }
+
     /// Crosses the next boundary along `axis`.
     #[inline]
     pub fn cross(&mut self, axis: usize) {
@@ -121,6 +157,45 @@ mod tests {
         assert_eq!(cells([2.0, 0.5], [1.0, 0.0], 1.0, 0.5), [[2, 0]]);
         // Along a grid line: the cells above it.
         assert_eq!(cells([0.5, 1.0], [1.0, 0.0], 1.0, 1.0), [[0, 1], [1, 1]]);
+    }
+
+    #[test]
+    fn a_leap_ends_where_crossing_one_boundary_at_a_time_does() {
+        // Directions at every angle (the axes and diagonals among them, whose corners tie),
+        // from starts on and off the lattice.
+        for i in 0..720 {
+            let angle = f64::from(i) * std::f64::consts::PI / 360.0;
+            let d = [angle.cos(), angle.sin()];
+            for p in [[0.0, 0.0], [0.013, 0.29], [1.5, 0.75], [0.1, 0.1]] {
+                for k in [1, 2, 5, 40] {
+                    let mut leapt = Traversal::new(p, d, 0.05);
+                    let mut stepped = leapt.clone();
+                    for _ in 0..3 {
+                        let (until, axis, corner) = leapt.leap(k);
+                        let mut last = (f64::NAN, 0, false);
+                        loop {
+                            let (t, a, tie) = stepped.exit();
+                            if t > until {
+                                break;
+                            }
+                            if tie {
+                                stepped.cross(0);
+                                stepped.cross(1);
+                            } else {
+                                stepped.cross(a);
+                            }
+                            last = (t, a, tie);
+                        }
+                        assert_eq!(leapt, stepped, "angle {angle}, from {p:?}, k {k}");
+                        assert_eq!(until, last.0);
+                        assert_eq!(corner, last.2);
+                        if !corner {
+                            assert_eq!(axis, last.1);
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -496,7 +496,8 @@ fn a_trial_on_a_log_conceals_in_it_and_diagnoses_it() {
     let out = hilsim(tmp.path(), &[&args[..], &["--trial", "2"]].concat());
     let text = stdout(&out);
     assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
-    assert!(text.starts_with("trial 2 (seed 1): concealed "), "{text}");
+    let heading = format!("trial {} (seed 1): concealed ", 2);
+    assert!(text.starts_with(&heading), "{text}");
     assert!(text.contains("verdict: "), "{text}");
     let err = assert_bad_input(&hilsim(
         tmp.path(),

@@ -32,7 +32,7 @@ const TWO_MECHANISMS: f64 = 0.2;
 
 /// Where each diagnosis's world comes from.
 pub trait TrialWorld: Sync {
-    /// The scenario `recording` (named `label`: `untouched`, `first half`, `trial 7`) is
+    /// The scenario `recording` (named `label`: `untouched`, `the first half`, `trial I`) is
     /// diagnosed against.
     ///
     /// # Errors

@@ -145,7 +145,7 @@ impl LogSelfTest {
             }
             None => writeln!(
                 out,
-                "  the halves are not diagnosed: the scenario's drive is not a part of the log"
+                "  the halves are not diagnosed: the given scenario's run starts where the whole log starts"
             )?,
         }
         writeln!(out, "concealed (exactly, in the log's own data), named:")?;

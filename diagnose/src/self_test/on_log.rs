@@ -41,7 +41,8 @@ pub trait TrialWorld: Sync {
     /// How the world is made, for the report.
     fn describe(&self) -> String;
     /// Whether a part of a log is a run in this world: a world built from each recording is
-    /// built for its part too; a scenario's scripted drive starts where it starts.
+    /// built for its part too; a scenario (a scripted drive, or a twin's path) starts where the
+    /// whole log starts, so the log's second half is not a run of it.
     fn takes_parts(&self) -> bool {
         true
     }
@@ -59,7 +60,7 @@ impl TrialWorld for GivenWorld {
         format!("the world of scenario {}", self.0.name)
     }
     fn takes_parts(&self) -> bool {
-        self.0.files.path.is_some()
+        false
     }
 }
 

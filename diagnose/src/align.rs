@@ -199,7 +199,7 @@ fn truth_trajectory(
     notes.push(format!(
         "truth.csv holds a pose every {:.2} s, sparser than the encoders: between its poses the \
          path follows the encoders' shape, bent to meet each pose, and the encoders are judged \
-         by their travel over its intervals",
+         by their travel over spans of its poses",
         (truth[truth.len() - 1].t_s - truth[0].t_s) / (truth.len() - 1).max(1) as f64,
     ));
     Trajectory::new(&sparse_truth::filled_by_encoders(

@@ -25,12 +25,18 @@ const READINGS_PER_INTERVAL: f64 = 2.0;
 /// an effect of the wheels grows with the travel.
 const JUDGED_SPAN_S: f64 = 10.0;
 
+/// The fewest spans a log is judged over when it is too short for spans of
+/// [`JUDGED_SPAN_S`]: two rows each, enough for the residuals to be placed in bins of 30.
+const MIN_SPANS: usize = 40;
+
 /// How many of `truth`'s intervals make one span of at least [`JUDGED_SPAN_S`], at their
-/// median step (at least one).
+/// median step, but no more than leave [`MIN_SPANS`] spans (at least one).
 #[must_use]
 pub(crate) fn poses_per_span(truth: &[TruthSample]) -> usize {
-    median_step(truth.iter().map(|s| s.t_s))
-        .map_or(1, |step| (JUDGED_SPAN_S / step).ceil().max(1.0) as usize)
+    let for_span = median_step(truth.iter().map(|s| s.t_s))
+        .map_or(1, |step| (JUDGED_SPAN_S / step).ceil() as usize);
+    let for_count = truth.len().saturating_sub(1) / MIN_SPANS;
+    for_span.min(for_count).max(1)
 }
 
 /// Whether `truth` is sparse beside `odometry`: its median step holds more than
@@ -351,14 +357,16 @@ mod tests {
     }
 
     /// Encoders counting 3 % long: the shape is bent back onto the truth, so the filled path
-    /// is still the circle, and the encoders' excess is left for the diagnosis to see.
+    /// is still the circle (within 1 cm: between poses the shape keeps 3 % of its own turn,
+    /// a few millimetres sideways over a 1.5 m chord), and the encoders' excess is left for
+    /// the diagnosis to see.
     #[test]
     fn encoders_counting_long_do_not_bend_the_path_away_from_the_truth() {
         let truth: Vec<_> = (0..=4).map(|k| on_circle(3.0 * f64::from(k))).collect();
         let filled = filled_by_encoders(&truth, &circle(1.03, 0.3, 12.0), 0.3);
         for s in &filled {
             let on = on_circle(s.t_s);
-            assert!((s.x_m - on.x_m).hypot(s.y_m - on.y_m) < 2e-3, "{s:?}");
+            assert!((s.x_m - on.x_m).hypot(s.y_m - on.y_m) < 1e-2, "{s:?}");
         }
     }
 

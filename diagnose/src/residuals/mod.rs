@@ -18,6 +18,6 @@ mod sensors;
 
 pub(crate) use self::clusters::shared_error_clusters;
 pub use self::data::Covariate;
-pub(crate) use self::data::{Context, Predictive, Queries, SensorData};
+pub(crate) use self::data::{Context, Predictive, SensorData};
 pub(crate) use self::likelihood::{fits, log_likelihood, rmse, Fit};
 pub(crate) use self::sensors::{drive, lidar, odometer, sonar};

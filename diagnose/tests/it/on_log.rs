@@ -8,7 +8,7 @@ use hilsim_diagnose::self_test::on_log::{
     baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan,
 };
 use hilsim_diagnose::self_test::Concealment;
-use hilsim_diagnose::{Options, Sensor};
+use hilsim_diagnose::{Diagnosis, Options, Sensor};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
@@ -75,20 +75,25 @@ fn wheels_and_a_late_lidar_concealed_in_the_log_are_named_with_their_sizes() {
     ] {
         let (_, d) = conceal_and_diagnose(&recording, &world, &[concealed], &trying(sensor), "t")
             .expect("a diagnosis");
-        let effect = concealed.effect();
-        let named = d
-            .effects
-            .iter()
-            .find(|e| e.fit.effect == effect)
-            .unwrap_or_else(|| panic!("{effect} not named: {}", d.explanation));
-        let got = effect.scored(&named.fit.params);
-        let error = (got - concealed.scored()).abs() / concealed.scored().abs();
-        assert!(
-            error < 0.2,
-            "{effect}: {got} against {}",
-            concealed.scored()
-        );
+        assert_named_within_a_fifth(&d, concealed);
     }
+}
+
+/// `d` names `concealed`'s entry with its size within the self-test's 20 %.
+fn assert_named_within_a_fifth(d: &Diagnosis, concealed: Concealment) {
+    let effect = concealed.effect();
+    let named = d
+        .effects
+        .iter()
+        .find(|e| e.fit.effect == effect)
+        .unwrap_or_else(|| panic!("{effect} not named: {}", d.explanation));
+    let got = effect.scored(&named.fit.params);
+    let error = (got - concealed.scored()).abs() / concealed.scored().abs();
+    assert!(
+        error < 0.2,
+        "{effect}: {got} against {}",
+        concealed.scored()
+    );
 }
 
 /// A truth with a pose only every half second, as a logger stores one with each scan: the
@@ -127,15 +132,7 @@ fn against_a_sparse_truth_the_encoders_are_judged_over_its_spans() {
     );
     let (_, d) =
         conceal_and_diagnose(&recording, &world, &[concealed], &options, "t").expect("a diagnosis");
-    let effect = concealed.effect();
-    let named = d
-        .effects
-        .iter()
-        .find(|e| e.fit.effect == effect)
-        .unwrap_or_else(|| panic!("{effect} not named: {}", d.explanation));
-    let got = effect.scored(&named.fit.params);
-    let error = (got - concealed.scored()).abs() / concealed.scored().abs();
-    assert!(error < 0.2, "{got} against {}", concealed.scored());
+    assert_named_within_a_fifth(&d, concealed);
 }
 
 #[test]

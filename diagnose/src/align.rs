@@ -5,12 +5,13 @@
 
 use std::sync::Mutex;
 
-use hilsim_recording::Recording;
+use hilsim_recording::{Recording, TruthSample};
 
 use crate::catalogue::{Effect, Sensor};
 use crate::error::MismatchError;
 use crate::estimate::{estimate_trajectory, DeadReckoning, Uncertainty};
 use crate::physics::{Hypothesis, Physics};
+use crate::sparse_truth;
 use crate::trajectory::{wrap, Trajectory};
 
 /// The shortest recording diagnosed, seconds: two training and two held-out blocks.
@@ -111,7 +112,7 @@ pub(crate) fn align(
     }
     let (trajectory, alignment, position_sd_m, yaw_sd_rad, reckoned) = match &recording.truth {
         Some(truth) if !truth.is_empty() => (
-            Trajectory::new(truth)?,
+            truth_trajectory(truth, recording, declared.wheel_base_m, &mut notes)?,
             Alignment::Truth,
             TRUTH_POSITION_SD_M,
             0.0,
@@ -178,6 +179,34 @@ pub(crate) fn align(
         replayed: Hypothesis::nominal(),
         notes,
     })
+}
+
+/// The trajectory of `truth`: filled between its poses by the encoders when it is sparser
+/// than they are (`sparse_truth.rs`), with a note saying so.
+fn truth_trajectory(
+    truth: &[TruthSample],
+    recording: &Recording,
+    wheel_base_m: f64,
+    notes: &mut Vec<String>,
+) -> Result<Trajectory, MismatchError> {
+    let Some(odometry) = recording
+        .odometry
+        .as_deref()
+        .filter(|o| sparse_truth::is_sparse(truth, o))
+    else {
+        return Trajectory::new(truth);
+    };
+    notes.push(format!(
+        "truth.csv holds a pose every {:.2} s, sparser than the encoders: between its poses the \
+         path follows the encoders' shape, bent to meet each pose, and the encoders are judged \
+         by their travel over spans of its poses",
+        (truth[truth.len() - 1].t_s - truth[0].t_s) / (truth.len() - 1).max(1) as f64,
+    ));
+    Trajectory::new(&sparse_truth::filled_by_encoders(
+        truth,
+        odometry,
+        wheel_base_m,
+    ))
 }
 
 /// The trajectories a diagnosis has estimated again ([`realign`]), by the effects they were

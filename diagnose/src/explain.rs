@@ -78,10 +78,14 @@ const SIZE_SHARE: f64 = 0.1;
 const FLOOR_MULTIPLE_SHARE: f64 = 0.01;
 const SIZE_MIN_READINGS: usize = 30;
 
-/// Training rows for fitting: every `stride`-th, at most `max_rows`.
+/// Training rows for fitting: every `stride`-th, at most `max_rows`. Data of two rows per
+/// reading (the encoders' two wheels) take an odd stride, so that both rows stay in.
 pub(crate) fn fit_rows(data: &SensorData, max_rows: usize) -> Vec<usize> {
     let train = data.rows(Some(false));
-    let stride = train.len().div_ceil(max_rows.max(1)).max(1);
+    let mut stride = train.len().div_ceil(max_rows.max(1)).max(1);
+    if data.queries.rows_per_reading() == 2 && stride % 2 == 0 {
+        stride += 1;
+    }
     train.into_iter().step_by(stride).collect()
 }
 

@@ -36,6 +36,7 @@ mod select;
 pub mod self_test;
 pub mod show;
 mod sim_physics;
+mod sparse_truth;
 pub mod stats;
 mod trajectory;
 

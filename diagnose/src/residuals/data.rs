@@ -7,6 +7,7 @@ use crate::align::Estimates;
 use crate::catalogue::{mounted, Effect, Sensor};
 use crate::locate::Floors;
 use crate::physics::{Gaussian, Hypothesis, LidarQuery, Mixture, Physics};
+use crate::sparse_truth::IntervalNoise;
 use crate::trajectory::Trajectory;
 
 /// Length of the alternating training / held-out blocks, seconds.
@@ -106,8 +107,27 @@ pub(crate) enum Queries {
     Sonar(Vec<f64>),
     /// One reading time per pair of rows (left, right).
     Odometer(Vec<f64>),
+    /// One span between two poses of a sparse truth per pair of rows: the wheels' mean travel
+    /// over it and their difference (right − left), and how far the truth's departs from each
+    /// beyond any effect. Apart: a pose's error along the path (a stamp off at speed) is both
+    /// wheels' alike, so their difference, the turn, is known far better.
+    OdometerSpans {
+        spans: Vec<(f64, f64)>,
+        noise: [IntervalNoise; 2],
+    },
     /// One window per pair of rows (left, right).
     Drive(Vec<(f64, f64)>),
+}
+
+impl Queries {
+    /// The data's rows per reading: two for the encoders and the drive, one for the others.
+    #[must_use]
+    pub(crate) fn rows_per_reading(&self) -> usize {
+        match self {
+            Queries::Lidar(_) | Queries::Sonar(_) => 1,
+            Queries::Odometer(_) | Queries::OdometerSpans { .. } | Queries::Drive(_) => 2,
+        }
+    }
 }
 
 /// One sensor's readings, ready to be predicted.

@@ -86,6 +86,35 @@ impl Context<'_> {
                     })
                     .collect()
             }
+            Queries::OdometerSpans { spans, noise } => {
+                let ends: Vec<f64> = rows
+                    .iter()
+                    .flat_map(|&i| [spans[i / 2].0, spans[i / 2].1])
+                    .collect();
+                let preds = self.physics.odometry(self.trajectory, &ends, h);
+                rows.iter()
+                    .zip(preds.chunks_exact(2))
+                    .map(|(&i, ends)| {
+                        let travel =
+                            [0, 1].map(|w| ends[1].wheels[w].mean_m - ends[0].wheels[w].mean_m);
+                        // Each end's readings carry the encoders' noise, the wheels' own; the
+                        // span, the truth's departure from them.
+                        let encoders: f64 = ends
+                            .iter()
+                            .flat_map(|e| e.wheels.iter().map(|g| g.sd_m * g.sd_m))
+                            .sum();
+                        let mut g = ends[1].wheels[0];
+                        g.mean_m = if i % 2 == 0 {
+                            (travel[0] + travel[1]) / 2.0
+                        } else {
+                            travel[1] - travel[0]
+                        };
+                        let encoders = if i % 2 == 0 { encoders / 4.0 } else { encoders };
+                        g.sd_m = (encoders + noise[i % 2].variance(data.y[i])).sqrt();
+                        smallvec![g]
+                    })
+                    .collect()
+            }
             Queries::Drive(windows) => {
                 let predicted = self.physics.drive(&self.recording.commands, self.end_s, h);
                 let Ok(path) = Trajectory::new(&predicted) else {

@@ -5,7 +5,9 @@ use super::data::{Context, Covariate, Queries, SensorData, DRIVE_WINDOW_S, SPLIT
 use crate::catalogue::Sensor;
 use crate::error::MismatchError;
 use crate::physics::{Hypothesis, LidarQuery};
+use crate::sparse_truth::{self, counted_at, IntervalNoise, GROSS_SHARE, GROSS_SPAN_M, REGRESSORS};
 use crate::trajectory::Trajectory;
+use hilsim_recording::{OdometrySample, TruthSample};
 
 /// Margin around a contact of the replayed robot in which the drive is not compared, seconds.
 const CONTACT_MARGIN_S: f64 = 0.5;
@@ -265,9 +267,27 @@ pub(crate) fn odometer(ctx: &Context<'_>) -> Result<Option<SensorData>, Mismatch
     let (Some(samples), true) = (&ctx.recording.odometry, ctx.physics.declared().odometer) else {
         return Ok(None);
     };
-    let rows: Vec<_> = samples.iter().filter(|s| s.t_s <= ctx.end_s).collect();
-    let times: Vec<f64> = rows.iter().map(|s| s.t_s).collect();
+    if let Some(truth) = ctx.recording.truth.as_deref() {
+        if !ctx.estimated && sparse_truth::is_sparse(truth, samples) {
+            return Ok(Some(odometer_over_spans(ctx, truth, samples)));
+        }
+    }
     let tr = ctx.trajectory;
+    // The path's wheel travel counts from its first pose: readings before it are not judged,
+    // and the travel the encoders had counted by then (a log whose truth starts late) is taken
+    // off the rest.
+    let start_s = tr.times()[0];
+    let rows: Vec<_> = samples
+        .iter()
+        .filter(|s| s.t_s >= start_s && s.t_s <= ctx.end_s)
+        .collect();
+    // Zero when the path starts at or before the encoders' first reading.
+    let [left_before, right_before] = if samples[0].t_s < start_s {
+        counted_at(samples, start_s)
+    } else {
+        [0.0; 2]
+    };
+    let times: Vec<f64> = rows.iter().map(|s| s.t_s).collect();
     let travel = tr.wheel_travel(ctx.physics.declared().wheel_base_m);
     let speed = |t: f64, wheel: usize| {
         let k = tr.interval(t);
@@ -290,7 +310,11 @@ pub(crate) fn odometer(ctx: &Context<'_>) -> Result<Option<SensorData>, Mismatch
     for s in &rows {
         for wheel in 0..2 {
             t.push(s.t_s);
-            y.push(if wheel == 0 { s.left_m } else { s.right_m });
+            y.push(if wheel == 0 {
+                s.left_m - left_before
+            } else {
+                s.right_m - right_before
+            });
             let v = speed(s.t_s, wheel);
             let a = (speed(s.t_s + 0.05, wheel) - speed(s.t_s - 0.05, wheel)) / 0.1;
             let values = [v, a.abs(), s.t_s, motion(tr, s.t_s)[2]];
@@ -311,6 +335,83 @@ pub(crate) fn odometer(ctx: &Context<'_>) -> Result<Option<SensorData>, Mismatch
         clusters: None,
         world_reach_m: Vec::new(),
     }))
+}
+
+/// The encoders' travel over spans of a sparse truth's poses
+/// ([`sparse_truth::poses_per_span`]): two rows per span, the wheels' mean travel and their
+/// difference ([`Queries::OdometerSpans`]). Their cumulative travel against a path through
+/// sparse poses would carry every span's error (a pose stamped late, a curve the filled path
+/// cut) into all later readings; over spans each error stays in its own.
+fn odometer_over_spans(
+    ctx: &Context<'_>,
+    truth: &[TruthSample],
+    samples: &[OdometrySample],
+) -> SensorData {
+    let tr = ctx.trajectory;
+    let (first_s, last_s) = (samples[0].t_s, samples[samples.len() - 1].t_s);
+    let poses: Vec<f64> = truth
+        .iter()
+        .map(|p| p.t_s)
+        .filter(|&t| t >= first_s && t <= last_s.min(ctx.end_s))
+        .step_by(sparse_truth::poses_per_span(truth))
+        .collect();
+    let spans: Vec<(f64, f64)> = poses
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .filter(|&(a, b)| b > a)
+        .collect();
+    let travel = tr.wheel_travel(ctx.physics.declared().wheel_base_m);
+    let mut t = Vec::new();
+    let mut y = Vec::new();
+    let mut cov: Vec<(Covariate, Vec<f64>)> =
+        [Covariate::WheelSpeed, Covariate::Time, Covariate::TurnRate]
+            .into_iter()
+            .map(|c| (c, Vec::new()))
+            .collect();
+    let mut regressed: [Vec<([f64; REGRESSORS], f64)>; 2] = [Vec::new(), Vec::new()];
+    let mean_and_difference = |w: [f64; 2]| [(w[0] + w[1]) / 2.0, w[1] - w[0]];
+    // The wheels' mean speed at `t`, over a quarter second either side.
+    let speed = |t: f64| {
+        let (a, b) = (
+            tr.interpolate(&travel, t - 0.25),
+            tr.interpolate(&travel, t + 0.25),
+        );
+        (b[0] - a[0] + b[1] - a[1]) / 2.0 / 0.5
+    };
+    for &(a, b) in &spans {
+        let (counted_a, counted_b) = (counted_at(samples, a), counted_at(samples, b));
+        let (path_a, path_b) = (tr.interpolate(&travel, a), tr.interpolate(&travel, b));
+        let counted = mean_and_difference([0, 1].map(|w| counted_b[w] - counted_a[w]));
+        let path = mean_and_difference([0, 1].map(|w| path_b[w] - path_a[w]));
+        let mid = (a + b) / 2.0;
+        for row in 0..2 {
+            t.push(mid);
+            y.push(counted[row]);
+            regressed[row].push(([path[0], path[1], speed(b) - speed(a)], counted[row]));
+            let values = [path[0] / (b - a), mid, motion(tr, mid)[2]];
+            for ((_, col), v) in cov.iter_mut().zip(values) {
+                col.push(v);
+            }
+        }
+    }
+    let noise = [0, 1].map(|row| {
+        IntervalNoise::measure(&regressed[row], row).unwrap_or(IntervalNoise {
+            sd_m: ctx.position_sd_m,
+            share: 0.0,
+        })
+    });
+    SensorData {
+        sensor: Sensor::Odometer,
+        heldout: t.iter().map(|&t| split(t)).collect(),
+        t,
+        y,
+        covariates: cov,
+        queries: Queries::OdometerSpans { spans, noise },
+        epsilon: GROSS_SHARE,
+        outlier_density: GROSS_SHARE / GROSS_SPAN_M,
+        clusters: None,
+        world_reach_m: Vec::new(),
+    }
 }
 
 /// The drive: the wheels' travel over 0.1 s windows along the aligned trajectory, against the

@@ -11,7 +11,7 @@ use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::effects::LidarEffects;
+use crate::effects::{dropout_probability, BeamReturn, LidarEffects};
 use crate::neato_packet::{rpm_to_fixed, MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
 use crate::unit_scans::UnitScans;
@@ -122,6 +122,9 @@ pub struct Lidar {
     byte_strength: bool,
     /// The unit.
     unit: LidarModel,
+    /// `[effects.lidar_dropout]` and the stream its losses are drawn from (a stream of its
+    /// own, so that every other draw, and so every reading it keeps, is the nominal lidar's).
+    dropout: Option<(scenario::LidarDropout, rng::Rng)>,
 }
 
 /// Where the scans come from when the lidar is not the XV-11 as it is.
@@ -199,6 +202,9 @@ impl Lidar {
             min_mm: config.min_range_m * 1000.0,
             max_mm: config.max_range_m * 1000.0,
             rng: rng::stream(seed, "lidar"),
+            dropout: effects
+                .lidar_dropout
+                .map(|d| (d, rng::stream(seed, "lidar.dropout"))),
             rev: 0,
             index: 0,
             rev_start_s: 0.0,
@@ -481,6 +487,8 @@ impl Lidar {
             Some(ERROR_TOO_CLOSE)
         } else if measured_mm > self.max_mm {
             Some(ERROR_NO_RETURN)
+        } else if self.drops(&ret) {
+            Some(ERROR_WEAK_SIGNAL)
         } else {
             None
         };
@@ -496,6 +504,23 @@ impl Lidar {
             reading.warning = strength < STRENGTH_WARNING_BELOW;
         }
         reading
+    }
+}
+
+impl Lidar {
+    /// Whether `[effects.lidar_dropout]` loses the return `ret` (never when it is off: no
+    /// number is drawn then).
+    fn drops(&mut self, ret: &BeamReturn) -> bool {
+        let Some((dropout, rng)) = self.dropout.as_mut() else {
+            return false;
+        };
+        let lost = dropout_probability(
+            dropout,
+            ret.hit.distance,
+            ret.cos_incidence,
+            ret.hit.reflectivity,
+        );
+        rng.random::<f64>() < lost
     }
 }
 

@@ -182,7 +182,14 @@ pub fn diagnose_with_progress(
         named
     };
     let mut left = structure_left(final_ctx, &data, &nominal, &named);
-    let named = explaining_their_sensor(&nominal, &left, named, options);
+    let mut before = named.len();
+    let mut named = explaining_their_sensor(&nominal, &left, named, options);
+    // An effect refused changes what its sensor's others leave: they are judged again without it.
+    while named.len() < before {
+        left = structure_left(final_ctx, &data, &nominal, &named);
+        before = named.len();
+        named = explaining_their_sensor(&nominal, &left, named, options);
+    }
     // A sensor whose effects were all dropped is left with its nominal structure.
     for l in &mut left {
         if !named.iter().any(|c| c.effect.shows_in(l.sensor)) {
@@ -262,7 +269,8 @@ const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 /// outside the catalogue (a periodic range error is part reflectivity walk, part warm-up, part
 /// incidence over a room's ranges) gain on held-out data, but leave its shape standing; the
 /// sensor's structure is then unexplained, not theirs. Structure that is not the sensor's main
-/// one (a small nuisance beside a large effect) does not count against them.
+/// one (a small nuisance beside a large effect) does not count against them, except against
+/// a range bias: it must leave nothing clustered by range ([`select::leaves_range_structure`]).
 fn explaining_their_sensor(
     nominal: &Nominal,
     left: &[Left],
@@ -291,6 +299,7 @@ fn explaining_their_sensor(
     named
         .into_iter()
         .filter(|c| !unexplained_sensor(c.effect.sensor()))
+        .filter(|c| !select::leaves_range_structure(c, left, threshold, &options.floors))
         .collect()
 }
 

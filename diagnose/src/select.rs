@@ -13,13 +13,16 @@
 //! ([`crate::locate::Floors`]) where it changes them most, in metres or in units of their noise: a small difference between the recording and the simulation
 //! that some effect can mimic is not that effect. Against a path estimated from the lidar, a
 //! delay of the sonar or the encoders must also exceed the path's own timing
-//! ([`Options::path_timing_s`]).
+//! ([`Options::path_timing_s`]). A range bias must leave nothing of its sensor's error
+//! clustered by range ([`leaves_range_structure`]).
 
 use rayon::prelude::*;
 
 use crate::catalogue::{Effect, Sensor};
-use crate::conclude::declared_cone;
+use crate::conclude::{declared_cone, Left};
 use crate::explain::{self, CandidateFit};
+use crate::locate::{Floors, TestKind};
+use crate::residuals::Covariate;
 use crate::outcome::Options;
 use crate::physics::Hypothesis;
 use crate::residuals::{Context, SensorData};
@@ -119,6 +122,34 @@ fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
         .params
         .first()
         .is_some_and(|d| d.abs() <= options.path_timing_s)
+}
+
+/// Whether `c` is a range bias (the lidar's or the sonar's) whose sensor's error, under the
+/// sensor's named effects (`left`), still clusters by range: the residuals' mean still changes
+/// with the range by a departure that counts (significant and above the sensor's floor,
+/// [`crate::locate::Evidence::counts`]). A range bias is a function of the range alone, so
+/// fitted to an error of its own shape it leaves nothing against the range; what it leaves
+/// there is an error of another shape (a periodic one, `A sin(2π d/λ)`, outside the catalogue)
+/// whose slow part its polynomial took up, and that error is not the unit's calibration. The
+/// spread against the range is not asked: a noise other than declared spreads by range beside
+/// a true bias.
+pub(crate) fn leaves_range_structure(
+    c: &CandidateFit,
+    left: &[Left],
+    threshold: f64,
+    floors: &Floors,
+) -> bool {
+    let sensor = c.effect.sensor();
+    matches!(c.effect, Effect::LidarRangeBias | Effect::SonarRangeBias)
+        && left
+            .iter()
+            .filter(|l| l.sensor == sensor)
+            .flat_map(|l| l.evidence.iter())
+            .any(|e| {
+                e.test == TestKind::BiasAgainst
+                    && e.covariate == Some(Covariate::Range)
+                    && e.counts(threshold, floors)
+            })
 }
 
 /// The hypothesis of the effects `fits` with their parameters.
@@ -312,6 +343,62 @@ mod tests {
             assert!(!earns_place(&short, 15.0, &estimated()), "{effect:?}");
             assert!(earns_place(&fitted(effect, vec![0.03]), 15.0, &estimated()));
         }
+    }
+
+    /// A test of the lidar's residuals against `covariate`, of `size_m`, scored 50 (beyond any
+    /// threshold).
+    fn left_against(test: TestKind, covariate: Covariate, size_m: f64) -> Left {
+        let evidence = crate::locate::Evidence {
+            sensor: Sensor::Lidar,
+            test,
+            covariate: Some(covariate),
+            score: 50.0,
+            place: String::new(),
+            detail: String::new(),
+            range: None,
+            size_m,
+            noise_m: 0.01,
+            world_m: 0.0,
+            beyond_world_m: size_m,
+        };
+        Left {
+            sensor: Sensor::Lidar,
+            evidence: vec![evidence],
+        }
+    }
+
+    /// A range bias that leaves the lidar's mean clustered by range (beyond the floor) is a
+    /// range error of another shape whose slow part it took up: refused. One that leaves it
+    /// within the floor, or leaves structure against another variable or the spread by range,
+    /// is not refused for it; nor is an effect other than a range bias.
+    #[test]
+    fn a_range_bias_leaving_the_mean_clustered_by_range_is_refused() {
+        let floors = Floors::default();
+        let bias = fitted(Effect::LidarRangeBias, vec![0.0, 0.01, 0.0]);
+        let refused = |c: &CandidateFit, left: Left| {
+            leaves_range_structure(c, &[left], 3.6, &floors)
+        };
+        assert!(refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.003)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::SpreadAgainst, Covariate::Range, 0.013)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Incidence, 0.013)
+        ));
+        let warmup = fitted(Effect::LidarWarmupDrift, vec![-0.002, 15.0, 0.0]);
+        assert!(!refused(
+            &warmup,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)
+        ));
     }
 
     /// A warm-up whose time constant outlasts the 60 s it was seen over is a constant range

@@ -5,6 +5,7 @@ use hilsim_recording::Recording;
 
 use crate::align::{self, Aligned, Alignment, Estimates};
 use crate::catalogue::{Effect, Sensor};
+use crate::dropout;
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
@@ -181,6 +182,16 @@ pub fn diagnose_with_progress(
     } else {
         named
     };
+    let mut named = named;
+    // The lidar's dropout, fitted on its reads and losses apart from the ranges (it moves none).
+    if let Some(dropout) = dropout::fitted(final_ctx, options) {
+        if dropout::earns_place(&dropout, options) {
+            named.push(dropout.clone());
+            named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+        }
+        candidates.push(dropout);
+        candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    }
     let mut left = structure_left(final_ctx, &data, &nominal, &named);
     let mut before = named.len();
     let mut named = explaining_their_sensor(&nominal, &left, named, options);
@@ -298,7 +309,7 @@ fn explaining_their_sensor(
     };
     named
         .into_iter()
-        .filter(|c| !unexplained_sensor(c.effect.sensor()))
+        .filter(|c| !c.effect.moves_readings() || !unexplained_sensor(c.effect.sensor()))
         .filter(|c| !select::leaves_range_structure(c, left, threshold, &options.floors))
         .collect()
 }
@@ -315,7 +326,7 @@ fn structure_left(
         .map(|d| {
             let mine: Vec<CandidateFit> = named
                 .iter()
-                .filter(|c| c.effect.shows_in(d.sensor))
+                .filter(|c| c.effect.shows_in(d.sensor) && c.effect.moves_readings())
                 .cloned()
                 .collect();
             let evidence = if mine.is_empty() {

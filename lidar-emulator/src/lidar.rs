@@ -472,13 +472,8 @@ impl Lidar {
         // The range model sees the distance the unit ranges: the true one unless an effect is on.
         let ranged = self.effects.ranged_m(&ret, t);
         let measured_mm = (self.model.sample(ranged, &mut self.rng) * 1000.0).round();
-        // Diffuse return: proportional to reflectivity and to the cosine of the incidence.
-        let cos_incidence = ret.cos_incidence;
         let speckle: f64 = StandardNormal.sample(&mut self.rng);
-        let strength = STRENGTH_AT_1M
-            * (hit.reflectivity / REFERENCE_REFLECTIVITY)
-            * cos_incidence
-            * d.max(0.05).powf(-STRENGTH_FALLOFF)
+        let strength = expected_strength(d, ret.cos_incidence, hit.reflectivity)
             * (1.0 + STRENGTH_SPREAD * speckle).max(0.0);
         let strength = strength.round().min(f64::from(u16::MAX)) as u16;
         let error = if strength < STRENGTH_INVALID_BELOW {
@@ -522,6 +517,17 @@ impl Lidar {
         );
         rng.random::<f64>() < lost
     }
+}
+
+/// The strength the unit reports on average for a surface of `reflectivity` at `range_m`, met
+/// at `|cos θ|` = `cos_incidence`: a diffuse return, proportional to the reflectivity and to the
+/// cosine of the incidence, falling with the range as the real capture's (before speckle).
+#[must_use]
+pub fn expected_strength(range_m: f64, cos_incidence: f64, reflectivity: f64) -> f64 {
+    STRENGTH_AT_1M
+        * (reflectivity / REFERENCE_REFLECTIVITY)
+        * cos_incidence
+        * range_m.max(0.05).powf(-STRENGTH_FALLOFF)
 }
 
 /// The lidar's pose through one physics step: the robot's pose interpolated as

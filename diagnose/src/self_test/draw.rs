@@ -151,6 +151,13 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
             delay_s: 2.0 * p(0) / speed_of_sound_mps(20.0),
             calibrated_at_c: 20.0,
         },
+        // The same loss written as a power threshold: a logistic of scale s in the log power
+        // has the standard deviation `s π / √3`, given here to a log-normal scatter.
+        Effect::LidarDropout => Concealed::LidarWeakReturns {
+            half_loss_range_m: p(0),
+            log_power_sd: p(1) * std::f64::consts::PI / 3f64.sqrt(),
+            reference: REFERENCE_REFLECTIVITY,
+        },
         Effect::LidarRangeBias => {
             let [c, s, q] = range_bias(values).coefficients();
             let ratio = 1.0 / (1.0 + s).max(0.1);

@@ -51,8 +51,7 @@ mod tests {
     use super::*;
 
     /// The loss grows with the range, the incidence and darkness, and is the logistic of the
-    /// log power: 12 % and 88 % at `e^{∓s}` times the half-loss range's power... i.e. at
-    /// ranges `d½ e^{∓s}` head-on.
+    /// log power: 12 % and 88 % lost at ranges `d½ e^{∓s}` head-on.
     #[test]
     fn the_loss_is_logistic_in_the_returned_log_power() {
         let d = LidarDropout {

@@ -5,8 +5,8 @@ use hilsim_recording::Recording;
 
 use crate::align::{self, Aligned, Alignment, Estimates};
 use crate::catalogue::{Effect, Sensor};
-use crate::dropout;
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
+use crate::dropout;
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};

@@ -95,12 +95,9 @@ fn share(lost: &[bool]) -> f64 {
 
 /// The root mean square of `lost − p` (the Brier score's root).
 fn brier_rms(lost: &[bool], p: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = lost
-        .iter()
-        .zip(p)
-        .fold((0.0, 0usize), |(s, n), (&l, p)| {
-            (s + (f64::from(u8::from(l)) - p).powi(2), n + 1)
-        });
+    let (sum, n) = lost.iter().zip(p).fold((0.0, 0usize), |(s, n), (&l, p)| {
+        (s + (f64::from(u8::from(l)) - p).powi(2), n + 1)
+    });
     (sum / n.max(1) as f64).sqrt()
 }
 
@@ -222,8 +219,18 @@ mod tests {
     fn the_loss_by_power_is_recovered_and_loss_at_random_is_not_named() {
         let fit = fit(&rows(20_000)).expect("a fit");
         let [d, s] = [fit.params[0], fit.params[1]];
-        assert!((d - 4.0).abs() < 0.12, "{:?} ± {:?}", fit.params, fit.param_sd);
-        assert!((s - 0.3).abs() < 0.045, "{:?} ± {:?}", fit.params, fit.param_sd);
+        assert!(
+            (d - 4.0).abs() < 0.12,
+            "{:?} ± {:?}",
+            fit.params,
+            fit.param_sd
+        );
+        assert!(
+            (s - 0.3).abs() < 0.045,
+            "{:?} ± {:?}",
+            fit.params,
+            fit.param_sd
+        );
         assert!(earns_place(&fit, &Options::default()), "{fit:?}");
         assert!(fit.rmse_after < fit.rmse_before);
         let mut random = rows(20_000);

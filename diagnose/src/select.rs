@@ -22,9 +22,9 @@ use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{declared_cone, Left};
 use crate::explain::{self, CandidateFit};
 use crate::locate::{Floors, TestKind};
-use crate::residuals::Covariate;
 use crate::outcome::Options;
 use crate::physics::Hypothesis;
+use crate::residuals::Covariate;
 use crate::residuals::{Context, SensorData};
 
 /// Effects named in one sensor at most (the catalogue's lidar has five; more than three at
@@ -375,9 +375,8 @@ mod tests {
     fn a_range_bias_leaving_the_mean_clustered_by_range_is_refused() {
         let floors = Floors::default();
         let bias = fitted(Effect::LidarRangeBias, vec![0.0, 0.01, 0.0]);
-        let refused = |c: &CandidateFit, left: Left| {
-            leaves_range_structure(c, &[left], 3.6, &floors)
-        };
+        let refused =
+            |c: &CandidateFit, left: Left| leaves_range_structure(c, &[left], 3.6, &floors);
         assert!(refused(
             &bias,
             left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)

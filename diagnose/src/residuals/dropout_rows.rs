@@ -6,8 +6,8 @@
 use hilsim_lidar_emulator::lidar::{expected_strength, STRENGTH_INVALID_BELOW};
 
 use super::data::Context;
-use super::sensors::{revolution_starts, split, LIMIT_GUARD_TRUE_SD};
-use crate::physics::{Hypothesis, LidarQuery};
+use super::sensors::{lidar_queries, split, LIMIT_GUARD_TRUE_SD};
+use crate::physics::Hypothesis;
 
 /// How many times the nominal unit's weak-signal threshold a reading's expected strength must
 /// be for its loss to count: the nominal unit already loses returns below the threshold (dark,
@@ -40,7 +40,6 @@ pub(crate) fn dropout_rows(ctx: &Context<'_>) -> Option<DropoutRows> {
     else {
         return None;
     };
-    let rev_start = revolution_starts(samples, declared.rpm);
     let taken: Vec<_> = samples.iter().filter(|s| s.t_s <= ctx.end_s).collect();
     let valid = |s: &hilsim_recording::LidarSample| !s.invalid && s.range_m > 0.0;
     let (lo, hi) = taken
@@ -50,14 +49,7 @@ pub(crate) fn dropout_rows(ctx: &Context<'_>) -> Option<DropoutRows> {
             (lo.min(s.range_m), hi.max(s.range_m))
         });
     let (min, max) = (declared.min_range_m.max(lo), declared.max_range_m.min(hi));
-    let queries: Vec<LidarQuery> = taken
-        .iter()
-        .map(|s| LidarQuery {
-            t_s: s.t_s,
-            rev_start_s: rev_start[&s.rev],
-            angle_deg: s.angle_deg,
-        })
-        .collect();
+    let queries = lidar_queries(samples, &taken, declared.rpm);
     let nominal = ctx
         .physics
         .lidar(ctx.trajectory, &queries, &Hypothesis::nominal());
@@ -65,7 +57,9 @@ pub(crate) fn dropout_rows(ctx: &Context<'_>) -> Option<DropoutRows> {
     for ((s, q), p) in taken.iter().zip(&queries).zip(&nominal) {
         let (Some(d), Some(main)) = (
             p.true_range_m,
-            p.components.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)),
+            p.components
+                .iter()
+                .max_by(|a, b| a.weight.total_cmp(&b.weight)),
         ) else {
             continue;
         };

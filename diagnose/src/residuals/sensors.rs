@@ -27,12 +27,14 @@ fn motion(tr: &Trajectory, t: f64) -> [f64; 3] {
     [v.abs(), accel_at(tr, t), w.abs().to_degrees()]
 }
 
-/// Each revolution's start: the timestamp of its reading 0, or extrapolated from its first
-/// reading at the nominal reading period of a head turning at `rpm`.
-pub(super) fn revolution_starts(
+/// The queries of the `chosen` readings among a lidar's `samples`, each with its revolution's
+/// start: the timestamp of its reading 0, or extrapolated from its first reading at the
+/// nominal reading period of a head turning at `rpm`.
+pub(super) fn lidar_queries(
     samples: &[hilsim_recording::LidarSample],
+    chosen: &[&hilsim_recording::LidarSample],
     rpm: f64,
-) -> std::collections::HashMap<u64, f64> {
+) -> Vec<LidarQuery> {
     let period = 60.0 / (rpm * 360.0);
     let mut rev_start = std::collections::HashMap::new();
     for s in samples {
@@ -40,7 +42,14 @@ pub(super) fn revolution_starts(
             .entry(s.rev)
             .or_insert(s.t_s - s.angle_deg * period);
     }
-    rev_start
+    chosen
+        .iter()
+        .map(|s| LidarQuery {
+            t_s: s.t_s,
+            rev_start_s: rev_start[&s.rev],
+            angle_deg: s.angle_deg,
+        })
+        .collect()
 }
 
 /// The lidar's valid readings.
@@ -49,19 +58,11 @@ pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
     else {
         return Ok(None);
     };
-    let rev_start = revolution_starts(samples, declared.rpm);
     let valid: Vec<_> = samples
         .iter()
         .filter(|s| !s.invalid && s.range_m > 0.0 && s.t_s <= ctx.end_s)
         .collect();
-    let queries: Vec<LidarQuery> = valid
-        .iter()
-        .map(|s| LidarQuery {
-            t_s: s.t_s,
-            rev_start_s: rev_start[&s.rev],
-            angle_deg: s.angle_deg,
-        })
-        .collect();
+    let queries = lidar_queries(samples, &valid, declared.rpm);
     let nominal = ctx
         .physics
         .lidar(ctx.trajectory, &queries, &Hypothesis::nominal());

@@ -199,9 +199,9 @@ pub(crate) struct Classes {
 }
 
 /// Trial `i`'s classes in the independent reality: with probability 1/5 two different
-/// catalogued entries, else one of seventeen classes (none, the fifteen entries, a periodic
-/// range error outside the catalogue), or the `only` one (0 none, 1..=15 the catalogue's
-/// entries, 16 outside).
+/// catalogued entries, else one of eighteen classes (none, the sixteen entries, a periodic
+/// range error outside the catalogue), or the `only` one (0 none, 1..=16 the catalogue's
+/// entries, 17 outside).
 pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize>) -> Classes {
     let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
@@ -277,7 +277,7 @@ pub(crate) fn draw_independent(
 }
 
 /// Draws trial `i`'s effect: none, or one of the catalogue's entries (each with probability
-/// 1/16, or the `only` one: 0 none, 1..=15 the entries in order; `sensor_latency` on a sensor
+/// 1/17, or the `only` one: 0 none, 1..=16 the entries in order; `sensor_latency` on a sensor
 /// drawn among the scenario's), and its parameters from their [`SelfTestRange`]s (the
 /// documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {

@@ -426,7 +426,10 @@ fn dropout_loses_readings_by_returned_power_and_keeps_the_rest_as_they_were() {
             assert_eq!(ra, rb);
             continue;
         }
-        assert!(!ra.invalid, "every reading of the nominal lidar is valid in this room");
+        assert!(
+            !ra.invalid,
+            "every reading of the nominal lidar is valid in this room"
+        );
         lost += 1.0;
     }
     for ra in &a {
@@ -445,5 +448,8 @@ fn dropout_loses_readings_by_returned_power_and_keeps_the_rest_as_they_were() {
         "lost {lost}, expected {expected} ± {}",
         variance.sqrt()
     );
-    assert!(expected > 1000.0 && expected < a.len() as f64 - 1000.0, "{expected}");
+    assert!(
+        expected > 1000.0 && expected < a.len() as f64 - 1000.0,
+        "{expected}"
+    );
 }

@@ -271,8 +271,6 @@ pub fn diagnose_with_progress(
 /// its main structure's score under the lidar effects that each mimic a part of it, while a
 /// real effect beside another simulator's own structure leaves much less (0.8–0.9) standing.
 const MAX_MAIN_LEFT: f64 = 0.95;
-/// Share of the main structure's size (metres) the named effects may leave.
-const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 
 /// The named effects, less those of a sensor whose main structure they do not explain: the
 /// same test (kind and variable) under the sensor's named effects still counts and keeps more
@@ -304,13 +302,15 @@ fn explaining_their_sensor(
             .is_some_and(|after| {
                 after.counts(threshold, &options.floors)
                     && after.score > MAX_MAIN_LEFT * main.score
-                    && after.size_m > MAX_MAIN_SIZE_LEFT * main.size_m
+                    && after.size_m > select::MAX_MAIN_SIZE_LEFT * main.size_m
             })
     };
     named
         .into_iter()
         .filter(|c| !c.effect.moves_readings() || !unexplained_sensor(c.effect.sensor()))
-        .filter(|c| !select::leaves_range_structure(c, left, threshold, &options.floors))
+        .filter(|c| {
+            !select::leaves_range_structure(c, &nominal.evidence, left, threshold, &options.floors)
+        })
         .collect()
 }
 

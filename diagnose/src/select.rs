@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{declared_cone, Left};
 use crate::explain::{self, CandidateFit};
-use crate::locate::{Floors, TestKind};
+use crate::locate::{Evidence, Floors, TestKind};
 use crate::outcome::Options;
 use crate::physics::Hypothesis;
 use crate::residuals::Covariate;
@@ -127,30 +127,45 @@ fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
 /// Whether `c` is a range bias (the lidar's or the sonar's) whose sensor's error, under the
 /// sensor's named effects (`left`), still clusters by range: the residuals' mean still changes
 /// with the range by a departure that counts (significant and above the sensor's floor,
-/// [`crate::locate::Evidence::counts`]). A range bias is a function of the range alone, so
-/// fitted to an error of its own shape it leaves nothing against the range; what it leaves
-/// there is an error of another shape (a periodic one, `A sin(2π d/λ)`, outside the catalogue)
-/// whose slow part its polynomial took up, and that error is not the unit's calibration. The
-/// spread against the range is not asked: a noise other than declared spreads by range beside
-/// a true bias.
+/// [`crate::locate::Evidence::counts`]), or their spread does and keeps more than
+/// [`MAX_MAIN_SIZE_LEFT`] of its size under the nominal model (`nominal`, the sensor's tests). A
+/// range bias is a function of the range alone, so fitted to an error of its own shape it
+/// leaves nothing against the range; what it leaves there is an error of another shape (a
+/// periodic one, `A sin(2π d/λ)`, outside the catalogue) whose slow part its polynomial took
+/// up, and that error is not the unit's calibration. A ripple much shorter than the range's
+/// bins averages out in each bin's mean and shows as their spread instead, which a bias moves
+/// not at all.
 pub(crate) fn leaves_range_structure(
     c: &CandidateFit,
+    nominal: &[Evidence],
     left: &[Left],
     threshold: f64,
     floors: &Floors,
 ) -> bool {
     let sensor = c.effect.sensor();
+    let against_range = |e: &&Evidence, test: TestKind| {
+        e.sensor == sensor && e.test == test && e.covariate == Some(Covariate::Range)
+    };
+    let spread_before = nominal
+        .iter()
+        .find(|e| against_range(e, TestKind::SpreadAgainst))
+        .map_or(f64::INFINITY, |e| e.size_m);
     matches!(c.effect, Effect::LidarRangeBias | Effect::SonarRangeBias)
         && left
             .iter()
             .filter(|l| l.sensor == sensor)
             .flat_map(|l| l.evidence.iter())
+            .filter(|e| e.counts(threshold, floors))
             .any(|e| {
-                e.test == TestKind::BiasAgainst
-                    && e.covariate == Some(Covariate::Range)
-                    && e.counts(threshold, floors)
+                against_range(&e, TestKind::BiasAgainst)
+                    || (against_range(&e, TestKind::SpreadAgainst)
+                        && e.size_m > MAX_MAIN_SIZE_LEFT * spread_before)
             })
 }
+
+/// Share of a sensor's main structure's size (metres) its named effects may leave, and of its
+/// spread against the range a range bias may leave ([`leaves_range_structure`]).
+pub(crate) const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 
 /// The hypothesis of the effects `fits` with their parameters.
 pub(crate) fn hypothesis_of(fits: &[CandidateFit]) -> Hypothesis {
@@ -367,16 +382,20 @@ mod tests {
         }
     }
 
-    /// A range bias that leaves the lidar's mean clustered by range (beyond the floor) is a
-    /// range error of another shape whose slow part it took up: refused. One that leaves it
-    /// within the floor, or leaves structure against another variable or the spread by range,
-    /// is not refused for it; nor is an effect other than a range bias.
+    /// A range bias that leaves the lidar's mean clustered by range (beyond the floor), or its
+    /// spread by range at more than half its nominal size, is a range error of another shape
+    /// whose slow part it took up: refused. One that leaves them within the floor, the spread
+    /// at half its nominal size, or structure against another variable, is not refused for it;
+    /// nor is an effect other than a range bias.
     #[test]
-    fn a_range_bias_leaving_the_mean_clustered_by_range_is_refused() {
+    fn a_range_bias_leaving_the_error_clustered_by_range_is_refused() {
         let floors = Floors::default();
         let bias = fitted(Effect::LidarRangeBias, vec![0.0, 0.01, 0.0]);
-        let refused =
-            |c: &CandidateFit, left: Left| leaves_range_structure(c, &[left], 3.6, &floors);
+        // Under the nominal model the spread by range is 20 mm.
+        let nominal = left_against(TestKind::SpreadAgainst, Covariate::Range, 0.02).evidence;
+        let refused = |c: &CandidateFit, left: Left| {
+            leaves_range_structure(c, &nominal, &[left], 3.6, &floors)
+        };
         assert!(refused(
             &bias,
             left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)
@@ -385,9 +404,13 @@ mod tests {
             &bias,
             left_against(TestKind::BiasAgainst, Covariate::Range, 0.003)
         ));
-        assert!(!refused(
+        assert!(refused(
             &bias,
             left_against(TestKind::SpreadAgainst, Covariate::Range, 0.013)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::SpreadAgainst, Covariate::Range, 0.009)
         ));
         assert!(!refused(
             &bias,

@@ -6,6 +6,7 @@ use hilsim_recording::Recording;
 use crate::align::{self, Aligned, Alignment, Estimates};
 use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
+use crate::dropout;
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
 use crate::explain::{self, CandidateFit};
@@ -181,8 +182,25 @@ pub fn diagnose_with_progress(
     } else {
         named
     };
+    let mut named = named;
+    // The lidar's dropout, fitted on its reads and losses apart from the ranges (it moves none).
+    if let Some(dropout) = dropout::fitted(final_ctx, options) {
+        if dropout::earns_place(&dropout, options) {
+            named.push(dropout.clone());
+            named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+        }
+        candidates.push(dropout);
+        candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    }
     let mut left = structure_left(final_ctx, &data, &nominal, &named);
-    let named = explaining_their_sensor(&nominal, &left, named, options);
+    let mut before = named.len();
+    let mut named = explaining_their_sensor(&nominal, &left, named, options);
+    // An effect refused changes what its sensor's others leave: they are judged again without it.
+    while named.len() < before {
+        left = structure_left(final_ctx, &data, &nominal, &named);
+        before = named.len();
+        named = explaining_their_sensor(&nominal, &left, named, options);
+    }
     // A sensor whose effects were all dropped is left with its nominal structure.
     for l in &mut left {
         if !named.iter().any(|c| c.effect.shows_in(l.sensor)) {
@@ -253,8 +271,6 @@ pub fn diagnose_with_progress(
 /// its main structure's score under the lidar effects that each mimic a part of it, while a
 /// real effect beside another simulator's own structure leaves much less (0.8–0.9) standing.
 const MAX_MAIN_LEFT: f64 = 0.95;
-/// Share of the main structure's size (metres) the named effects may leave.
-const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 
 /// The named effects, less those of a sensor whose main structure they do not explain: the
 /// same test (kind and variable) under the sensor's named effects still counts and keeps more
@@ -262,7 +278,8 @@ const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 /// outside the catalogue (a periodic range error is part reflectivity walk, part warm-up, part
 /// incidence over a room's ranges) gain on held-out data, but leave its shape standing; the
 /// sensor's structure is then unexplained, not theirs. Structure that is not the sensor's main
-/// one (a small nuisance beside a large effect) does not count against them.
+/// one (a small nuisance beside a large effect) does not count against them, except against
+/// a range bias: it must leave nothing clustered by range ([`select::leaves_range_structure`]).
 fn explaining_their_sensor(
     nominal: &Nominal,
     left: &[Left],
@@ -285,12 +302,15 @@ fn explaining_their_sensor(
             .is_some_and(|after| {
                 after.counts(threshold, &options.floors)
                     && after.score > MAX_MAIN_LEFT * main.score
-                    && after.size_m > MAX_MAIN_SIZE_LEFT * main.size_m
+                    && after.size_m > select::MAX_MAIN_SIZE_LEFT * main.size_m
             })
     };
     named
         .into_iter()
-        .filter(|c| !unexplained_sensor(c.effect.sensor()))
+        .filter(|c| !c.effect.moves_readings() || !unexplained_sensor(c.effect.sensor()))
+        .filter(|c| {
+            !select::leaves_range_structure(c, &nominal.evidence, left, threshold, &options.floors)
+        })
         .collect()
 }
 
@@ -306,7 +326,7 @@ fn structure_left(
         .map(|d| {
             let mine: Vec<CandidateFit> = named
                 .iter()
-                .filter(|c| c.effect.shows_in(d.sensor))
+                .filter(|c| c.effect.shows_in(d.sensor) && c.effect.moves_readings())
                 .cloned()
                 .collect();
             let evidence = if mine.is_empty() {

@@ -467,6 +467,8 @@ pub(crate) fn applicable(effect: Effect, ctx: &Context<'_>, sensors: &[Sensor]) 
     match effect {
         // A per-reading lidar already takes each reading at its own instant.
         Effect::LidarMotionSkew => ctx.physics.declared().lidar.is_some_and(|l| l.snapshot),
+        // Fitted on the lidar's reads and losses, not on its ranges (`crate::dropout`).
+        Effect::LidarDropout => false,
         _ => true,
     }
 }

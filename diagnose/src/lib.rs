@@ -21,6 +21,7 @@ pub mod align;
 mod catalogue;
 mod conclude;
 mod diagnosis;
+mod dropout;
 mod error;
 mod estimate;
 pub mod explain;

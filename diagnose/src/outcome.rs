@@ -39,6 +39,11 @@ pub struct Options {
     /// `truth.csv` (the mount's own departure decides); the diagnosis sets
     /// [`ESTIMATED_MOUNT_MIN_M`] against a path estimated from the lidar.
     pub mount_min_m: f64,
+    /// The least share of readings a lidar dropout must lose, beyond those lost at random,
+    /// over the tenth of the readings it loses most, to be named: a unit whose far or grazing
+    /// readings a scan matcher or a map builder gets a twentieth fewer of is not a different
+    /// unit to them, and two simulators' validity rules near a range limit differ by that.
+    pub dropout_min_share: f64,
 }
 
 /// How well the timing of a path estimated from the lidar is known, seconds. Each revolution's
@@ -69,6 +74,7 @@ impl Default for Options {
             misaligned_share: 0.5,
             path_timing_s: 0.0,
             mount_min_m: 0.0,
+            dropout_min_share: 0.05,
         }
     }
 }

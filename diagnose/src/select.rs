@@ -13,15 +13,18 @@
 //! ([`crate::locate::Floors`]) where it changes them most, in metres or in units of their noise: a small difference between the recording and the simulation
 //! that some effect can mimic is not that effect. Against a path estimated from the lidar, a
 //! delay of the sonar or the encoders must also exceed the path's own timing
-//! ([`Options::path_timing_s`]).
+//! ([`Options::path_timing_s`]). A range bias must leave nothing of its sensor's error
+//! clustered by range ([`leaves_range_structure`]).
 
 use rayon::prelude::*;
 
 use crate::catalogue::{Effect, Sensor};
-use crate::conclude::declared_cone;
+use crate::conclude::{declared_cone, Left};
 use crate::explain::{self, CandidateFit};
+use crate::locate::{Evidence, Floors, TestKind};
 use crate::outcome::Options;
 use crate::physics::Hypothesis;
+use crate::residuals::Covariate;
 use crate::residuals::{Context, SensorData};
 
 /// Effects named in one sensor at most (the catalogue's lidar has five; more than three at
@@ -120,6 +123,49 @@ fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
         .first()
         .is_some_and(|d| d.abs() <= options.path_timing_s)
 }
+
+/// Whether `c` is a range bias (the lidar's or the sonar's) whose sensor's error, under the
+/// sensor's named effects (`left`), still clusters by range: the residuals' mean still changes
+/// with the range by a departure that counts (significant and above the sensor's floor,
+/// [`crate::locate::Evidence::counts`]), or their spread does and keeps more than
+/// [`MAX_MAIN_SIZE_LEFT`] of its size under the nominal model (`nominal`, the sensor's tests). A
+/// range bias is a function of the range alone, so fitted to an error of its own shape it
+/// leaves nothing against the range; what it leaves there is an error of another shape (a
+/// periodic one, `A sin(2π d/λ)`, outside the catalogue) whose slow part its polynomial took
+/// up, and that error is not the unit's calibration. A ripple much shorter than the range's
+/// bins averages out in each bin's mean and shows as their spread instead, which a bias moves
+/// not at all.
+pub(crate) fn leaves_range_structure(
+    c: &CandidateFit,
+    nominal: &[Evidence],
+    left: &[Left],
+    threshold: f64,
+    floors: &Floors,
+) -> bool {
+    let sensor = c.effect.sensor();
+    let against_range = |e: &&Evidence, test: TestKind| {
+        e.sensor == sensor && e.test == test && e.covariate == Some(Covariate::Range)
+    };
+    let spread_before = nominal
+        .iter()
+        .find(|e| against_range(e, TestKind::SpreadAgainst))
+        .map_or(f64::INFINITY, |e| e.size_m);
+    matches!(c.effect, Effect::LidarRangeBias | Effect::SonarRangeBias)
+        && left
+            .iter()
+            .filter(|l| l.sensor == sensor)
+            .flat_map(|l| l.evidence.iter())
+            .filter(|e| e.counts(threshold, floors))
+            .any(|e| {
+                against_range(&e, TestKind::BiasAgainst)
+                    || (against_range(&e, TestKind::SpreadAgainst)
+                        && e.size_m > MAX_MAIN_SIZE_LEFT * spread_before)
+            })
+}
+
+/// Share of a sensor's main structure's size (metres) its named effects may leave, and of its
+/// spread against the range a range bias may leave ([`leaves_range_structure`]).
+pub(crate) const MAX_MAIN_SIZE_LEFT: f64 = 0.5;
 
 /// The hypothesis of the effects `fits` with their parameters.
 pub(crate) fn hypothesis_of(fits: &[CandidateFit]) -> Hypothesis {
@@ -312,6 +358,69 @@ mod tests {
             assert!(!earns_place(&short, 15.0, &estimated()), "{effect:?}");
             assert!(earns_place(&fitted(effect, vec![0.03]), 15.0, &estimated()));
         }
+    }
+
+    /// A test of the lidar's residuals against `covariate`, of `size_m`, scored 50 (beyond any
+    /// threshold).
+    fn left_against(test: TestKind, covariate: Covariate, size_m: f64) -> Left {
+        let evidence = crate::locate::Evidence {
+            sensor: Sensor::Lidar,
+            test,
+            covariate: Some(covariate),
+            score: 50.0,
+            place: String::new(),
+            detail: String::new(),
+            range: None,
+            size_m,
+            noise_m: 0.01,
+            world_m: 0.0,
+            beyond_world_m: size_m,
+        };
+        Left {
+            sensor: Sensor::Lidar,
+            evidence: vec![evidence],
+        }
+    }
+
+    /// A range bias that leaves the lidar's mean clustered by range (beyond the floor), or its
+    /// spread by range at more than half its nominal size, is a range error of another shape
+    /// whose slow part it took up: refused. One that leaves them within the floor, the spread
+    /// at half its nominal size, or structure against another variable, is not refused for it;
+    /// nor is an effect other than a range bias.
+    #[test]
+    fn a_range_bias_leaving_the_error_clustered_by_range_is_refused() {
+        let floors = Floors::default();
+        let bias = fitted(Effect::LidarRangeBias, vec![0.0, 0.01, 0.0]);
+        // Under the nominal model the spread by range is 20 mm.
+        let nominal = left_against(TestKind::SpreadAgainst, Covariate::Range, 0.02).evidence;
+        let refused = |c: &CandidateFit, left: Left| {
+            leaves_range_structure(c, &nominal, &[left], 3.6, &floors)
+        };
+        assert!(refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.003)
+        ));
+        assert!(refused(
+            &bias,
+            left_against(TestKind::SpreadAgainst, Covariate::Range, 0.013)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::SpreadAgainst, Covariate::Range, 0.009)
+        ));
+        assert!(!refused(
+            &bias,
+            left_against(TestKind::BiasAgainst, Covariate::Incidence, 0.013)
+        ));
+        let warmup = fitted(Effect::LidarWarmupDrift, vec![-0.002, 15.0, 0.0]);
+        assert!(!refused(
+            &warmup,
+            left_against(TestKind::BiasAgainst, Covariate::Range, 0.013)
+        ));
     }
 
     /// A warm-up whose time constant outlasts the 60 s it was seen over is a constant range

@@ -11,7 +11,7 @@ use hilsim_sim::{rng, scenario, StepState, World};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::effects::LidarEffects;
+use crate::effects::{dropout_probability, BeamReturn, LidarEffects};
 use crate::neato_packet::{rpm_to_fixed, MAX_DISTANCE_MM, READINGS_PER_REVOLUTION};
 use crate::range_model::{ModelError, RangeModel};
 use crate::unit_scans::UnitScans;
@@ -122,6 +122,9 @@ pub struct Lidar {
     byte_strength: bool,
     /// The unit.
     unit: LidarModel,
+    /// `[effects.lidar_dropout]` and the stream its losses are drawn from (a stream of its
+    /// own, so that every other draw, and so every reading it keeps, is the nominal lidar's).
+    dropout: Option<(scenario::LidarDropout, rng::Rng)>,
 }
 
 /// Where the scans come from when the lidar is not the XV-11 as it is.
@@ -199,6 +202,9 @@ impl Lidar {
             min_mm: config.min_range_m * 1000.0,
             max_mm: config.max_range_m * 1000.0,
             rng: rng::stream(seed, "lidar"),
+            dropout: effects
+                .lidar_dropout
+                .map(|d| (d, rng::stream(seed, "lidar.dropout"))),
             rev: 0,
             index: 0,
             rev_start_s: 0.0,
@@ -466,13 +472,8 @@ impl Lidar {
         // The range model sees the distance the unit ranges: the true one unless an effect is on.
         let ranged = self.effects.ranged_m(&ret, t);
         let measured_mm = (self.model.sample(ranged, &mut self.rng) * 1000.0).round();
-        // Diffuse return: proportional to reflectivity and to the cosine of the incidence.
-        let cos_incidence = ret.cos_incidence;
         let speckle: f64 = StandardNormal.sample(&mut self.rng);
-        let strength = STRENGTH_AT_1M
-            * (hit.reflectivity / REFERENCE_REFLECTIVITY)
-            * cos_incidence
-            * d.max(0.05).powf(-STRENGTH_FALLOFF)
+        let strength = expected_strength(d, ret.cos_incidence, hit.reflectivity)
             * (1.0 + STRENGTH_SPREAD * speckle).max(0.0);
         let strength = strength.round().min(f64::from(u16::MAX)) as u16;
         let error = if strength < STRENGTH_INVALID_BELOW {
@@ -481,6 +482,8 @@ impl Lidar {
             Some(ERROR_TOO_CLOSE)
         } else if measured_mm > self.max_mm {
             Some(ERROR_NO_RETURN)
+        } else if self.drops(&ret) {
+            Some(ERROR_WEAK_SIGNAL)
         } else {
             None
         };
@@ -497,6 +500,34 @@ impl Lidar {
         }
         reading
     }
+}
+
+impl Lidar {
+    /// Whether `[effects.lidar_dropout]` loses the return `ret` (never when it is off: no
+    /// number is drawn then).
+    fn drops(&mut self, ret: &BeamReturn) -> bool {
+        let Some((dropout, rng)) = self.dropout.as_mut() else {
+            return false;
+        };
+        let lost = dropout_probability(
+            dropout,
+            ret.hit.distance,
+            ret.cos_incidence,
+            ret.hit.reflectivity,
+        );
+        rng.random::<f64>() < lost
+    }
+}
+
+/// The strength the unit reports on average for a surface of `reflectivity` at `range_m`, met
+/// at `|cos θ|` = `cos_incidence`: a diffuse return, proportional to the reflectivity and to the
+/// cosine of the incidence, falling with the range as the real capture's (before speckle).
+#[must_use]
+pub fn expected_strength(range_m: f64, cos_incidence: f64, reflectivity: f64) -> f64 {
+    STRENGTH_AT_1M
+        * (reflectivity / REFERENCE_REFLECTIVITY)
+        * cos_incidence
+        * range_m.max(0.05).powf(-STRENGTH_FALLOFF)
 }
 
 /// The lidar's pose through one physics step: the robot's pose interpolated as

@@ -60,6 +60,15 @@ pub enum Concealed {
     /// crossed later in the echo's rise, or a transducer's ring-down), and converts that time
     /// too with the speed of sound at `calibrated_at_c`: `c(T) · delay / 2` more range.
     SonarEchoDelay { delay_s: f64, calibrated_at_c: f64 },
+    /// The lidar loses returns too weak to range: the power its camera receives from a diffuse
+    /// surface, relative to its detection threshold, is `(ρ / reference) cos θ (d½ / d)²`
+    /// times a log-normal scatter of `log_power_sd` from reading to reading, and a return below
+    /// the threshold (a relative power under 1) is reported invalid.
+    LidarWeakReturns {
+        half_loss_range_m: f64,
+        log_power_sd: f64,
+        reference: f64,
+    },
     /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
     /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
     /// the sensor, which moves with 1/d; over a room's ranges it reads as a ripple in d).
@@ -86,6 +95,7 @@ impl Concealed {
             Self::WheelBase { .. } => "drive_wheel_base",
             Self::LidarTriangulation { .. } => "lidar_range_bias",
             Self::SonarEchoDelay { .. } => "sonar_range_bias",
+            Self::LidarWeakReturns { .. } => "lidar_dropout",
             Self::LidarPeriodicRange { .. } => "lidar_periodic_range",
         }
     }

@@ -73,6 +73,15 @@ impl Run<'_> {
         let n = &self.nuisances;
         let mut noise = Stream::new(seed, "reality-lidar");
         let mut drops = Stream::new(seed, "reality-lidar-drops");
+        let mut returns = Stream::new(seed, "reality-lidar-returns");
+        let weak = self.concealed.iter().find_map(|c| match *c {
+            Concealed::LidarWeakReturns {
+                half_loss_range_m,
+                log_power_sd,
+                reference,
+            } => Some((half_loss_range_m, log_power_sd, reference)),
+            _ => None,
+        });
         let period = 60.0 / cfg.rpm;
         let slot = period / 360.0;
         let snapshot = cfg.timing == LidarTiming::PerRevolution
@@ -123,10 +132,16 @@ impl Run<'_> {
                     continue;
                 }
                 let reading = self.lidar_reading(cfg, origin, direction, t, e, max_range);
-                let (range, true_range, strength) = match reading {
+                let (range, true_range, strength, power) = match reading {
                     Some(r) => r,
-                    None => (0.0, None, 0.0),
+                    None => (0.0, None, 0.0, 0.0),
                 };
+                // A return whose received power, scattered, falls below the threshold is lost.
+                let lost = weak.is_some_and(|(half_m, sd, reference)| {
+                    let relative = power / reference * half_m * half_m;
+                    relative * (sd * returns.normal()).exp() < 1.0
+                });
+                let range = if lost { 0.0 } else { range };
                 let range = if spurious { spurious_at } else { range };
                 let range = quantise(range, n.lidar_resolution_m);
                 let valid_by = if n.validity_by_true_range && !spurious {
@@ -152,8 +167,9 @@ impl Run<'_> {
         Some(out)
     }
 
-    /// One lidar reading (before rounding and validity): the reported range, the true range
-    /// and the intensity, or `None` when nothing is within reach.
+    /// One lidar reading (before rounding and validity): the reported range, the true range,
+    /// the intensity and the power a diffuse surface returns, `ρ cos θ / d²`, or `None` when
+    /// nothing is within reach.
     fn lidar_reading(
         &self,
         cfg: &hilsim_sim::scenario::Lidar,
@@ -162,7 +178,7 @@ impl Run<'_> {
         t: f64,
         e: f64,
         max_range: f64,
-    ) -> Option<(f64, Option<f64>, f64)> {
+    ) -> Option<(f64, Option<f64>, f64, f64)> {
         let reach = 2.0 * max_range;
         let hit = self.world.cast(origin, direction, reach)?;
         let mut d = hit.range_m;
@@ -228,7 +244,8 @@ impl Run<'_> {
         }
         let intensity =
             INTENSITY_AT_1M * hit.reflectivity / 0.8 * hit.incidence_rad.cos() * d.powf(-0.7);
-        Some((reading.max(0.0), Some(hit.range_m), intensity))
+        let power = hit.reflectivity * hit.incidence_rad.cos() / (hit.range_m * hit.range_m);
+        Some((reading.max(0.0), Some(hit.range_m), intensity, power))
     }
 
     /// The sonar's pings (none where no echo is within range).

@@ -41,12 +41,15 @@ pub enum Effect {
     LidarRangeBias,
     /// `sonar_range_bias`.
     SonarRangeBias,
+    /// `lidar_dropout`: readings missing where the world says the unit would read. Fitted on
+    /// the lidar's readings valid or not (`crate::dropout`), not on the ranges.
+    LidarDropout,
 }
 
 impl Effect {
     /// The whole catalogue, in `interfaces.md` order (`sensor_latency` once per sensor it
     /// concerns).
-    pub const ALL: [Effect; 17] = [
+    pub const ALL: [Effect; 18] = [
         Effect::LidarIncidenceAngle,
         Effect::LidarReflectivity,
         Effect::LidarMixedPixels,
@@ -64,13 +67,14 @@ impl Effect {
         Effect::DriveWheelBase,
         Effect::LidarRangeBias,
         Effect::SonarRangeBias,
+        Effect::LidarDropout,
     ];
 
     /// The catalogue's entries (its names, each once), in `interfaces.md` order.
     ///
     /// ```
     /// use hilsim_diagnose::Effect;
-    /// assert_eq!(Effect::entries().len(), 15);
+    /// assert_eq!(Effect::entries().len(), 16);
     /// assert_eq!(Effect::entries()[10], "sensor_latency");
     /// ```
     #[must_use]
@@ -121,6 +125,7 @@ impl Effect {
             Effect::DriveWheelBase => "drive_wheel_base",
             Effect::LidarRangeBias => "lidar_range_bias",
             Effect::SonarRangeBias => "sonar_range_bias",
+            Effect::LidarDropout => "lidar_dropout",
         }
     }
 
@@ -153,7 +158,9 @@ impl Effect {
     #[must_use]
     pub fn sensor(self) -> Sensor {
         match self {
-            Effect::LidarMountOffset | Effect::LidarRangeBias => Sensor::Lidar,
+            Effect::LidarMountOffset | Effect::LidarRangeBias | Effect::LidarDropout => {
+                Sensor::Lidar
+            }
             Effect::SensorLatency(s) => s,
             Effect::OdometerWheelRadius | Effect::DriveWheelBase => Sensor::Odometer,
             Effect::LidarIncidenceAngle
@@ -183,6 +190,13 @@ impl Effect {
                     Sensor::Drive
                 )
             )
+    }
+
+    /// Whether it changes the values its sensor reads (or where the drive goes): every entry
+    /// but the lidar's dropout, which changes which readings there are, not what they read.
+    #[must_use]
+    pub fn moves_readings(self) -> bool {
+        self != Effect::LidarDropout
     }
 
     /// Its parameters, in the order a [`super::Hypothesis`] holds them.
@@ -395,7 +409,29 @@ impl Effect {
             9,
             R::uniform(0.01, 0.06).signed(),
         )];
+        // The range at which half the returns are lost head-on on the reference surface over
+        // 0.5–50 m on a log grid (a unit that loses half at 50 m loses nothing a room shows),
+        // the spread of the returned log power over 0.05–2 (the loss rising from 12 % to 88 %
+        // over a factor 1.1 to 55 of range). The loss chance is smooth in both, so the
+        // Bernoulli likelihood is unimodal between grid points.
+        const DROPOUT: [ParamSpec; 2] = [
+            log(
+                "half_loss_range_m",
+                "m",
+                (0.5, 50.0),
+                11,
+                R::uniform(3.0, 5.0).unscaled(),
+            ),
+            log(
+                "log_power_spread",
+                "",
+                (0.05, 2.0),
+                7,
+                R::uniform(0.15, 0.4).unscaled(),
+            ),
+        ];
         match self {
+            Effect::LidarDropout => &DROPOUT,
             Effect::LidarMountOffset => &MOUNT,
             Effect::SonarRangeBias => &SONAR_RANGE_BIAS,
             Effect::LidarRangeBias => &RANGE_BIAS,
@@ -525,6 +561,8 @@ impl Effect {
             Effect::OdometerWheelRadius => vec![1.0, 1.0],
             Effect::DriveWheelBase => vec![1.0],
             Effect::OdometerWheelSlip => vec![0.0, 1.0],
+            // Half the returns lost only at the search's far end.
+            Effect::LidarDropout => vec![50.0, 0.3],
             _ => vec![0.0],
         }
     }
@@ -552,7 +590,9 @@ impl Effect {
     ///   wheel's arc differ by 0.1 % (an independent reality's faithful runs fit 0.999);
     /// - wheel base: a scale of 0.0005, 1 mm of turn per 2 m of wheel travel;
     /// - range bias: 1 mm at 2 m, or 1 mm at 0 and 4 m of its scale error or curvature; the
-    ///   sonar's offset 1 mm.
+    ///   sonar's offset 1 mm;
+    /// - dropout: half the returns lost nearer than 25 m (at the search's far end of 50 m a
+    ///   room's readings are lost only in the logistic's tail, which the spread alone sets).
     ///
     /// An effect of several parameters that all describe its size (the mount, the two
     /// wheels, the warm-up's and the incidence's two terms, the range bias's three) departs when any of them does.
@@ -592,6 +632,7 @@ impl Effect {
             Effect::SensorLatency(_) => 0.005,
             Effect::DriveWheelBase => 0.000_5,
             Effect::SonarRangeBias => 0.001,
+            Effect::LidarDropout => 25.0,
             // Returned above.
             Effect::LidarMountOffset
             | Effect::OdometerWheelRadius

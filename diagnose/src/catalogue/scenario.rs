@@ -146,6 +146,13 @@ impl Effect {
                     ..scenario::RangeBias::default()
                 });
             }
+            Effect::LidarDropout => {
+                e.lidar_dropout = Some(scenario::LidarDropout {
+                    half_loss_range_m: p(0),
+                    log_power_spread: p(1),
+                    reference: REFERENCE_REFLECTIVITY,
+                });
+            }
             Effect::DriveWheelBase => {
                 e.drive_wheel_base = Some(scenario::DriveWheelBase {
                     scale: params.first().copied().unwrap_or(1.0),

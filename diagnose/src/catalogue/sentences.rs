@@ -2,7 +2,7 @@
 
 use hilsim_sim::scenario::RangeBias;
 
-use super::{range_bias, Effect};
+use super::{range_bias, Effect, REFERENCE_REFLECTIVITY};
 
 impl Effect {
     /// One sentence: the physics the simulation left out, with the fitted parameters (and the
@@ -93,6 +93,15 @@ impl Effect {
                 "The real sonar reads {:+.1} mm more than the scenario's range bias declares, at \
                  every range: its echo is detected that much later than its calibration says.",
                 p(0) * 1000.0
+            ),
+            Effect::LidarDropout => format!(
+                "The simulated lidar reads every surface within its range; the real one loses \
+                 returns too weak to range: half of them at {:.1} m head-on on a surface of \
+                 reflectivity {REFERENCE_REFLECTIVITY}, nearer at grazing incidence and on darker \
+                 surfaces (head-on, from 12 % lost at {:.1} m to 88 % at {:.1} m).",
+                p(0),
+                p(0) * (-p(1)).exp(),
+                p(0) * p(1).exp()
             ),
         }
     }

@@ -11,6 +11,7 @@
 mod clusters;
 mod data;
 mod drive_filter;
+mod dropout_rows;
 mod likelihood;
 mod path_error;
 mod predict;
@@ -19,5 +20,6 @@ mod sensors;
 pub(crate) use self::clusters::shared_error_clusters;
 pub use self::data::Covariate;
 pub(crate) use self::data::{Context, Predictive, SensorData};
+pub(crate) use self::dropout_rows::{dropout_rows, DropoutRows};
 pub(crate) use self::likelihood::{fits, log_likelihood, rmse, Fit};
 pub(crate) use self::sensors::{drive, lidar, odometer, sonar};

@@ -12,7 +12,7 @@ use hilsim_recording::{OdometrySample, TruthSample};
 /// Margin around a contact of the replayed robot in which the drive is not compared, seconds.
 const CONTACT_MARGIN_S: f64 = 0.5;
 
-fn split(t: f64) -> bool {
+pub(super) fn split(t: f64) -> bool {
     ((t / SPLIT_BLOCK_S).floor() as i64).rem_euclid(2) == 1
 }
 
@@ -29,33 +29,42 @@ fn motion(tr: &Trajectory, t: f64) -> [f64; 3] {
     [v.abs(), accel_at(tr, t), w.abs().to_degrees()]
 }
 
-/// The lidar's valid readings.
-pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
-    let (Some(samples), Some(declared)) = (&ctx.recording.lidar, ctx.physics.declared().lidar)
-    else {
-        return Ok(None);
-    };
-    // Each revolution's start: the timestamp of its reading 0, or extrapolated from its first
-    // reading at the nominal reading period.
-    let period = 60.0 / (declared.rpm * 360.0);
+/// The queries of the `chosen` readings among a lidar's `samples`, each with its revolution's
+/// start: the timestamp of its reading 0, or extrapolated from its first reading at the
+/// nominal reading period of a head turning at `rpm`.
+pub(super) fn lidar_queries(
+    samples: &[hilsim_recording::LidarSample],
+    chosen: &[&hilsim_recording::LidarSample],
+    rpm: f64,
+) -> Vec<LidarQuery> {
+    let period = 60.0 / (rpm * 360.0);
     let mut rev_start = std::collections::HashMap::new();
     for s in samples {
         rev_start
             .entry(s.rev)
             .or_insert(s.t_s - s.angle_deg * period);
     }
-    let valid: Vec<_> = samples
-        .iter()
-        .filter(|s| !s.invalid && s.range_m > 0.0 && s.t_s <= ctx.end_s)
-        .collect();
-    let queries: Vec<LidarQuery> = valid
+    chosen
         .iter()
         .map(|s| LidarQuery {
             t_s: s.t_s,
             rev_start_s: rev_start[&s.rev],
             angle_deg: s.angle_deg,
         })
+        .collect()
+}
+
+/// The lidar's valid readings.
+pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchError> {
+    let (Some(samples), Some(declared)) = (&ctx.recording.lidar, ctx.physics.declared().lidar)
+    else {
+        return Ok(None);
+    };
+    let valid: Vec<_> = samples
+        .iter()
+        .filter(|s| !s.invalid && s.range_m > 0.0 && s.t_s <= ctx.end_s)
         .collect();
+    let queries = lidar_queries(samples, &valid, declared.rpm);
     let nominal = ctx
         .physics
         .lidar(ctx.trajectory, &queries, &Hypothesis::nominal());
@@ -135,7 +144,7 @@ pub(crate) fn lidar(ctx: &Context<'_>) -> Result<Option<SensorData>, MismatchErr
 /// Standard deviations from a range limit within which a reading, and six within which a
 /// true range, are not compared (see [`away_from_limits`]).
 const LIMIT_GUARD_SD: f64 = 3.0;
-const LIMIT_GUARD_TRUE_SD: f64 = 6.0;
+pub(super) const LIMIT_GUARD_TRUE_SD: f64 = 6.0;
 
 /// Which lidar readings are compared: those whose reading and true range are well inside the
 /// range limits. Near a limit the unit's validity rule decides which readings are reported

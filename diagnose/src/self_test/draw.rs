@@ -151,6 +151,13 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
             delay_s: 2.0 * p(0) / speed_of_sound_mps(20.0),
             calibrated_at_c: 20.0,
         },
+        // The same loss written as a power threshold: a logistic of scale s in the log power
+        // has the standard deviation `s π / √3`, given here to a log-normal scatter.
+        Effect::LidarDropout => Concealed::LidarWeakReturns {
+            half_loss_range_m: p(0),
+            log_power_sd: p(1) * std::f64::consts::PI / 3f64.sqrt(),
+            reference: REFERENCE_REFLECTIVITY,
+        },
         Effect::LidarRangeBias => {
             let [c, s, q] = range_bias(values).coefficients();
             let ratio = 1.0 / (1.0 + s).max(0.1);
@@ -192,9 +199,9 @@ pub(crate) struct Classes {
 }
 
 /// Trial `i`'s classes in the independent reality: with probability 1/5 two different
-/// catalogued entries, else one of seventeen classes (none, the fifteen entries, a periodic
-/// range error outside the catalogue), or the `only` one (0 none, 1..=15 the catalogue's
-/// entries, 16 outside).
+/// catalogued entries, else one of eighteen classes (none, the sixteen entries, a periodic
+/// range error outside the catalogue), or the `only` one (0 none, 1..=16 the catalogue's
+/// entries, 17 outside).
 pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize>) -> Classes {
     let entries = Effect::entries().len();
     let two = only.is_none() && d.unit() < TWO_EFFECTS;
@@ -270,7 +277,7 @@ pub(crate) fn draw_independent(
 }
 
 /// Draws trial `i`'s effect: none, or one of the catalogue's entries (each with probability
-/// 1/16, or the `only` one: 0 none, 1..=15 the entries in order; `sensor_latency` on a sensor
+/// 1/17, or the `only` one: 0 none, 1..=16 the entries in order; `sensor_latency` on a sensor
 /// drawn among the scenario's), and its parameters from their [`SelfTestRange`]s (the
 /// documented moderate ranges × `strength`; [`Effect::params`]).
 pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Option<usize>) -> Drawn {

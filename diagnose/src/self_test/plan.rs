@@ -10,7 +10,7 @@ pub struct Plan {
     pub seed: u64,
     /// The drawn parameters' scale (1: the documented moderate ranges).
     pub strength: f64,
-    /// Draw only this class (0: none; 1..=9: the catalogue in order; 10, the independent
+    /// Draw only this class (0: none; 1..=16: the catalogue in order; 17, the independent
     /// reality only: the effect outside the catalogue), or any.
     pub only: Option<usize>,
     /// What makes the "real" recordings.

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{escape, fmt_sig, given_past, mm};
+use super::format::{escape, fit_metric, fit_value, fmt_sig, given_past, mm};
 use crate::locate::Evidence;
 use crate::outcome::{Diagnosis, Verdict};
 
@@ -104,8 +104,8 @@ fn fix(s: &mut String, d: &Diagnosis) {
                     escape(&l.place)
                 )),
                 escape(&params.join(", ")),
-                mm(f.rmse_before),
-                mm(f.rmse_after)
+                fit_value(f, f.rmse_before),
+                fit_value(f, f.rmse_after)
             );
         }
         let _ = writeln!(s, "</table>");
@@ -145,12 +145,13 @@ fn fix(s: &mut String, d: &Diagnosis) {
         }
         let _ = writeln!(
             s,
-            "</table><p>Held-out {} RMSE{}: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
+            "</table><p>Held-out {} {}{}: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
             f.sensor,
+            escape(fit_metric(f)),
             given_past(f),
-            mm(f.rmse_before),
-            mm(f.rmse_after),
-            mm(f.noise_floor),
+            fit_value(f, f.rmse_before),
+            fit_value(f, f.rmse_after),
+            fit_value(f, f.noise_floor),
             f.heldout_n
         );
     }

@@ -41,7 +41,9 @@ fn params_of(f: &CandidateFit) -> (Map<String, Value>, Map<String, Value>) {
 /// place) and with it.
 fn fit_of(f: &CandidateFit) -> Value {
     json!({
-        "metric": "heldout_rmse_m",
+        // The dropout moves no reading: its before and after are of the losses (1 lost, 0
+        // read) less their chances.
+        "metric": if f.effect.moves_readings() { "heldout_rmse_m" } else { "heldout_loss_rms" },
         "sensor": f.sensor.name(),
         "before": num(f.rmse_before),
         "after": num(f.rmse_after),

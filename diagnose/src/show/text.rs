@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{fmt_sig, given_past, mm};
+use super::format::{fit_metric, fit_size, fit_value, fmt_sig, given_past, mm};
 use crate::outcome::Diagnosis;
 
 /// The diagnosis for people: a few lines.
@@ -45,16 +45,17 @@ pub fn summary(d: &Diagnosis) -> String {
         }
         let _ = writeln!(
             s,
-            "  held-out {} RMSE{}: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
+            "  held-out {} {}{}: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
              changes the readings by {})",
             f.sensor,
+            fit_metric(f),
             given_past(f),
-            mm(f.rmse_before),
-            mm(f.rmse_after),
-            mm(f.noise_floor),
+            fit_value(f, f.rmse_before),
+            fit_value(f, f.rmse_after),
+            fit_value(f, f.noise_floor),
             f.heldout_n,
             f.heldout_gain,
-            mm(f.size_m)
+            fit_size(f)
         );
     }
     for w in &d.world {

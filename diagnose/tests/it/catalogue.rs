@@ -463,3 +463,30 @@ fn a_faithful_sparse_run_without_truth_names_nothing_in_the_encoders() {
         assert!(names.is_empty(), "seed {seed}: named {names:?}");
     }
 }
+
+/// A lidar that loses its weak returns (half of them at 3 m head-on, a log-power spread of
+/// 0.3) is named `lidar_dropout` with its half-loss range and spread; the same room recorded
+/// without it names nothing in the lidar.
+#[test]
+fn a_lidar_losing_weak_returns_is_named_dropout_and_a_faithful_one_is_not() {
+    let d = diagnosed(Effect::LidarDropout, &[3.0, 0.3], 17, &of(Sensor::Lidar));
+    let p = named(&d, Effect::LidarDropout);
+    // ~20,000 reads and losses: each parameter's standard error is under 1 %; within 5 %
+    // (the half-loss range) and 10 % (the spread).
+    assert!((p[0] - 3.0).abs() < 0.15, "{p:?}");
+    assert!((p[1] - 0.3).abs() < 0.03, "{p:?}");
+    let names: Vec<Effect> = d.effects.iter().map(|e| e.fit.effect).collect();
+    assert_eq!(names, [Effect::LidarDropout], "{names:?}");
+    let nominal = room();
+    let recording = Emulation::new(&nominal, 17)
+        .expect("the emulation")
+        .run()
+        .recording;
+    let physics = SimPhysics::new(&nominal).expect("the physics");
+    let options = Options {
+        effects: vec![Effect::LidarDropout],
+        ..Options::default()
+    };
+    let faithful = diagnose(&physics, &recording, &options).expect("a diagnosis");
+    assert!(faithful.effects.is_empty(), "{:?}", faithful.verdict);
+}

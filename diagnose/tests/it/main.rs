@@ -6,3 +6,4 @@ mod dead_sensors;
 mod estimated_path;
 mod mismatch;
 mod on_log;
+mod range_shape;

@@ -6,7 +6,7 @@
 //! reading is a deterministic function of the geometry. Tolerances: millimetre rounding (±0.5 mm)
 //! plus rapier's f32 ray casts (a few µm at these ranges); 0.6 mm covers both.
 
-use hilsim_lidar_emulator::effects::{footprint_range_m, sonar_range_scale};
+use hilsim_lidar_emulator::effects::{dropout_probability, footprint_range_m, sonar_range_scale};
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::{LidarSample, Recording};
 use hilsim_sim::pose::Pose;
@@ -400,4 +400,56 @@ fn a_slip_that_braking_does_not_give_back_accumulates_stage_by_stage() {
         );
         assert!((end.right_m - at_rest.right_m - lead).abs() < 1e-9);
     }
+}
+
+/// The lidar's dropout loses each reading with the chance its returned power gives
+/// (`dropout_probability`), and the readings it keeps are the nominal lidar's, noise and all
+/// (its losses are drawn from a stream of their own).
+#[test]
+fn dropout_loses_readings_by_returned_power_and_keeps_the_rest_as_they_were() {
+    let noisy = "[sensors.lidar]\nnoise = [0.01]\nangle_noise_deg = 0.0\n";
+    let mut nominal = scenario("", noisy);
+    nominal.duration_s = Some(10.0);
+    let mut dropping = nominal.clone();
+    let dropout = hilsim_sim::scenario::LidarDropout {
+        half_loss_range_m: 3.5,
+        log_power_spread: 0.3,
+        reference: 0.8,
+    };
+    dropping.effects.lidar_dropout = Some(dropout);
+    let (a, b) = (lidar(&nominal), lidar(&dropping));
+    assert_eq!(a.len(), b.len());
+    let (mut lost, mut expected, mut variance) = (0.0, 0.0, 0.0);
+    for (ra, rb) in a.iter().zip(&b) {
+        assert_eq!((ra.rev, ra.angle_deg), (rb.rev, rb.angle_deg));
+        if !rb.invalid {
+            assert_eq!(ra, rb);
+            continue;
+        }
+        assert!(
+            !ra.invalid,
+            "every reading of the nominal lidar is valid in this room"
+        );
+        lost += 1.0;
+    }
+    for ra in &a {
+        // From the room's centre a wall at bearing φ is met at cos θ = max(|cos φ|, |sin φ|).
+        let phi = ra.angle_deg.to_radians();
+        let cos_incidence = phi.cos().abs().max(phi.sin().abs());
+        let d = ra.true_range_m.unwrap();
+        let p = dropout_probability(&dropout, d, cos_incidence, 0.8);
+        expected += p;
+        variance += p * (1.0 - p);
+    }
+    // ~18,000 readings at 3–4.2 m and 0–45°: the count lost within 5 standard deviations of
+    // the count the model expects.
+    assert!(
+        (lost - expected).abs() < 5.0 * variance.sqrt(),
+        "lost {lost}, expected {expected} ± {}",
+        variance.sqrt()
+    );
+    assert!(
+        expected > 1000.0 && expected < a.len() as f64 - 1000.0,
+        "{expected}"
+    );
 }

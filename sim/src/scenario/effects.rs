@@ -58,6 +58,9 @@ pub struct Effects {
     /// The real sonar's range bias differs from its declared one (`[sensors.sonar] bias`).
     #[serde(default)]
     pub sonar_range_bias: Option<RangeBias>,
+    /// The lidar loses returns too weak to range: far, at grazing incidence, on dark surfaces.
+    #[serde(default)]
+    pub lidar_dropout: Option<LidarDropout>,
 }
 
 impl Effects {
@@ -86,6 +89,7 @@ impl Effects {
             ("drive_wheel_base", self.drive_wheel_base.is_some()),
             ("lidar_range_bias", self.lidar_range_bias.is_some()),
             ("sonar_range_bias", self.sonar_range_bias.is_some()),
+            ("lidar_dropout", self.lidar_dropout.is_some()),
         ];
         on.iter().filter(|(_, o)| *o).map(|(n, _)| *n).collect()
     }
@@ -313,4 +317,30 @@ impl RangeBias {
     pub fn coefficients(&self) -> [f64; 3] {
         [self.offset_m, self.scale_error, self.quadratic_per_m]
     }
+}
+
+/// `[effects.lidar_dropout]`: the lidar loses a return whose power falls below its detection
+/// threshold, and reports the reading invalid. The power a triangulation unit's camera receives
+/// from a diffuse (Lambertian) surface filling its spot goes as `ρ cos θ / d²`; with the power's
+/// reading-to-reading scatter logistic in its logarithm, the chance a reading is lost is
+/// `1 / (1 + e^{−z/s})`, `z = 2 ln(d / d½) − ln cos θ − ln(ρ / ρ_ref)`: half are lost at
+/// `half_loss_range_m` on a surface of the reference reflectivity met head-on, nearer at
+/// grazing incidence and on darker surfaces.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarDropout {
+    /// The range at which half the returns are lost, head-on on a surface of reflectivity
+    /// `reference`, metres.
+    pub half_loss_range_m: f64,
+    /// The scatter of the return's log power from reading to reading (s above): head-on, the
+    /// loss rises from 12 % to 88 % as the range grows by a factor `e^{2s}`.
+    pub log_power_spread: f64,
+    /// The reflectivity `half_loss_range_m` is stated for (default 0.8, the emulator's
+    /// strength reference).
+    #[serde(default = "default_dropout_reference")]
+    pub reference: f64,
+}
+
+fn default_dropout_reference() -> f64 {
+    0.8
 }

@@ -181,5 +181,12 @@ pub(super) fn validate(s: &Scenario) -> Check {
             "a coefficient per metre",
         )?;
     }
+    if let Some(x) = e.lidar_dropout {
+        let p = |k: &'static str| key_path!["effects", "lidar_dropout", k];
+        needs(p("half_loss_range_m"), lidar.is_some(), "lidar")?;
+        positive_up_to(p("half_loss_range_m"), x.half_loss_range_m, 100.0, "metres")?;
+        positive_up_to(p("log_power_spread"), x.log_power_spread, 5.0, "a spread")?;
+        positive_up_to(p("reference"), x.reference, 1.0, "a reflectivity")?;
+    }
     Ok(())
 }

@@ -6,6 +6,7 @@
 //! diagnosis is quick and the verdict is the health check's and the tests' alone.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use hilsim_diagnose::{diagnose, Diagnosis, Options, Sensor, SimPhysics, Verdict};
 use hilsim_fixtures::rooms::ROOM_4X3;
@@ -50,11 +51,16 @@ fn scenario() -> Scenario {
     Scenario::from_toml(&text, Path::new("dead-sensor-room.toml")).expect("the test's scenario")
 }
 
+/// The room's run, recorded once for every test of this module (each changes its own copy).
 fn recording() -> Recording {
-    Emulation::new(&scenario(), 3)
-        .expect("the emulation")
-        .run()
-        .recording
+    static RUN: OnceLock<Recording> = OnceLock::new();
+    RUN.get_or_init(|| {
+        Emulation::new(&scenario(), 3)
+            .expect("the emulation")
+            .run()
+            .recording
+    })
+    .clone()
 }
 
 fn diagnosed(recording: &Recording) -> Diagnosis {

@@ -4,6 +4,8 @@
 //! figures are in docs/diagnose.md, with the commands that make them); each diagnosis tries the
 //! concealed mechanism's sensor's effects, which keeps a debug build's test time to a minute.
 
+use std::sync::OnceLock;
+
 use hilsim_diagnose::self_test::on_log::{
     baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan,
 };
@@ -17,16 +19,21 @@ use crate::catalogue::{of, room};
 
 /// A faithful run of the room, with truth, its encoders without the scenario's systematic
 /// slip (a twin built from a log declares ideal encoders, and names that slip as radii).
+/// Recorded once for every test of this module (each takes its own copy).
 fn log() -> (Scenario, Recording) {
-    let mut room = room();
-    if let Some(odometer) = room.sensors.odometer.as_mut() {
-        odometer.slip = 0.0;
-    }
-    let recording = Emulation::new(&room, 11)
-        .expect("the emulation")
-        .run()
-        .recording;
-    (room, recording)
+    static LOG: OnceLock<(Scenario, Recording)> = OnceLock::new();
+    LOG.get_or_init(|| {
+        let mut room = room();
+        if let Some(odometer) = room.sensors.odometer.as_mut() {
+            odometer.slip = 0.0;
+        }
+        let recording = Emulation::new(&room, 11)
+            .expect("the emulation")
+            .run()
+            .recording;
+        (room, recording)
+    })
+    .clone()
 }
 
 fn trying(sensor: Sensor) -> Options {

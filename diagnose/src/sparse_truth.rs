@@ -9,6 +9,7 @@
 //! At each pose the path is the truth, so whatever the encoders get wrong between poses (a
 //! radius, a base, a delay) is still measured against it.
 
+use hilsim_calibrator::stats::median;
 use hilsim_recording::{OdometrySample, Pose, TruthSample};
 use nalgebra::{DMatrix, DVector};
 
@@ -59,11 +60,7 @@ fn median_step(times: impl Iterator<Item = f64>) -> Option<f64> {
         .map(|w| w[1] - w[0])
         .filter(|d| *d > 0.0)
         .collect();
-    if steps.is_empty() {
-        return None;
-    }
-    let mid = steps.len() / 2;
-    Some(*steps.select_nth_unstable_by(mid, f64::total_cmp).1)
+    (!steps.is_empty()).then(|| median(&mut steps))
 }
 
 /// How far the encoders' travel over a span of a sparse truth departs from the truth's, beyond

@@ -996,20 +996,10 @@ fn realign_lidar(
         } else {
             Vec::new()
         };
-        let mut best: Option<Settled> = None;
-        for contender in std::iter::once(&first).chain(&rivals) {
-            let Some(settled) = settled_in_its_shapes(ctx, aligned, &base, contender, options)?
-            else {
-                continue;
-            };
-            if best
-                .as_ref()
-                .is_none_or(|b| settled.fit.heldout_ll_per_reading > b.fit.heldout_ll_per_reading)
-            {
-                best = Some(settled);
-            }
-        }
-        let Some(Settled { fit, lidar, path }) = best else {
+        let contenders: Vec<&CandidateFit> = std::iter::once(&first).chain(&rivals).collect();
+        let Some(Settled { fit, lidar, path }) =
+            best_settled(ctx, aligned, &base, &contenders, options)?
+        else {
             continue;
         };
         // The plots show the data against the trajectory the verdict rests on.
@@ -1057,37 +1047,36 @@ const RIVAL_SHARE: f64 = 0.1;
 /// How many rivals are settled: each costs a path estimate a round.
 const MAX_RIVALS: usize = 2;
 
-/// `effect` settled along its own path ([`settle`]); a warm-up's two terms apart, each from the
-/// first fit's size, the one the lidar's held-out readings favour kept: the path first takes up
-/// a constant term, the fit then reads the near walls' shift as `k d²`, and rounds that follow
-/// both at once move the drift between them instead of settling it.
-fn settled_in_its_shapes(
+/// Each of `contenders` settled along its own path ([`settle`]), the one the lidar's held-out
+/// readings favour kept (the first on a tie). A warm-up's two terms are settled apart, each
+/// from the first fit's size: the path first takes up a constant term, the fit then reads the
+/// near walls' shift as `k d²`, and rounds that follow both at once move the drift between
+/// them instead of settling it.
+fn best_settled(
     ctx: &Context<'_>,
     aligned: &Aligned,
     base: &Hypothesis,
-    first: &CandidateFit,
+    contenders: &[&CandidateFit],
     options: &Options,
 ) -> Result<Option<Settled>, MismatchError> {
-    let apart: Vec<&[&[usize]]> = if first.effect == Effect::LidarWarmupDrift {
-        first
-            .effect
-            .shapes()
-            .iter()
-            .map(std::slice::from_ref)
-            .collect()
-    } else {
-        vec![first.effect.shapes()]
-    };
     let mut best: Option<Settled> = None;
-    for shapes in apart {
-        let Some(settled) = settle(ctx, aligned, base, first, shapes, options)? else {
-            continue;
+    for &contender in contenders {
+        let effect = contender.effect;
+        let apart: Vec<&[&[usize]]> = if effect == Effect::LidarWarmupDrift {
+            effect.shapes().iter().map(std::slice::from_ref).collect()
+        } else {
+            vec![effect.shapes()]
         };
-        if best
-            .as_ref()
-            .is_none_or(|b| settled.fit.heldout_ll_per_reading > b.fit.heldout_ll_per_reading)
-        {
-            best = Some(settled);
+        for shapes in apart {
+            let Some(settled) = settle(ctx, aligned, base, contender, shapes, options)? else {
+                continue;
+            };
+            if best
+                .as_ref()
+                .is_none_or(|b| settled.fit.heldout_ll_per_reading > b.fit.heldout_ll_per_reading)
+            {
+                best = Some(settled);
+            }
         }
     }
     Ok(best)

@@ -387,41 +387,15 @@ impl<L: SerialLink> Streamer<L> {
         Ok(true)
     }
 
-    /// Writes all of `bytes`, waiting for the link as the pacing allows. Returns `false` when
-    /// the link stayed full (the partial revolution is then discarded).
-    fn write_all(&mut self, mut bytes: &[u8]) -> io::Result<bool> {
-        let wait = match self.pacing {
-            Pacing::Realtime => Duration::from_millis(2),
-            Pacing::Fast if self.reader_reading => FAST_STALL_GRACE,
-            Pacing::Fast => STALL_DETECT,
-            Pacing::Lossless => LOSSLESS_TIMEOUT,
-        };
-        let mut deadline = Instant::now() + wait;
-        while !bytes.is_empty() {
-            match self.link.write(bytes) {
-                Ok(0) => {}
-                Ok(n) => {
-                    self.stats.bytes_written += n as u64;
-                    bytes = &bytes[n..];
-                    deadline = Instant::now() + wait;
-                    continue;
-                }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                Err(e) => return Err(e),
-            }
-            if Instant::now() >= deadline {
-                if self.pacing == Pacing::Lossless {
-                    return Err(io::Error::new(
-                        ErrorKind::TimedOut,
-                        "the reader took nothing for 10 s",
-                    ));
-                }
-                self.stats.bytes_discarded += self.link.backlog()? as u64;
-                self.link.discard_backlog()?;
-                return Ok(false);
-            }
-            thread::sleep(Duration::from_micros(200));
+    /// Writes all of `bytes`, waiting for the link as the pacing allows ([`write_waiting`]).
+    /// Returns `false` when the link stayed full (the partial revolution is then discarded).
+    fn write_all(&mut self, bytes: &[u8]) -> io::Result<bool> {
+        let taken = write_waiting(&mut self.link, bytes, self.pacing, self.reader_reading)?;
+        self.stats.bytes_written += taken as u64;
+        if taken < bytes.len() {
+            self.stats.bytes_discarded += self.link.backlog()? as u64;
+            self.link.discard_backlog()?;
+            return Ok(false);
         }
         Ok(true)
     }
@@ -450,6 +424,55 @@ impl<L: SerialLink> Streamer<L> {
         self.bytes = bytes;
         Ok(all_sent)
     }
+}
+
+/// Writes all of `bytes` to a link that never blocks, waiting while it is full for as long as
+/// `pacing` lets a reader take nothing: 2 ms in real time (live data first), the grace for a
+/// fast stream's reader that has been reading ([`FAST_STALL_GRACE`]), [`STALL_DETECT`] for one
+/// that never has, [`LOSSLESS_TIMEOUT`] for hilsim's own reader (then an error). Every byte the
+/// link takes restarts the wait. Returns how many bytes the link took: fewer than `bytes` only
+/// when the reader stalled.
+///
+/// # Errors
+/// The link failed, or a lossless stream's reader took nothing for [`LOSSLESS_TIMEOUT`].
+pub(crate) fn write_waiting<L: SerialLink + ?Sized>(
+    link: &mut L,
+    bytes: &[u8],
+    pacing: Pacing,
+    reader_reading: bool,
+) -> io::Result<usize> {
+    let patience = match pacing {
+        Pacing::Realtime => Duration::from_millis(2),
+        Pacing::Fast if reader_reading => FAST_STALL_GRACE,
+        Pacing::Fast => STALL_DETECT,
+        Pacing::Lossless => LOSSLESS_TIMEOUT,
+    };
+    let mut taken = 0;
+    let mut deadline = Instant::now() + patience;
+    while taken < bytes.len() {
+        match link.write(&bytes[taken..]) {
+            Ok(0) => {}
+            Ok(n) => {
+                taken += n;
+                deadline = Instant::now() + patience;
+                continue;
+            }
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        }
+        if Instant::now() >= deadline {
+            if pacing == Pacing::Lossless {
+                return Err(io::Error::new(
+                    ErrorKind::TimedOut,
+                    "the reader took nothing for 10 s",
+                ));
+            }
+            break;
+        }
+        thread::sleep(Duration::from_micros(200));
+    }
+    Ok(taken)
 }
 
 /// The OS may wake a sleeper late by its timer slack (~50 µs) or more; sleep to just before

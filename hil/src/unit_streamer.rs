@@ -6,7 +6,7 @@
 //! speaks through a [`Unit`], a pure state machine, and this streamer only moves its bytes and
 //! keeps time.
 
-use std::io::{self, ErrorKind};
+use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::{Duration, Instant};
@@ -15,7 +15,7 @@ use hilsim_lidar_protocols::{Output, PacketSpan, Unit, UnitReading};
 
 use crate::faults::{FaultCounts, WireFaults};
 use crate::link::SerialLink;
-use crate::streamer::{Pacing, StreamStats, FAST_STALL_GRACE, STALL_DETECT};
+use crate::streamer::{write_waiting, Pacing, StreamStats, FAST_STALL_GRACE, STALL_DETECT};
 
 /// How long the streamer sleeps between looks at the host's commands while it waits: a
 /// command is answered within about this (a real unit answers within a few milliseconds).
@@ -292,22 +292,18 @@ impl<L: SerialLink> UnitStreamer<L> {
         Ok(())
     }
 
-    /// Writes `bytes` without blocking; `false` when the link could not take them all.
+    /// Writes `bytes`, waiting for the link as the pacing allows ([`write_waiting`]); `false`
+    /// when the reader stalled, whose backlog (with the partial packet) is then thrown away.
     fn write_all(&mut self, bytes: &[u8]) -> io::Result<bool> {
-        let mut at = 0;
-        while at < bytes.len() {
-            match self.link.write(&bytes[at..]) {
-                Ok(0) => break,
-                Ok(n) => at += n,
-                Err(err) if err.kind() == ErrorKind::Interrupted => {}
-                Err(err) if matches!(err.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
-                    break
-                }
-                Err(err) => return Err(err),
-            }
+        let taken = write_waiting(&mut self.link, bytes, self.pacing, self.reader_reading)?;
+        self.stats.bytes_written += taken as u64;
+        if taken < bytes.len() {
+            self.stats.bytes_discarded += self.link.backlog()? as u64;
+            self.link.discard_backlog()?;
+            self.reader_reading = false;
+            return Ok(false);
         }
-        self.stats.bytes_written += at as u64;
-        Ok(at == bytes.len())
+        Ok(true)
     }
 
     /// Brings the backlog under one revolution at a revolution's start: waits for a reader
@@ -349,6 +345,7 @@ impl<L: SerialLink> UnitStreamer<L> {
 mod tests {
     use super::*;
     use crate::MemoryLink;
+    use std::io::ErrorKind;
 
     /// A toy command-driven unit: `S` starts it, `T` stops it, `I` asks for its info; each
     /// reading is a 3-byte packet.
@@ -441,6 +438,75 @@ mod tests {
         // Inside the silent second: neither the reply nor the packet comes.
         assert!(s.link().take().is_empty());
         assert_eq!(s.fault_counts().unwrap().silenced_packets, 2);
+    }
+
+    /// A link whose reader takes `per_wait` bytes each time the writer finds it full: a reader
+    /// slower than the stream, but reading.
+    struct SlowReaderLink {
+        queue: Vec<u8>,
+        capacity: usize,
+        per_wait: usize,
+        received: Vec<u8>,
+    }
+
+    impl std::io::Write for SlowReaderLink {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            let room = self.capacity - self.queue.len();
+            if room == 0 {
+                let n = self.per_wait.min(self.queue.len());
+                self.received.extend(self.queue.drain(..n));
+                return Err(ErrorKind::WouldBlock.into());
+            }
+            let n = room.min(buf.len());
+            self.queue.extend_from_slice(&buf[..n]);
+            Ok(n)
+        }
+
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl SerialLink for SlowReaderLink {
+        fn backlog(&mut self) -> io::Result<usize> {
+            // Time passes while the stream looks: the reader takes its share.
+            let n = self.per_wait.min(self.queue.len());
+            self.received.extend(self.queue.drain(..n));
+            Ok(self.queue.len())
+        }
+
+        fn discard_backlog(&mut self) -> io::Result<()> {
+            self.queue.clear();
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_fast_streams_reader_that_reads_slowly_loses_nothing() {
+        let stop = AtomicBool::new(false);
+        // A link that holds less than a packet's worth beyond a revolution: every revolution
+        // meets a full link, as a pty does behind a descheduled reader.
+        let link = SlowReaderLink {
+            queue: Vec::new(),
+            capacity: 40,
+            per_wait: 7,
+            received: Vec::new(),
+        };
+        let mut s = UnitStreamer::new(link, Box::new(ToyUnit { scanning: true }), Pacing::Fast);
+        s.reader_connected();
+        for k in 0..2_000 {
+            s.take(&reading(k), &stop).unwrap();
+        }
+        let link = s.link();
+        let mut received = std::mem::take(&mut link.received);
+        received.append(&mut link.queue);
+        let expected: Vec<u8> = (0..2_000)
+            .flat_map(|k| [0xAB, (k % 10) as u8, (100 + k) as u8])
+            .collect();
+        assert_eq!(received.len(), expected.len());
+        assert!(received == expected, "the stream lost or reordered bytes");
+        assert_eq!(s.stats().revolutions_dropped, 0);
+        assert_eq!(s.stats().bytes_discarded, 0);
     }
 
     #[test]

@@ -39,7 +39,7 @@ impl Alignment {
     pub fn name(self) -> &'static str {
         match self {
             Alignment::Truth => "truth.csv",
-            Alignment::Estimated => "estimated (replayed commands + scan-to-map matching)",
+            Alignment::Estimated => "estimated (scan-to-map matching)",
         }
     }
 }
@@ -335,6 +335,7 @@ pub(crate) fn along_encoders(
         &Hypothesis::nominal(),
         DeadReckoning::Encoders,
     )?;
-    Ok((reckoned == DeadReckoning::Encoders)
+    Ok(reckoned
+        .follows_the_encoders()
         .then(|| aligned.estimated_again(trajectory, sd, reckoned, Hypothesis::nominal())))
 }

@@ -654,7 +654,10 @@ fn gather(
         .is_some_and(|o| !o.is_empty())
         && ctx.physics.declared().odometer;
     // The encoders judged against a path that follows them would be judged against themselves.
-    let odometer = if aligned.reckoned == Some(DeadReckoning::Encoders) {
+    let odometer = if aligned
+        .reckoned
+        .is_some_and(DeadReckoning::follows_the_encoders)
+    {
         if has_odometry {
             notes.push(
                 "the odometer is not diagnosed: without truth.csv or commands, the only path \

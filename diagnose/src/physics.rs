@@ -84,6 +84,11 @@ pub struct Declared {
     pub odometer: bool,
     /// The declared actuation error (zero for an ideal drive).
     pub actuation: DeclaredActuation,
+    /// The path the scenario's robot follows (`[robot] path`), when it declares one: a twin's,
+    /// which `hilsim world` matched to the log's own scans. An estimate of the real trajectory
+    /// starts from it rather than from the encoders' bare integration, whose drift over a long
+    /// run is more than a revolution's match can take back.
+    pub path: Option<Trajectory>,
 }
 
 /// The declared actuation error: the wheels turn at `command × (1 + scale + wander(t))`, one
@@ -213,7 +218,7 @@ pub struct OdometryPrediction {
 ///         mount: Default::default(), world_uncertainty_m: 0.0,
 ///     }),
 ///     sonar_half_angle_deg: None, odometer: false,
-///     actuation: Default::default(),
+///     actuation: Default::default(), path: None,
 /// });
 /// let still = Trajectory::new(&physics.drive(&[], 1.0, &Hypothesis::nominal()))?;
 /// let ahead = physics.lidar(&still, &[LidarQuery { t_s: 0.5, rev_start_s: 0.4, angle_deg: 0.0 }],

@@ -118,6 +118,12 @@ impl SimPhysics {
                     wander_sd: a.wander_sd,
                     wander_tau_s: a.wander_tau_s,
                 },
+                path: s
+                    .files
+                    .path
+                    .as_ref()
+                    .map(|path| Trajectory::from_poses(path.iter()))
+                    .transpose()?,
             },
             world,
             scenario: scenario.clone(),

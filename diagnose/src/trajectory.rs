@@ -33,39 +33,45 @@ impl Trajectory {
     /// # Errors
     /// No samples, a non-finite value, or time going backwards.
     pub fn new(samples: &[TruthSample]) -> Result<Self, MismatchError> {
-        if samples.is_empty() {
-            return Err(MismatchError::Input("the trajectory has no poses".into()));
-        }
-        let mut path = TimedPath::with_capacity(samples.len());
-        for s in samples {
-            if ![s.t_s, s.x_m, s.y_m, s.yaw_rad]
-                .iter()
-                .all(|v| v.is_finite())
-            {
-                return Err(MismatchError::Input(format!(
-                    "a pose at t = {} s is not finite",
-                    s.t_s
-                )));
-            }
-            if let Some(&last) = path.times().last() {
-                if s.t_s < last {
-                    return Err(MismatchError::Input(format!(
-                        "the trajectory's time goes backwards at {} s",
-                        s.t_s
-                    )));
-                }
-                if s.t_s == last {
-                    continue;
-                }
-            }
-            path.push(
+        Self::from_poses(samples.iter().map(|s| {
+            (
                 s.t_s,
                 Pose {
                     x: s.x_m,
                     y: s.y_m,
                     yaw: s.yaw_rad,
                 },
-            );
+            )
+        }))
+    }
+
+    /// A trajectory through `(t_s, pose)` pairs, as [`Trajectory::new`].
+    ///
+    /// # Errors
+    /// As [`Trajectory::new`].
+    pub fn from_poses(poses: impl IntoIterator<Item = (f64, Pose)>) -> Result<Self, MismatchError> {
+        let poses = poses.into_iter();
+        let mut path = TimedPath::with_capacity(poses.size_hint().0);
+        for (t_s, p) in poses {
+            if ![t_s, p.x, p.y, p.yaw].iter().all(|v| v.is_finite()) {
+                return Err(MismatchError::Input(format!(
+                    "a pose at t = {t_s} s is not finite"
+                )));
+            }
+            if let Some(&last) = path.times().last() {
+                if t_s < last {
+                    return Err(MismatchError::Input(format!(
+                        "the trajectory's time goes backwards at {t_s} s"
+                    )));
+                }
+                if t_s == last {
+                    continue;
+                }
+            }
+            path.push(t_s, p);
+        }
+        if path.times().is_empty() {
+            return Err(MismatchError::Input("the trajectory has no poses".into()));
         }
         Ok(Self { path })
     }

@@ -388,16 +388,14 @@ impl<L: SerialLink> Streamer<L> {
     }
 
     /// Writes all of `bytes`, waiting for the link as the pacing allows ([`write_waiting`]).
-    /// Returns `false` when the link stayed full (the partial revolution is then discarded).
     fn write_all(&mut self, bytes: &[u8]) -> io::Result<bool> {
-        let taken = write_waiting(&mut self.link, bytes, self.pacing, self.reader_reading)?;
-        self.stats.bytes_written += taken as u64;
-        if taken < bytes.len() {
-            self.stats.bytes_discarded += self.link.backlog()? as u64;
-            self.link.discard_backlog()?;
-            return Ok(false);
-        }
-        Ok(true)
+        write_waiting(
+            &mut self.link,
+            bytes,
+            self.pacing,
+            &mut self.reader_reading,
+            &mut self.stats,
+        )
     }
 
     /// Writes the revolution packet by packet, each when its last reading has been taken.
@@ -430,8 +428,9 @@ impl<L: SerialLink> Streamer<L> {
 /// `pacing` lets a reader take nothing: 2 ms in real time (live data first), the grace for a
 /// fast stream's reader that has been reading ([`FAST_STALL_GRACE`]), [`STALL_DETECT`] for one
 /// that never has, [`LOSSLESS_TIMEOUT`] for hilsim's own reader (then an error). Every byte the
-/// link takes restarts the wait. Returns how many bytes the link took: fewer than `bytes` only
-/// when the reader stalled.
+/// link takes restarts the wait. Returns `false` when the reader stalled: what it left (a
+/// partial packet with it) is then thrown away, counted in `stats`, and the reader is no longer
+/// waited for until it reads again.
 ///
 /// # Errors
 /// The link failed, or a lossless stream's reader took nothing for [`LOSSLESS_TIMEOUT`].
@@ -439,11 +438,12 @@ pub(crate) fn write_waiting<L: SerialLink + ?Sized>(
     link: &mut L,
     bytes: &[u8],
     pacing: Pacing,
-    reader_reading: bool,
-) -> io::Result<usize> {
+    reader_reading: &mut bool,
+    stats: &mut StreamStats,
+) -> io::Result<bool> {
     let patience = match pacing {
         Pacing::Realtime => Duration::from_millis(2),
-        Pacing::Fast if reader_reading => FAST_STALL_GRACE,
+        Pacing::Fast if *reader_reading => FAST_STALL_GRACE,
         Pacing::Fast => STALL_DETECT,
         Pacing::Lossless => LOSSLESS_TIMEOUT,
     };
@@ -454,6 +454,7 @@ pub(crate) fn write_waiting<L: SerialLink + ?Sized>(
             Ok(0) => {}
             Ok(n) => {
                 taken += n;
+                stats.bytes_written += n as u64;
                 deadline = Instant::now() + patience;
                 continue;
             }
@@ -468,11 +469,14 @@ pub(crate) fn write_waiting<L: SerialLink + ?Sized>(
                     "the reader took nothing for 10 s",
                 ));
             }
-            break;
+            stats.bytes_discarded += link.backlog()? as u64;
+            link.discard_backlog()?;
+            *reader_reading = false;
+            return Ok(false);
         }
         thread::sleep(Duration::from_micros(200));
     }
-    Ok(taken)
+    Ok(true)
 }
 
 /// The OS may wake a sleeper late by its timer slack (~50 µs) or more; sleep to just before

@@ -292,18 +292,15 @@ impl<L: SerialLink> UnitStreamer<L> {
         Ok(())
     }
 
-    /// Writes `bytes`, waiting for the link as the pacing allows ([`write_waiting`]); `false`
-    /// when the reader stalled, whose backlog (with the partial packet) is then thrown away.
+    /// Writes `bytes`, waiting for the link as the pacing allows ([`write_waiting`]).
     fn write_all(&mut self, bytes: &[u8]) -> io::Result<bool> {
-        let taken = write_waiting(&mut self.link, bytes, self.pacing, self.reader_reading)?;
-        self.stats.bytes_written += taken as u64;
-        if taken < bytes.len() {
-            self.stats.bytes_discarded += self.link.backlog()? as u64;
-            self.link.discard_backlog()?;
-            self.reader_reading = false;
-            return Ok(false);
-        }
-        Ok(true)
+        write_waiting(
+            &mut self.link,
+            bytes,
+            self.pacing,
+            &mut self.reader_reading,
+            &mut self.stats,
+        )
     }
 
     /// Brings the backlog under one revolution at a revolution's start: waits for a reader

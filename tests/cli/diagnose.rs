@@ -212,10 +212,7 @@ fn without_truth_the_trajectory_is_estimated() {
         ],
     );
     let j = json(&out);
-    assert_eq!(
-        j["alignment"],
-        "estimated (replayed commands + scan-to-map matching)"
-    );
+    assert_eq!(j["alignment"], "estimated (scan-to-map matching)");
     // The page's map draws the path every sensor was judged against, named as estimated.
     let map = std::fs::read_to_string(tmp.path().join("rep/map.svg")).unwrap();
     assert!(map.contains("path estimated from the lidar"), "{map}");

@@ -153,3 +153,85 @@ fn what_is_in_the_way_or_missing_is_one_line() {
     ));
     assert!(err.contains("--resolution-m"), "{err}");
 }
+
+/// The room's drive, longer, on wheels 6 % long and 4 % short: the commands replayed through
+/// the nominal drive turn away from the real path faster than a revolution's match follows.
+const LONGER_ON_WRONG_WHEELS: &str = "
+[[drive]]
+turn_deg = 120.0
+[[drive]]
+speed_mps = 0.3
+distance_m = 1.2
+[[drive]]
+turn_deg = -150.0
+[[drive]]
+speed_mps = 0.3
+distance_m = 1.0
+[effects.odometer_wheel_radius]
+left_scale = 1.06
+right_scale = 0.96
+";
+
+/// A log without truth diagnosed against its own twin: the twin's path (the encoders already
+/// matched to the scans) carries the trajectory's estimate where the commands' replay loses the
+/// robot, and where the log has no commands. Along the commands the diagnosis named a lidar
+/// mount at its search's bound. The lidar is as declared: no physics is named (at most a
+/// mismatch within the map's cells).
+#[test]
+fn a_twins_path_carries_the_estimate_where_the_commands_lose_the_robot() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("room.toml"),
+        format!("{ROOM}{LONGER_ON_WRONG_WHEELS}"),
+    )
+    .unwrap();
+    let out = hilsim(tmp.path(), &["record", "room.toml", "--out", "rec"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_file(tmp.path().join("rec/truth.csv")).unwrap();
+    let out = hilsim(tmp.path(), &["world", "rec", "--out", "twin/room.toml"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let diagnose = |rec: &str| {
+        let out = hilsim(
+            tmp.path(),
+            &[
+                "diagnose",
+                "--sim",
+                "twin/room.toml",
+                "--real",
+                rec,
+                "--json",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_str(stdout(&out).trim()).unwrap();
+        json
+    };
+    let along_commands = diagnose("rec");
+    // The log without commands: the header alone.
+    std::fs::create_dir(tmp.path().join("no-commands")).unwrap();
+    for file in ["meta.toml", "lidar.csv", "odometry.csv"] {
+        std::fs::copy(
+            tmp.path().join("rec").join(file),
+            tmp.path().join("no-commands").join(file),
+        )
+        .unwrap();
+    }
+    std::fs::write(
+        tmp.path().join("no-commands/commands.csv"),
+        "t_s,left_mps,right_mps\n",
+    )
+    .unwrap();
+    let without_commands = diagnose("no-commands");
+    for json in [along_commands, without_commands] {
+        let effect = json["effect"].as_str().unwrap();
+        assert!(
+            ["none", "world_mismatch"].contains(&effect),
+            "{effect}: {}",
+            json["explanation"]
+        );
+        assert_eq!(
+            json["references"]["lidar"], "lidar-estimated path (the scenario's path between scans)",
+            "{json}"
+        );
+    }
+}

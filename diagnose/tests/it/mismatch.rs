@@ -71,6 +71,7 @@ impl Corridor {
                 sonar_half_angle_deg: None,
                 odometer: false,
                 actuation: Default::default(),
+                path: None,
             },
         }
     }

@@ -4,7 +4,7 @@
 use hilsim_recording::Recording;
 
 use crate::align::{self, Aligned, Alignment, Estimates};
-use crate::catalogue::{Effect, Sensor};
+use crate::catalogue::{Effect, SearchLimits, Sensor};
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
 use crate::dropout;
 use crate::error::MismatchError;
@@ -19,6 +19,7 @@ use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, Covariate, SensorData};
 use crate::select::{self, hypothesis_of, Selection};
+use hilsim_report::svg::fmt_sig;
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
 /// it (against an estimated trajectory only); they stop once each free parameter moves by less
@@ -201,6 +202,11 @@ pub fn diagnose_with_progress(
         before = named.len();
         named = explaining_their_sensor(&nominal, &left, named, options);
     }
+    let before = named.len();
+    named = within_the_search(named, &mut notes);
+    if named.len() < before {
+        left = structure_left(final_ctx, &data, &nominal, &named);
+    }
     nominal_where_none_named(&mut left, &named, &nominal);
     if final_ctx.estimated {
         let before = named.len();
@@ -273,6 +279,40 @@ fn nominal_where_none_named(left: &mut [Left], named: &[CandidateFit], nominal: 
                 .collect();
         }
     }
+}
+
+/// The named effects, less those whose fit sits at a limit of its search
+/// ([`SearchLimits::at_limit`]): the likelihood still rose there, so the value is a bound, not
+/// an estimate, and its standard error (the curvature at a point that is no maximum) means
+/// nothing. What the log shows is then something the effect bends towards without taking its
+/// shape, a world built wrong, or a path the matches lost; `notes` says which parameter stopped
+/// where, and what it would explain is left unexplained.
+fn within_the_search(named: Vec<CandidateFit>, notes: &mut Vec<String>) -> Vec<CandidateFit> {
+    named
+        .into_iter()
+        .filter(|c| {
+            let Some((spec, value)) = c
+                .effect
+                .params()
+                .iter()
+                .zip(&c.params)
+                .find(|(spec, &value)| SearchLimits::at_limit(spec, value))
+            else {
+                return true;
+            };
+            notes.push(format!(
+                "{} is not named: its best fit stops at the edge of its search ({} = {} {}, \
+                 searched over {} to {}), so its size is not identifiable from this log",
+                c.effect.name(),
+                spec.name,
+                fmt_sig(*value),
+                spec.unit,
+                fmt_sig(spec.lo),
+                fmt_sig(spec.hi),
+            ));
+            false
+        })
+        .collect()
 }
 
 /// The named effects, less a wheel radius within what the lidar's error left by range can
@@ -1201,7 +1241,10 @@ fn settle(
 
 #[cfg(test)]
 mod tests {
-    use super::{fixed_point_step, within_the_paths_scale, REALIGN_ROUNDS, REALIGN_SETTLED};
+    use super::{
+        fixed_point_step, within_the_paths_scale, within_the_search, REALIGN_ROUNDS,
+        REALIGN_SETTLED,
+    };
     use crate::catalogue::{Effect, Sensor};
     use crate::conclude::Left;
     use crate::explain::CandidateFit;
@@ -1277,6 +1320,37 @@ mod tests {
             &mut notes,
         );
         assert_eq!(kept.len(), 1);
+        assert!(notes.is_empty(), "{notes:?}");
+    }
+
+    #[test]
+    fn a_fit_stopped_at_its_searchs_edge_is_not_named_and_a_form_at_its_end_is() {
+        let mount = |yaw_deg: f64, y_m: f64| CandidateFit {
+            effect: Effect::LidarMountOffset,
+            sensor: Sensor::Lidar,
+            params: vec![yaw_deg, 0.03, y_m],
+            ..wheels(1.0, 1.0)
+        };
+        let slip = |braking_share: f64| CandidateFit {
+            effect: Effect::OdometerWheelSlip,
+            params: vec![0.05, braking_share],
+            ..wheels(1.0, 1.0)
+        };
+        let mut notes = Vec::new();
+        let kept = within_the_search(
+            vec![mount(-7.98, 0.0), mount(-5.6, -0.1), mount(2.5, 0.02)],
+            &mut notes,
+        );
+        assert_eq!(kept.len(), 1);
+        assert!((kept[0].params[0] - 2.5).abs() < 1e-12);
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(notes[0].contains("yaw_deg = -7.98 deg"), "{notes:?}");
+        assert!(notes[1].contains("y_m = -0.100 m"), "{notes:?}");
+        assert!(notes[1].contains("not identifiable"), "{notes:?}");
+        // A braking share of −1 is a form of slip (a lead gained at every change of speed),
+        // not a limit: named.
+        let mut notes = Vec::new();
+        assert_eq!(within_the_search(vec![slip(-1.0)], &mut notes).len(), 1);
         assert!(notes.is_empty(), "{notes:?}");
     }
 

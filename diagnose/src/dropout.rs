@@ -101,6 +101,35 @@ fn brier_rms(lost: &[bool], p: impl Iterator<Item = f64>) -> f64 {
     (sum / n.max(1) as f64).sqrt()
 }
 
+/// How much more the losses vary between revolutions than independent readings would: the sum
+/// over revolutions of the squared excess of losses (lost less its chance, summed in the
+/// revolution) over the binomial variance those sums would have, at least 1. Losses cluster (a
+/// dark wall or a pane of glass loses every beam that meets it in a revolution, and again in
+/// the next), so the readings are fewer independent trials than they look; the standard errors
+/// are scaled by its root, the quasi-likelihood dispersion of a binomial model with clustered
+/// trials (McCullagh and Nelder, *Generalized Linear Models*, 2nd ed., sec. 4.5). `revolution`
+/// is each reading's, in the order of `lost` and `p`, with each revolution's readings together.
+fn dispersion(lost: &[bool], p: &[f64], revolution: &[u64]) -> f64 {
+    let (mut excess, mut variance) = (0.0, 0.0);
+    let mut k = 0;
+    while k < lost.len() {
+        let (mut sum, mut var) = (0.0, 0.0);
+        let rev = revolution[k];
+        while k < lost.len() && revolution[k] == rev {
+            sum += f64::from(u8::from(lost[k])) - p[k];
+            var += p[k] * (1.0 - p[k]);
+            k += 1;
+        }
+        excess += sum * sum;
+        variance += var;
+    }
+    if variance > 0.0 {
+        (excess / variance).max(1.0)
+    } else {
+        1.0
+    }
+}
+
 /// The lidar's dropout fitted on the training half of `rows` and scored on the held-out half
 /// against the loss at random; `None` when a half has no rows.
 pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
@@ -123,8 +152,23 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
         log_likelihood(&train_lost, &q, profiled_p0(&train_lost, &q))
     };
     let (params, best) = maximize(specs, &mut train_ll);
-    let param_sd = standard_errors(specs, &params, best, &mut train_ll, 0.01);
     let p0 = profiled_p0(&train_lost, &power_loss(rows, &train, &params));
+    let p_train: Vec<f64> = power_loss(rows, &train, &params)
+        .iter()
+        .map(|q| p0 + (1.0 - p0) * q)
+        .collect();
+    let spread = dispersion(
+        &train_lost,
+        &p_train,
+        &train
+            .iter()
+            .map(|&i| rows.revolution[i])
+            .collect::<Vec<_>>(),
+    );
+    let param_sd: Vec<f64> = standard_errors(specs, &params, best, &mut train_ll, 0.01)
+        .into_iter()
+        .map(|sd| sd * spread.sqrt())
+        .collect();
     let q_held = power_loss(rows, &held, &params);
     let p_held: Vec<f64> = q_held.iter().map(|q| p0 + (1.0 - p0) * q).collect();
     let held_ll = log_likelihood(&held_lost, &q_held, p0);
@@ -183,6 +227,17 @@ pub(crate) fn fitted(ctx: &Context<'_>, options: &Options) -> Option<CandidateFi
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from xorshift64* seeded with `state`: a fixed stream for a
+    /// fixed test.
+    fn uniform_stream(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state >> 12;
+            state ^= state << 25;
+            state ^= state >> 27;
+            (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// Rows at ranges 0.5–6 m head-on on the reference surface, each lost with the loss by
     /// power at (4 m, 0.3) on top of 1 % lost at random, drawn from a fixed stream.
     fn rows(n: usize) -> DropoutRows {
@@ -191,14 +246,7 @@ mod tests {
             log_power_spread: 0.3,
             reference: REFERENCE_REFLECTIVITY,
         };
-        let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
-        let mut unit = || {
-            // xorshift64*: a fixed stream for a fixed test.
-            state ^= state >> 12;
-            state ^= state << 25;
-            state ^= state >> 27;
-            (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = uniform_stream(0x9e37_79b9_7f4a_7c15);
         let mut r = DropoutRows::default();
         for i in 0..n {
             let d = 0.5 + 5.5 * (i as f64 + 0.5) / n as f64;
@@ -209,8 +257,30 @@ mod tests {
             r.reflectivity.push(0.55);
             r.lost.push(unit() < p);
             r.heldout.push(i % 2 == 1);
+            r.revolution.push((i / 100) as u64);
         }
         r
+    }
+
+    /// Losses drawn one by one spread as a binomial's (dispersion near 1); losses of whole
+    /// revolutions (a wall lost at once) spread as many times more as a revolution has readings.
+    #[test]
+    fn losses_clustered_by_revolution_widen_the_errors_and_independent_ones_do_not() {
+        let (revs, per) = (400_usize, 50_usize);
+        let mut unit = uniform_stream(0x2545_f491_4f6c_dd1d);
+        let revolution: Vec<u64> = (0..revs * per).map(|i| (i / per) as u64).collect();
+        let p = vec![0.3; revs * per];
+        let independent: Vec<bool> = (0..revs * per).map(|_| unit() < 0.3).collect();
+        let whole: Vec<bool> = (0..revs)
+            .flat_map(|_| std::iter::repeat_n(unit() < 0.3, per))
+            .collect();
+        // Over 400 revolutions the estimate's relative spread is about √(2/400) = 7 %: 1.3 is
+        // over four of them.
+        let one_by_one = dispersion(&independent, &p, &revolution);
+        assert!(one_by_one < 1.3, "{one_by_one}");
+        // Whole revolutions: 50 readings' worth of variance in each sum (within 30 %).
+        let clustered = dispersion(&whole, &p, &revolution);
+        assert!((35.0..65.0).contains(&clustered), "{clustered}");
     }
 
     /// 20,000 rows: the half-loss range within 3 % and the spread within 15 % (several of

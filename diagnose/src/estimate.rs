@@ -100,13 +100,10 @@ fn dead_reckoning(
             return Ok((Trajectory::new(&replay)?, DeadReckoning::Commands));
         }
     }
-    // A twin's path is the encoders' travel already matched to these scans by `hilsim world`:
-    // the same motion, without the drift a long run's bare integration gathers (measured on a
-    // 75 s rover log: from the bare integration the matches lost the path by metres).
-    if let Some(path) = declared_path(physics) {
-        return Ok((path, DeadReckoning::DeclaredPath));
-    }
     let Some(odometry) = odometry else {
+        if let Some(path) = declared_path(physics) {
+            return Ok((path, DeadReckoning::DeclaredPath));
+        }
         return Err(MismatchError::Refused(
             "the recording has no truth.csv, no commands and no odometry to follow the robot by"
                 .into(),
@@ -220,15 +217,21 @@ pub(crate) fn estimate_trajectory(
     };
     let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
     let estimate = matched(physics, lidar, &base, hypothesis)?;
-    // Commands replayed through the nominal drive can leave the real path faster than a
-    // revolution's match follows (wheels of another size turn it away); a twin's own path
-    // cannot, being the encoders already matched to these scans. Along the commands the
-    // encoders stay diagnosable, so the twin's path is taken only when it matches clearly more
-    // of the readings.
-    if reckoned == DeadReckoning::Commands {
+    // A twin's path is the encoders already matched to these scans by `hilsim world`: the same
+    // motion without the drift that the encoders' bare integration gathers over a long run, or
+    // that commands replayed on wheels of another size turn away by, faster than a revolution's
+    // match follows (measured on a 75 s rover log: from the bare integration the matches lost
+    // the path by metres). It is taken when it matches at least as many of the readings as the
+    // encoders, and clearly more than the commands (along which the encoders stay
+    // diagnosable). A twin of another run matches few of this one's.
+    if reckoned != DeadReckoning::DeclaredPath {
         if let Some(path) = declared_path(physics) {
             let along_path = matched(physics, lidar, &path, hypothesis)?;
-            if along_path.matched_share > estimate.matched_share + LOST_TRACK_SHARE {
+            let margin = match reckoned {
+                DeadReckoning::Commands => LOST_TRACK_SHARE,
+                _ => 0.0,
+            };
+            if along_path.matched_share >= estimate.matched_share + margin {
                 return Ok((
                     along_path.trajectory,
                     along_path.uncertainty,

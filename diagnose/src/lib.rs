@@ -42,7 +42,7 @@ pub mod stats;
 mod trajectory;
 
 pub use align::Alignment;
-pub use catalogue::{DrawSource, Effect, ParamSpec, SelfTestRange, Sensor};
+pub use catalogue::{DrawSource, Effect, ParamSpec, SearchLimits, SelfTestRange, Sensor};
 pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
 pub use explain::CandidateFit;

@@ -391,6 +391,7 @@ mod tests {
             log,
             grid: 11,
             self_test: crate::SelfTestRange::uniform(lo, hi),
+            limits: crate::catalogue::SearchLimits::Both,
         }
     }
 

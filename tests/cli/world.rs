@@ -206,23 +206,35 @@ fn a_twins_path_carries_the_estimate_where_the_commands_lose_the_robot() {
         let json: serde_json::Value = serde_json::from_str(stdout(&out).trim()).unwrap();
         json
     };
-    let along_commands = diagnose("rec");
-    // The log without commands: the header alone.
-    std::fs::create_dir(tmp.path().join("no-commands")).unwrap();
-    for file in ["meta.toml", "lidar.csv", "odometry.csv"] {
-        std::fs::copy(
-            tmp.path().join("rec").join(file),
-            tmp.path().join("no-commands").join(file),
+    // A log without truth and without commands (the header alone) from `from`, at `to`.
+    let without_commands = |from: &str, to: &str| {
+        std::fs::create_dir(tmp.path().join(to)).unwrap();
+        for file in ["meta.toml", "lidar.csv", "odometry.csv"] {
+            std::fs::copy(
+                tmp.path().join(from).join(file),
+                tmp.path().join(to).join(file),
+            )
+            .unwrap();
+        }
+        std::fs::write(
+            tmp.path().join(to).join("commands.csv"),
+            "t_s,left_mps,right_mps\n",
         )
         .unwrap();
-    }
-    std::fs::write(
-        tmp.path().join("no-commands/commands.csv"),
-        "t_s,left_mps,right_mps\n",
-    )
-    .unwrap();
-    let without_commands = diagnose("no-commands");
-    for json in [along_commands, without_commands] {
+    };
+    let along_commands = diagnose("rec");
+    without_commands("rec", "no-commands");
+    let without_commands_json = diagnose("no-commands");
+    // Another run in the same room, held against this run's twin: its path is not this run's,
+    // and the estimate follows the encoders.
+    record(tmp.path());
+    without_commands("rec", "other-run");
+    let other_run = diagnose("other-run");
+    assert_eq!(
+        other_run["references"]["lidar"],
+        "lidar-estimated path (encoders between scans)"
+    );
+    for json in [along_commands, without_commands_json] {
         let effect = json["effect"].as_str().unwrap();
         assert!(
             ["none", "world_mismatch"].contains(&effect),

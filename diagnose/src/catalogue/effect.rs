@@ -216,8 +216,9 @@ impl Effect {
     #[must_use]
     pub const fn params(self) -> &'static [ParamSpec] {
         use super::params::SelfTestRange as R;
-        // The collimated beam's term over ±5 cm at 45° on a 1 cm grid; the self-test draws
-        // its size as κ's (`draw_values` puts it all in one or the other).
+        // The collimated beam's term over ±0.2 m at 45° on a 2 cm grid: κ's window at 2 m, as
+        // the self-test draws its size as κ's there (`draw_values` puts it all in one or the
+        // other), so that a draw is never past the search's edge.
         // The power of tan θ over [0.5, 4] on a √2 grid through 1 (the footprint's depth) and 2
         // (an asymmetry that grows with it, `1/cos² θ − 1`): the form of the growth, which
         // the self-test's catalogue reality does not vary.
@@ -229,14 +230,15 @@ impl Effect {
                 11,
                 R::uniform(0.01, 0.03).signed(),
             ),
-            lin("collimated_m", "m", (-0.05, 0.05), 11, R::zero()),
+            lin("collimated_m", "m", (-0.2, 0.2), 21, R::zero()),
             log(
                 "exponent",
                 "",
                 (0.5, 4.0),
                 7,
                 R::zero().around(1.0, 0.5, 4.0),
-            ),
+            )
+            .form(),
         ];
         const REFLECTIVITY: [ParamSpec; 1] = [lin(
             "coefficient_m",
@@ -251,14 +253,10 @@ impl Effect {
             (0.05, 3.0),
             10,
             R::uniform(0.5, 1.5).at_most(5.0),
-        )];
-        const SKEW: [ParamSpec; 1] = [lin(
-            "revolution_s",
-            "s",
-            (0.0, 0.6),
-            9,
-            R::lidar_revolution(),
-        )];
+        )
+        .searched_from_zero()];
+        const SKEW: [ParamSpec; 1] =
+            [lin("revolution_s", "s", (0.0, 0.6), 9, R::lidar_revolution()).searched_from_zero()];
         // The warm-up's constant term over ±0.1 m on a 5 cm grid (a unit's drift is
         // centimetres at most), Nelder–Mead refining the three together. The self-test draws
         // its size as the quadratic term's (`draw_values` puts it all in one or the other).
@@ -276,7 +274,8 @@ impl Effect {
                 (1.0, 1000.0),
                 6,
                 R::uniform(5.0, 20.0).unscaled(),
-            ),
+            )
+            .form(),
             lin("offset_m", "m", (-0.1, 0.1), 5, R::zero()),
         ];
         const BEAM: [ParamSpec; 1] = [lin(
@@ -285,7 +284,8 @@ impl Effect {
             (0.0, 45.0),
             16,
             R::uniform(8.0, 20.0).at_most(60.0),
-        )];
+        )
+        .searched_from_zero()];
         const SOUND: [ParamSpec; 1] = [lin(
             "air_temperature_c",
             "degC",
@@ -304,14 +304,15 @@ impl Effect {
         // up) and −1 (a lead gained at every change of speed): the form, which the self-test's
         // catalogue reality keeps even.
         const SLIP: [ParamSpec; 2] = [
-            lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1)),
+            lin("gain_s", "s", (0.0, 0.5), 6, R::uniform(0.03, 0.1)).searched_from_zero(),
             lin(
                 "braking_share",
                 "",
                 (-1.0, 1.0),
                 5,
                 R::zero().around(1.0, -1.0, 1.0),
-            ),
+            )
+            .form(),
         ];
         const LAG: [ParamSpec; 1] = [log(
             "time_constant_s",
@@ -319,7 +320,8 @@ impl Effect {
             (0.005, 5.0),
             13,
             R::uniform(0.1, 0.4).at_most(10.0),
-        )];
+        )
+        .searched_from_zero()];
         // The mount's yaw is searched over ±8° (a unit bolted visibly crooked is past it) on
         // a 2° grid: a wall seen 2° off moves by 3.5 % of its range, which the likelihood
         // follows smoothly; its position over ±0.1 m on a coarse grid, Nelder–Mead refining
@@ -338,16 +340,11 @@ impl Effect {
         // A delay of up to 0.3 s (a driver buffering a whole revolution of a 5 Hz lidar is
         // 0.2 s) on a 0.02 s grid.
         const LIDAR_LATENCY: [ParamSpec; 1] =
-            [lin("lidar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08))];
+            [lin("lidar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08)).searched_from_zero()];
         const SONAR_LATENCY: [ParamSpec; 1] =
-            [lin("sonar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08))];
-        const ODOMETER_LATENCY: [ParamSpec; 1] = [lin(
-            "odometer_s",
-            "s",
-            (0.0, 0.3),
-            16,
-            R::uniform(0.02, 0.08),
-        )];
+            [lin("sonar_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08)).searched_from_zero()];
+        const ODOMETER_LATENCY: [ParamSpec; 1] =
+            [lin("odometer_s", "s", (0.0, 0.3), 16, R::uniform(0.02, 0.08)).searched_from_zero()];
         // Radius and base scales within ±20 % / ±30 % of nominal (a worn or soft tyre is a
         // few per cent; the scenario allows ±50 %).
         const RADIUS: [ParamSpec; 2] = [
@@ -396,7 +393,7 @@ impl Effect {
                 5,
                 R::uniform(0.005, 0.03).signed(),
             ),
-            lin("quadratic_per_m", "1/m", (-0.02, 0.02), 3, R::zero()),
+            lin("quadratic_per_m", "1/m", (-0.02, 0.02), 3, R::zero()).form(),
         ];
         // The sonar's range offset alone, over ±0.2 m on a 5 cm grid: its scale is the speed
         // of sound's (`sonar_speed_of_sound` scales every range, and an affine sonar's scale
@@ -421,14 +418,16 @@ impl Effect {
                 (0.5, 50.0),
                 11,
                 R::uniform(3.0, 5.0).unscaled(),
-            ),
+            )
+            .form(),
             log(
                 "log_power_spread",
                 "",
                 (0.05, 2.0),
                 7,
                 R::uniform(0.15, 0.4).unscaled(),
-            ),
+            )
+            .form(),
         ];
         match self {
             Effect::LidarDropout => &DROPOUT,

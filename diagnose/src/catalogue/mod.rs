@@ -13,6 +13,6 @@ mod sensor;
 mod sentences;
 
 pub use effect::Effect;
-pub use params::{DrawSource, ParamSpec, SelfTestRange};
+pub use params::{DrawSource, ParamSpec, SearchLimits, SelfTestRange};
 pub(crate) use scenario::{mounted, range_bias, REFERENCE_REFLECTIVITY};
 pub use sensor::Sensor;

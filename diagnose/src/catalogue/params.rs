@@ -18,6 +18,42 @@ pub struct ParamSpec {
     pub grid: usize,
     /// Where the self-test draws its true value from.
     pub self_test: SelfTestRange,
+    /// Which ends of the search are only where it stops, not ends of the effect: a fit there
+    /// is a bound on the size, not an estimate of it.
+    pub limits: SearchLimits,
+}
+
+/// Which ends of a parameter's search are where the search stops rather than ends the effect
+/// itself has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchLimits {
+    /// Both: a size searched over a window (a mount's yaw, a wheel's scale).
+    Both,
+    /// The upper one: a size that starts at zero, the effect's absence (a delay, a slip's
+    /// gain).
+    Upper,
+    /// Neither: the ends of a family of forms (the power of `tan θ`, the braking share, a
+    /// warm-up's time constant past the log's length), where a fit is a form it takes.
+    Form,
+}
+
+impl SearchLimits {
+    /// Whether `value` sits at one of `spec`'s search limits: within half a percent of the
+    /// searched span (on a log scale, of its logarithm) of a limiting end.
+    #[must_use]
+    pub fn at_limit(spec: &ParamSpec, value: f64) -> bool {
+        let unit = if spec.log {
+            (value.max(spec.lo).ln() - spec.lo.ln()) / (spec.hi.ln() - spec.lo.ln())
+        } else {
+            (value - spec.lo) / (spec.hi - spec.lo)
+        };
+        const EDGE: f64 = 0.005;
+        match spec.limits {
+            SearchLimits::Both => unit <= EDGE || unit >= 1.0 - EDGE,
+            SearchLimits::Upper => unit >= 1.0 - EDGE,
+            SearchLimits::Form => false,
+        }
+    }
 }
 
 /// Searched on a linear scale; the self-test draws it from `self_test`.
@@ -36,6 +72,7 @@ pub(super) const fn lin(
         log: false,
         grid,
         self_test,
+        limits: SearchLimits::Both,
     }
 }
 
@@ -50,6 +87,26 @@ pub(super) const fn log(
     ParamSpec {
         log: true,
         ..lin(name, unit, range, grid, self_test)
+    }
+}
+
+impl ParamSpec {
+    /// Searched from zero, the effect's absence: only its upper end is a search limit.
+    #[must_use]
+    pub(super) const fn searched_from_zero(self) -> Self {
+        Self {
+            limits: SearchLimits::Upper,
+            ..self
+        }
+    }
+
+    /// A form's parameter: its ends are forms the effect takes, not search limits.
+    #[must_use]
+    pub(super) const fn form(self) -> Self {
+        Self {
+            limits: SearchLimits::Form,
+            ..self
+        }
     }
 }
 
@@ -167,5 +224,36 @@ impl SelfTestRange {
             Some(centre) => value - centre,
             None => value,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_ends_where_a_search_stops_are_its_limits() {
+        let window = lin("yaw_deg", "deg", (-8.0, 8.0), 9, SelfTestRange::zero());
+        assert!(SearchLimits::at_limit(&window, -7.97));
+        assert!(SearchLimits::at_limit(&window, 8.0));
+        assert!(!SearchLimits::at_limit(&window, -7.8));
+        // From zero: zero is the effect's absence, not a limit.
+        let delay = window.searched_from_zero();
+        assert!(!SearchLimits::at_limit(&delay, -8.0));
+        assert!(SearchLimits::at_limit(&delay, 8.0));
+        // A form's ends are forms.
+        assert!(!SearchLimits::at_limit(&window.form(), 8.0));
+        // On a log scale, half a percent of the decades: 0.5–50 m spans 4.6 in ln, so 2.3 %
+        // of the value.
+        let ranged = log(
+            "half_loss_range_m",
+            "m",
+            (0.5, 50.0),
+            11,
+            SelfTestRange::zero(),
+        );
+        assert!(SearchLimits::at_limit(&ranged, 49.0));
+        assert!(!SearchLimits::at_limit(&ranged, 48.0));
+        assert!(SearchLimits::at_limit(&ranged, 0.51));
     }
 }

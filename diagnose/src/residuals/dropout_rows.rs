@@ -28,6 +28,9 @@ pub(crate) struct DropoutRows {
     pub lost: Vec<bool>,
     /// Whether the row is held out (the ranges' split: alternate blocks by revolution).
     pub heldout: Vec<bool>,
+    /// The revolution the reading belongs to: losses cluster within one (a dark wall, a pane
+    /// of glass loses every beam that meets it).
+    pub revolution: Vec<u64>,
 }
 
 /// The lidar's rows, `None` without a lidar. The range limits are the declared ones narrowed
@@ -78,6 +81,7 @@ pub(crate) fn dropout_rows(ctx: &Context<'_>) -> Option<DropoutRows> {
         rows.reflectivity.push(p.reflectivity);
         rows.lost.push(!valid(s));
         rows.heldout.push(split(q.rev_start_s));
+        rows.revolution.push(s.rev);
     }
     Some(rows)
 }

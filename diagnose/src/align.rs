@@ -58,6 +58,9 @@ pub(crate) struct Aligned {
     pub yaw_sd_rad: f64,
     /// What an estimate followed between the lidar's corrections (`None` for `truth.csv`).
     pub reckoned: Option<DeadReckoning>,
+    /// What the path the drive is judged against followed between the lidar's corrections,
+    /// when the drive is judged against an estimate (`None` otherwise).
+    pub drive_reckoned: Option<DeadReckoning>,
     /// The drive effects an estimate's commands were replayed under (nominal at first).
     pub replayed: Hypothesis,
     /// What the user should know (sensors missing on one side).
@@ -176,6 +179,7 @@ pub(crate) fn align(
         position_sd_m,
         yaw_sd_rad,
         reckoned,
+        drive_reckoned: None,
         replayed: Hypothesis::nominal(),
         notes,
     })
@@ -308,6 +312,7 @@ impl Aligned {
             position_sd_m: sd.position_m,
             yaw_sd_rad: sd.yaw_rad,
             reckoned: Some(reckoned),
+            drive_reckoned: self.drive_reckoned,
             replayed,
             notes: self.notes.clone(),
         }

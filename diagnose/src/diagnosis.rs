@@ -96,7 +96,16 @@ pub fn diagnose_with_progress(
     // along it would be the commands against themselves.
     let along_encoders = match aligned.reckoned {
         Some(DeadReckoning::Commands) => align::along_encoders(physics, recording, &aligned)?,
+        // A path that already follows the encoders (a twin's taken over the commands' replay)
+        // is the drive's reference itself.
+        Some(r) if r.follows_the_encoders() && !recording.commands.is_empty() => {
+            Some(aligned.clone())
+        }
         _ => None,
+    };
+    let aligned = Aligned {
+        drive_reckoned: along_encoders.as_ref().and_then(|a| a.reckoned),
+        ..aligned
     };
     let estimates = Estimates::default();
     let aligned = replayed_under_drive(
@@ -670,9 +679,12 @@ fn reference_of(sensor: Sensor, aligned: &Aligned) -> &'static str {
     match (aligned.reckoned, sensor) {
         (None, Sensor::Drive) => "commands against truth.csv",
         (None, _) => "truth.csv",
-        (Some(_), Sensor::Drive) => {
-            "commands against the lidar-estimated path (encoders between scans)"
-        }
+        (Some(_), Sensor::Drive) => match aligned.drive_reckoned {
+            Some(DeadReckoning::DeclaredPath) => {
+                "commands against the lidar-estimated path (the scenario's path between scans)"
+            }
+            _ => "commands against the lidar-estimated path (encoders between scans)",
+        },
         (Some(r), _) => r.describe(),
     }
 }

@@ -152,11 +152,9 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
         log_likelihood(&train_lost, &q, profiled_p0(&train_lost, &q))
     };
     let (params, best) = maximize(specs, &mut train_ll);
-    let p0 = profiled_p0(&train_lost, &power_loss(rows, &train, &params));
-    let p_train: Vec<f64> = power_loss(rows, &train, &params)
-        .iter()
-        .map(|q| p0 + (1.0 - p0) * q)
-        .collect();
+    let q_train = power_loss(rows, &train, &params);
+    let p0 = profiled_p0(&train_lost, &q_train);
+    let p_train: Vec<f64> = q_train.iter().map(|q| p0 + (1.0 - p0) * q).collect();
     let spread = dispersion(
         &train_lost,
         &p_train,

@@ -223,6 +223,11 @@ fn a_twins_path_carries_the_estimate_where_the_commands_lose_the_robot() {
         .unwrap();
     };
     let along_commands = diagnose("rec");
+    // The commands are then judged against the twin's path, which follows the encoders.
+    assert_eq!(
+        along_commands["references"]["drive"],
+        "commands against the lidar-estimated path (the scenario's path between scans)"
+    );
     without_commands("rec", "no-commands");
     let without_commands_json = diagnose("no-commands");
     // Another run in the same room, held against this run's twin: its path is not this run's,

@@ -318,9 +318,11 @@ pub struct DiagnoseArgs {
     /// Self-test: what makes the "real" recordings: `hilsim` (its own simulator with the drawn
     /// effect switched on) or `independent` (a generator that shares no model code with it,
     /// with random nuisances, two effects at once in a fifth of the trials and an effect
-    /// outside the catalogue).
+    /// outside the catalogue) or `varied` (the independent one with each effect in a form the
+    /// catalogue does not write: a random smooth monotone curve, or a physical form from the
+    /// literature).
     #[arg(long, value_name = "REALITY", requires = "self_test", default_value = "hilsim",
-          value_parser = ["hilsim", "independent"])]
+          value_parser = ["hilsim", "independent", "varied"])]
     pub reality: String,
     /// Self-test: run only trial I (of the N), print its whole diagnosis and, with `--report`,
     /// write its report and its "real" recording (`DIR/recording`).

@@ -1,39 +1,66 @@
 //! What a "real" robot has that its scenario does not say: the catalogue's physics, written
 //! here again from its definitions (`docs/diagnose.md`, `scenarios/README.md` `[effects]`), and
-//! physics outside the catalogue.
+//! physics outside the catalogue. Each mechanism carries its form ([`crate::form`]): the
+//! catalogue's by default, another where the self-test's varied reality draws one.
+
+use crate::form::{
+    Blend, Curve, DriveResponse, EchoPick, IncidenceGrowth, LossBy, ReflectivityWalk, Settling,
+    Traction,
+};
 
 /// One concealed effect with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Concealed {
-    /// The lidar reads `(κ d + c) tan θ` long (θ the incidence angle, capped at 80°): a
-    /// diverging beam's footprint and a collimated one's.
-    LidarIncidence { coefficient: f64, collimated_m: f64 },
-    /// The lidar's range walks by `c (ρ_ref/ρ − 1)` on a surface of reflectivity ρ.
-    LidarReflectivity { coefficient_m: f64, reference: f64 },
-    /// The beam has an angular half-width; a footprint over several surfaces returns the
-    /// harmonic mean of their ranges weighted by `share · ρ cos θ / d²`.
-    LidarMixedPixels { half_width_deg: f64 },
+    /// The lidar reads `(κ d + c) g(θ)` long (θ the incidence angle, capped at 80°; `g` the
+    /// growth, `tan θ` in the catalogue): a diverging beam's footprint and a collimated one's.
+    LidarIncidence {
+        coefficient: f64,
+        collimated_m: f64,
+        growth: IncidenceGrowth,
+    },
+    /// The lidar's range walks by `c h(ρ)` on a surface of reflectivity ρ (`h` the walk,
+    /// `ρ_ref/ρ − 1` in the catalogue).
+    LidarReflectivity {
+        coefficient_m: f64,
+        reference: f64,
+        walk: ReflectivityWalk,
+    },
+    /// The beam has an angular half-width; a footprint over several surfaces returns a blend
+    /// of their ranges weighted by `share · ρ cos θ / d²` (the harmonic mean in the catalogue).
+    LidarMixedPixels { half_width_deg: f64, blend: Blend },
     /// Each reading's geometry is taken at its own instant (the head turns while the robot
     /// moves), where the scenario says a revolution is one instant.
     LidarMotionSkew,
-    /// The range error `(c + k d²) e^{−t/τ}` of a unit warming up: its pointing (k) and its
-    /// housing (c) settling together.
+    /// The range error `(c + k d²) w(t)` of a unit warming up: its pointing (k) and its
+    /// housing (c) settling together (`w` the settling, `e^{−t/τ}` in the catalogue).
     LidarWarmup {
         coefficient_per_m: f64,
         time_constant_s: f64,
         offset_m: f64,
+        settling: Settling,
     },
-    /// The sonar returns the nearest echo in a cone of this half-angle.
-    SonarBeamWidth { half_angle_deg: f64 },
+    /// The sonar's beam has this half-angle; `pick` says which echo across it is reported
+    /// (the nearest in the catalogue).
+    SonarBeamWidth { half_angle_deg: f64, pick: EchoPick },
     /// Every sonar range scaled by `c(calibrated)/c(air)`, `c(T) = 331.3 √(1 + T/273.15)`.
     SonarSpeedOfSound {
         air_temperature_c: f64,
         calibrated_at_c: f64,
     },
-    /// The encoders lead the true travel by `g v` (slip at `g a`).
-    WheelSlip { gain_s: f64 },
-    /// Each wheel's speed follows its command with a first-order lag.
-    MotorLag { time_constant_s: f64 },
+    /// The encoders lead the true travel by a slip that grows at `g f(a)` while a wheel speeds
+    /// up and `braking_share · g f(a)` while it slows (`f(a) = a` in the catalogue, where an
+    /// even slip, share 1, leads by `g v`).
+    WheelSlip {
+        gain_s: f64,
+        braking_share: f64,
+        traction: Traction,
+    },
+    /// Each wheel's speed follows its command with response time τ (a first-order lag in the
+    /// catalogue).
+    MotorLag {
+        time_constant_s: f64,
+        response: DriveResponse,
+    },
     /// The lidar sits turned by `yaw_deg` (counter-clockwise) and moved `x_m` forward, `y_m`
     /// left of where the scenario mounts it.
     LidarMountOffset { yaw_deg: f64, x_m: f64, y_m: f64 },
@@ -68,6 +95,14 @@ pub enum Concealed {
         half_loss_range_m: f64,
         log_power_sd: f64,
         reference: f64,
+        loss: LossBy,
+    },
+    /// The lidar's range error a smooth increasing curve of the range: `at_2m_m` at 2 m, and
+    /// `slope` its mean slope over [0, 8] m (a unit's calibration table off by a drawn shape).
+    LidarRangeCurve {
+        at_2m_m: f64,
+        slope: f64,
+        curve: Curve,
     },
     /// Outside the catalogue: a periodic range error of the lidar, `A sin(2π d / λ)` (a
     /// triangulation unit's sub-pixel interpolation error repeats with the spot's position on
@@ -93,7 +128,7 @@ impl Concealed {
             Self::SensorLatency { .. } => "sensor_latency",
             Self::WheelRadius { .. } => "odometer_wheel_radius",
             Self::WheelBase { .. } => "drive_wheel_base",
-            Self::LidarTriangulation { .. } => "lidar_range_bias",
+            Self::LidarTriangulation { .. } | Self::LidarRangeCurve { .. } => "lidar_range_bias",
             Self::SonarEchoDelay { .. } => "sonar_range_bias",
             Self::LidarWeakReturns { .. } => "lidar_dropout",
             Self::LidarPeriodicRange { .. } => "lidar_periodic_range",

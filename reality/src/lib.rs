@@ -9,6 +9,7 @@
 //! `hilsim diagnose --self-test N --reality independent` proves the diagnosis on it.
 
 mod concealed;
+pub mod form;
 mod motion;
 mod noise;
 mod nuisance;
@@ -44,8 +45,11 @@ pub fn record(
     );
     let spans = motion::program(scenario);
     let end_s = motion::run_length(scenario, &spans);
-    let lag_s = concealed.iter().find_map(|c| match *c {
-        Concealed::MotorLag { time_constant_s } => Some(time_constant_s),
+    let lag = concealed.iter().find_map(|c| match *c {
+        Concealed::MotorLag {
+            time_constant_s,
+            response,
+        } => Some((time_constant_s, response)),
         _ => None,
     });
     let start = Pose {
@@ -77,7 +81,7 @@ pub fn record(
         scenario.robot.wheel_base_m * base_scale,
         end_s,
         Drive {
-            lag_s,
+            lag,
             speed_noise: nuisances.speed_noise,
             radius_scale,
         },
@@ -119,6 +123,7 @@ pub fn record(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::form::{DriveResponse, EchoPick, Traction};
 
     /// A robot standing 2 m in front of a wall, every sensor, for 10 s.
     fn facing_a_wall() -> Scenario {
@@ -294,6 +299,134 @@ noise_m = 0.0
         // The turn comes out 1/1.1 as large; the straight run and the encoders are the same.
         assert!((end(&base).yaw_rad / n.yaw_rad - 1.0 / 1.1).abs() < 0.001);
         assert!((odo(&base).right_m - odo(&nominal).right_m).abs() <= 0.0011);
+    }
+
+    /// A straight run of 1 m at 0.2 m/s, then a stop.
+    fn run_and_stop() -> Scenario {
+        Scenario::from_toml(
+            r#"name = "run"
+duration_s = 8.0
+[world]
+walls = [{ from = [5.0, -5.0], to = [5.0, 5.0] }]
+[robot]
+start = { x = 0.0, y = 0.0, yaw_deg = 0.0 }
+wheel_base_m = 0.23
+[[drive]]
+speed_mps = 0.2
+distance_m = 1.0
+[sensors.odometer]
+noise_m = 0.0
+"#,
+            std::path::Path::new("run.toml"),
+        )
+        .unwrap()
+    }
+
+    /// Slip that braking gives back leaves the encoders on the travel once stopped; slip only
+    /// while speeding up keeps its lead `g v`; a saturating tyre scaled at the largest step
+    /// leads by the same there.
+    #[test]
+    fn a_slip_keeps_what_braking_does_not_give_back() {
+        let s = run_and_stop();
+        let last = |slip: Option<Concealed>| {
+            let r = record(
+                &s,
+                &slip.into_iter().collect::<Vec<_>>(),
+                Nuisances::default(),
+                3,
+            );
+            r.odometry.unwrap().last().unwrap().left_m
+        };
+        let plain = last(None);
+        let slip = |share: f64, traction: Traction| {
+            last(Some(Concealed::WheelSlip {
+                gain_s: 0.1,
+                braking_share: share,
+                traction,
+            }))
+        };
+        // Even slip: back on the travel, to the 1 mm tick.
+        assert!((slip(1.0, Traction::Linear) - plain).abs() <= 0.0011);
+        // Speeding up only: ahead by g v = 0.1 s × 0.2 m/s = 20 mm; a lead at every change,
+        // twice that.
+        assert!((slip(0.0, Traction::Linear) - plain - 0.02).abs() <= 0.0011);
+        assert!((slip(-1.0, Traction::Linear) - plain - 0.04).abs() <= 0.0011);
+        // The odometer's 20 Hz sees the step as 4 m/s² over one sample.
+        let saturating = Traction::Saturating {
+            accel_mps2: 2.0,
+            top_mps2: 4.0,
+        };
+        assert!((slip(0.0, saturating) - plain - 0.02).abs() <= 0.0011);
+    }
+
+    /// Every drive response reaches `1 − 1/e` of a step at its response time, within 5 %.
+    #[test]
+    fn every_drive_response_reaches_its_share_of_a_step_at_its_time() {
+        let spans = [motion::Span {
+            from_s: 0.0,
+            to_s: 3.0,
+            left_mps: 0.2,
+            right_mps: 0.2,
+        }];
+        let start = Pose {
+            x: 0.0,
+            y: 0.0,
+            yaw: 0.0,
+        };
+        let tau = 0.3;
+        for response in [
+            DriveResponse::FirstOrder,
+            DriveResponse::SecondOrder { damping: 0.5 },
+            DriveResponse::SecondOrder { damping: 1.0 },
+            DriveResponse::SlewLimited {
+                accel_mps2: (1.0 - (-1.0f64).exp()) * 0.2 / tau,
+            },
+            DriveResponse::DeadTime { share: 0.5 },
+        ] {
+            let drive = Drive {
+                lag: Some((tau, response)),
+                ..Drive::default()
+            };
+            let m = motion::integrate(&spans, start, 0.23, 3.0, drive, &mut Stream::new(1, "d"));
+            let reached = m
+                .speed
+                .iter()
+                .position(|v| v[0] >= 0.2 * (1.0 - (-1.0f64).exp()))
+                .unwrap() as f64
+                * motion::STEP_S;
+            assert!(
+                (reached / tau - 1.0).abs() < 0.05,
+                "{response:?}: {reached}"
+            );
+        }
+    }
+
+    /// Facing a wall 2 m away, the nearest echo in a 15° cone reads 2 m; the echoes' centroid
+    /// reads long (the cone's edges are farther); a threshold's cone, 15° at 2 m, also reads
+    /// 2 m head-on.
+    #[test]
+    fn a_sonar_reads_the_echo_its_form_picks() {
+        let s = facing_a_wall();
+        let sonar = |pick: EchoPick| {
+            let beam = Concealed::SonarBeamWidth {
+                half_angle_deg: 15.0,
+                pick,
+            };
+            let r = record(&s, &[beam], Nuisances::default(), 7);
+            mean(
+                &r.sonar
+                    .unwrap()
+                    .iter()
+                    .map(|p| p.range_m)
+                    .collect::<Vec<_>>(),
+            )
+        };
+        assert!((sonar(EchoPick::Nearest) - 2.0).abs() < 0.004);
+        assert!((sonar(EchoPick::Threshold) - 2.0).abs() < 0.004);
+        // A lobe of 15° (σ 7.5°) over ±30°, each echo 2/cos φ weighted by its lobe and
+        // spreading: `1 + σ²/2` is 0.86 % long, 17 mm; the noise's mean within 4 mm.
+        let centroid = sonar(EchoPick::BeamCentroid);
+        assert!((centroid - 2.017).abs() < 0.004, "{centroid}");
     }
 
     #[test]

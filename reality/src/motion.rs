@@ -1,10 +1,11 @@
 //! The robot's motion: the drive program turned into wheel commands, and the commands into a
 //! trajectory by differential-drive kinematics (exact arcs over 1 ms steps), with an optional
-//! first-order motor lag and white noise of the wheels' speed around what they are commanded.
+//! motor lag (first-order, or another response: [`DriveResponse`]) and white noise of the wheels' speed around what they are commanded.
 
 use hilsim_recording::{CommandSample, Pose};
 use hilsim_sim::scenario::Scenario;
 
+use crate::form::DriveResponse;
 use crate::noise::Stream;
 
 /// Integration step, seconds.
@@ -103,8 +104,9 @@ pub struct Motion {
 /// How the wheels follow their commands.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Drive {
-    /// First-order lag of each wheel's speed, seconds (`None`: at once).
-    pub lag_s: Option<f64>,
+    /// How each wheel's speed lags its command: the response time, seconds, and the form
+    /// (`None`: at once).
+    pub lag: Option<(f64, DriveResponse)>,
     /// Relative standard deviation of white noise on each wheel's speed, held 10 ms.
     pub speed_noise: f64,
     /// Each wheel's radius over nominal: the motor turns it at the command over the nominal
@@ -115,7 +117,7 @@ pub struct Drive {
 impl Default for Drive {
     fn default() -> Self {
         Self {
-            lag_s: None,
+            lag: None,
             speed_noise: 0.0,
             radius_scale: [1.0; 2],
         }
@@ -139,13 +141,24 @@ pub fn integrate(
     let mut pose = start;
     let mut wheels = [0.0f64; 2];
     let mut v = [0.0f64; 2];
+    let mut acceleration = [0.0f64; 2];
     let mut jitter = [0.0f64; 2];
+    let natural_rad_s = match drive.lag {
+        Some((tau, DriveResponse::SecondOrder { damping })) => {
+            second_order_rise(damping) / tau.max(STEP_S)
+        }
+        _ => 0.0,
+    };
     for k in 0..n {
         poses.push(pose);
         travel.push(wheels);
         speed.push(v);
         let t = k as f64 * STEP_S;
-        let (l, r) = command_at(spans, t);
+        let delay = match drive.lag {
+            Some((tau, DriveResponse::DeadTime { share })) => share * tau,
+            _ => 0.0,
+        };
+        let (l, r) = command_at(spans, t - delay);
         let u = [l, r];
         // The speed noise is redrawn every 10 ms (one motor-controller period).
         if k % 10 == 0 {
@@ -156,10 +169,28 @@ pub fn integrate(
         }
         for w in 0..2 {
             let target = u[w] * drive.radius_scale[w] * (1.0 + jitter[w]);
-            v[w] = match drive.lag_s {
-                // τ v̇ + v = u, exactly over one step.
-                Some(tau) => target + (v[w] - target) * (-STEP_S / tau).exp(),
+            v[w] = match drive.lag {
                 None => target,
+                // τ v̇ + v = u, exactly over one step.
+                Some((tau, DriveResponse::FirstOrder)) => {
+                    target + (v[w] - target) * (-STEP_S / tau).exp()
+                }
+                Some((tau, DriveResponse::DeadTime { share })) => {
+                    let rest = (tau * (1.0 - share)).max(STEP_S);
+                    target + (v[w] - target) * (-STEP_S / rest).exp()
+                }
+                Some((_, DriveResponse::SlewLimited { accel_mps2 })) => {
+                    let step = accel_mps2 * STEP_S;
+                    v[w] + (target - v[w]).clamp(-step, step)
+                }
+                // Semi-implicit Euler, stable for ωₙ Δt < 2: any response time above 2 ms.
+                Some((_, DriveResponse::SecondOrder { damping })) => {
+                    let w2 = natural_rad_s * natural_rad_s;
+                    acceleration[w] += (w2 * (target - v[w])
+                        - 2.0 * damping * natural_rad_s * acceleration[w])
+                        * STEP_S;
+                    v[w] + acceleration[w] * STEP_S
+                }
             };
         }
         let ds = (v[0] + v[1]) / 2.0 * STEP_S;
@@ -184,6 +215,21 @@ pub fn integrate(
         travel,
         speed,
     }
+}
+
+/// `ωₙ t` at which a second-order system of damping ζ, from rest, reaches `1 − 1/e` of a
+/// step: so that its response time is comparable to a first-order lag's τ.
+#[must_use]
+pub fn second_order_rise(damping: f64) -> f64 {
+    let target = 1.0 - (-1.0f64).exp();
+    let dt = 1e-4;
+    let (mut x, mut v, mut t) = (0.0f64, 0.0f64, 0.0f64);
+    while x < target && t < 50.0 {
+        v += ((1.0 - x) - 2.0 * damping * v) * dt;
+        x += v * dt;
+        t += dt;
+    }
+    t
 }
 
 impl Motion {

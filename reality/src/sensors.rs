@@ -6,6 +6,7 @@ use hilsim_recording::{LidarSample, OdometrySample, Pose, SonarSample, TruthSamp
 use hilsim_sim::scenario::{LidarTiming, Scenario};
 
 use crate::concealed::{delay_s, speed_of_sound, Concealed, Stamped};
+use crate::form::{EchoPick, LossBy, RANGE_CURVE_SPAN_M};
 use crate::motion::Motion;
 use crate::noise::Stream;
 use crate::nuisance::Nuisances;
@@ -79,9 +80,15 @@ impl Run<'_> {
                 half_loss_range_m,
                 log_power_sd,
                 reference,
-            } => Some((half_loss_range_m, log_power_sd, reference)),
+                loss,
+            } => Some((half_loss_range_m, log_power_sd, reference, loss)),
             _ => None,
         });
+        // A loss curve's own half point, so that half the returns are lost at d½.
+        let half_point = match weak {
+            Some((_, _, _, LossBy::RangeCurve(c))) => c.reaches(0.5),
+            _ => 0.0,
+        };
         let period = 60.0 / cfg.rpm;
         let slot = period / 360.0;
         let snapshot = cfg.timing == LidarTiming::PerRevolution
@@ -136,10 +143,16 @@ impl Run<'_> {
                     Some(r) => r,
                     None => (0.0, None, 0.0, 0.0),
                 };
-                // A return whose received power, scattered, falls below the threshold is lost.
-                let lost = weak.is_some_and(|(half_m, sd, reference)| {
-                    let relative = power / reference * half_m * half_m;
-                    relative * (sd * returns.normal()).exp() < 1.0
+                let lost = weak.is_some_and(|(half_m, sd, reference, loss)| match loss {
+                    // A return whose received power, scattered, falls below the threshold.
+                    LossBy::Power => {
+                        let relative = power / reference * half_m * half_m;
+                        relative * (sd * returns.normal()).exp() < 1.0
+                    }
+                    LossBy::RangeCurve(c) => {
+                        let d = true_range.unwrap_or(f64::INFINITY);
+                        returns.chance(c.at((d / half_m).ln() + half_point))
+                    }
                 });
                 let range = if lost { 0.0 } else { range };
                 let range = if spurious { spurious_at } else { range };
@@ -183,17 +196,29 @@ impl Run<'_> {
         let hit = self.world.cast(origin, direction, reach)?;
         let mut d = hit.range_m;
         for c in self.concealed {
-            if let Concealed::LidarMixedPixels { half_width_deg } = *c {
-                // A top-hat footprint sampled across its width: the triangulation camera sees
-                // every part and reports f b / x̄, the weighted harmonic mean of their ranges.
+            if let Concealed::LidarMixedPixels {
+                half_width_deg,
+                blend,
+            } = *c
+            {
+                // The footprint sampled across its width (its blend's profile). A harmonic blend:
+                // the triangulation camera sees every part and reports f b / x̄, the weighted
+                // harmonic mean of their ranges; else the power-weighted mean of the ranges.
                 let (mut num, mut den) = (0.0, 0.0);
                 for k in 0..FOOTPRINT_SAMPLES {
                     let u = (k as f64 + 0.5) / FOOTPRINT_SAMPLES as f64 * 2.0 - 1.0;
-                    let dir = direction + u * half_width_deg.to_radians();
+                    let (offset, profile) = blend.profile(u);
+                    let dir = direction + offset * half_width_deg.to_radians();
                     if let Some(h) = self.world.cast(origin, dir, reach) {
-                        let w = h.reflectivity * h.incidence_rad.cos() / (h.range_m * h.range_m);
-                        num += w;
-                        den += w / h.range_m;
+                        let w = profile * h.reflectivity * h.incidence_rad.cos()
+                            / (h.range_m * h.range_m);
+                        if blend.harmonic() {
+                            num += w;
+                            den += w / h.range_m;
+                        } else {
+                            num += w * h.range_m;
+                            den += w;
+                        }
                     }
                 }
                 if den > 0.0 {
@@ -210,16 +235,19 @@ impl Run<'_> {
                 Concealed::LidarIncidence {
                     coefficient,
                     collimated_m,
-                } => (coefficient * d + collimated_m) * theta.tan(),
+                    growth,
+                } => (coefficient * d + collimated_m) * growth.at(theta),
                 Concealed::LidarReflectivity {
                     coefficient_m,
                     reference,
-                } => coefficient_m * (reference / hit.reflectivity - 1.0),
+                    walk,
+                } => coefficient_m * walk.at(hit.reflectivity, reference),
                 Concealed::LidarWarmup {
                     coefficient_per_m,
                     time_constant_s,
                     offset_m,
-                } => (offset_m + coefficient_per_m * d * d) * (-t / time_constant_s).exp(),
+                    settling,
+                } => (offset_m + coefficient_per_m * d * d) * settling.at(t, time_constant_s),
                 Concealed::LidarPeriodicRange {
                     amplitude_m,
                     period_m,
@@ -241,6 +269,15 @@ impl Run<'_> {
                     origin_m + measured / (baseline_ratio + measured * pointing_per_m).max(0.1);
                 reading += own - measured;
             }
+            if let Concealed::LidarRangeCurve {
+                at_2m_m,
+                slope,
+                curve,
+            } = *c
+            {
+                let shaped = RANGE_CURVE_SPAN_M * (curve.at(measured) - curve.at(2.0));
+                reading += at_2m_m + slope * shaped;
+            }
         }
         let intensity =
             INTENSITY_AT_1M * hit.reflectivity / 0.8 * hit.incidence_rad.cos() * d.powf(-0.7);
@@ -253,14 +290,17 @@ impl Run<'_> {
         let cfg = self.scenario.sensors.sonar.as_ref()?;
         let n = &self.nuisances;
         let mut noise = Stream::new(seed, "reality-sonar");
-        let half_angle = self
+        let (half_angle, pick) = self
             .concealed
             .iter()
             .find_map(|c| match *c {
-                Concealed::SonarBeamWidth { half_angle_deg } => Some(half_angle_deg),
+                Concealed::SonarBeamWidth {
+                    half_angle_deg,
+                    pick,
+                } => Some((half_angle_deg, pick)),
                 _ => None,
             })
-            .unwrap_or(cfg.half_angle_deg);
+            .unwrap_or((cfg.half_angle_deg, EchoPick::Nearest));
         let scale = self
             .concealed
             .iter()
@@ -301,19 +341,7 @@ impl Run<'_> {
                 cfg.mount.y_m,
                 cfg.mount.yaw_deg,
             );
-            // The nearest echo in the cone, every 0.25° across it.
-            let steps = (half_angle / 0.25).ceil() as i64;
-            let nearest = (-steps..=steps)
-                .filter_map(|j| {
-                    let a = heading
-                        + (j as f64 * 0.25)
-                            .clamp(-half_angle, half_angle)
-                            .to_radians();
-                    self.world
-                        .cast(origin, a, cfg.max_range_m)
-                        .map(|h| h.range_m)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let nearest = self.echo(origin, heading, half_angle, pick, cfg.max_range_m);
             let e = self.deviate(&mut noise);
             let jitter = n.timestamp_jitter_s * noise.normal();
             if !nearest.is_finite() {
@@ -333,19 +361,65 @@ impl Run<'_> {
         Some(out)
     }
 
+    /// The range the sonar reports from the echoes across its beam (infinite: none), the
+    /// beam sampled every 0.25°: within the cone for the nearest echo, over twice the
+    /// half-angle for a lobe.
+    fn echo(
+        &self,
+        origin: [f64; 2],
+        heading: f64,
+        half_angle_deg: f64,
+        pick: EchoPick,
+        max_range_m: f64,
+    ) -> f64 {
+        let reach = if pick == EchoPick::Nearest { 1.0 } else { 2.0 };
+        let steps = (reach * half_angle_deg / 0.25).ceil() as i64;
+        let echoes = (-steps..=steps).filter_map(|j| {
+            let off = (j as f64 * 0.25).clamp(-reach * half_angle_deg, reach * half_angle_deg);
+            self.world
+                .cast(origin, heading + off.to_radians(), max_range_m)
+                .map(|h| (off, h.range_m))
+        });
+        // The main lobe's amplitude `e^{−2 φ²/φ₀²}`, φ₀ the half-angle.
+        let lobe = |off: f64| (-2.0 * (off / half_angle_deg.max(0.1)).powi(2)).exp();
+        match pick {
+            EchoPick::Nearest => echoes.map(|(_, d)| d).fold(f64::INFINITY, f64::min),
+            EchoPick::BeamCentroid => {
+                let (num, den) = echoes.fold((0.0, 0.0), |(n, w), (off, d)| {
+                    let weight = lobe(off) / (d * d);
+                    (n + weight * d, w + weight)
+                });
+                if den > 0.0 {
+                    num / den
+                } else {
+                    f64::INFINITY
+                }
+            }
+            // Detected where the lobe and the spreading clear the amplitude at the half-angle
+            // at 2 m.
+            EchoPick::Threshold => echoes
+                .filter(|&(off, d)| lobe(off) * (2.0 / d).powi(2) >= (-2.0f64).exp())
+                .map(|(_, d)| d)
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
     /// The encoders' cumulative travel.
     pub fn odometer(&self, seed: u64) -> Option<Vec<OdometrySample>> {
         let cfg = self.scenario.sensors.odometer.as_ref()?;
         let n = &self.nuisances;
         let mut noise = Stream::new(seed, "reality-odometer");
-        let gain = self
-            .concealed
-            .iter()
-            .find_map(|c| match *c {
-                Concealed::WheelSlip { gain_s } => Some(gain_s),
-                _ => None,
-            })
-            .unwrap_or(0.0);
+        let slip = self.concealed.iter().find_map(|c| match *c {
+            Concealed::WheelSlip {
+                gain_s,
+                braking_share,
+                traction,
+            } => Some((gain_s, braking_share, traction)),
+            _ => None,
+        });
+        let mut lead = [0.0f64; 2];
+        let mut last_speed = [0.0f64; 2];
+        let mut last_t = 0.0f64;
         let rate = cfg.rate_hz * n.rate_factor;
         let rho = n.encoder_correlation;
         let late_s = delay_s(self.concealed, Stamped::Odometer);
@@ -359,12 +433,26 @@ impl Run<'_> {
             }
             let travel = self.motion.travel(t);
             let speed = self.motion.speed(t);
+            // The slip grows with each wheel's change of speed since the last sample: at the
+            // driving gain while its speed's magnitude grows, the braking share of it while it
+            // falls.
+            if let Some((gain, share, traction)) = slip {
+                let dt = (t - last_t).max(1e-6);
+                for w in 0..2 {
+                    let dv = speed[w] - last_speed[w];
+                    let grows = speed[w].abs() > last_speed[w].abs();
+                    let rate = gain * traction.at(dv / dt) * dt;
+                    lead[w] += if grows { rate } else { share * rate };
+                }
+                last_speed = speed;
+                last_t = t;
+            }
             let (a, b) = (noise.normal(), noise.normal());
             let e = [a, rho * a + (1.0 - rho * rho).sqrt() * b];
             let jitter = n.timestamp_jitter_s * noise.normal();
             let wheel = |w: usize| {
                 // The encoders count the wheel's turns and report them at the nominal radius.
-                let ground = (travel[w] + gain * speed[w]) / self.radius_scale[w];
+                let ground = (travel[w] + lead[w]) / self.radius_scale[w];
                 let v = ground * (1.0 + cfg.slip) + cfg.noise_m * e[w];
                 quantise(v, cfg.tick_m)
             };

@@ -464,6 +464,40 @@ fn the_self_test_on_the_independent_reality_names_and_leaves_unexplained() {
     }
 }
 
+/// The self-test on the varied reality draws each mechanism in a form the catalogue does not
+/// write and says which: two incidence trials, each named (fixed seed), their forms listed
+/// in the trial's report.
+#[test]
+fn the_self_test_on_the_varied_reality_says_each_trials_form() {
+    let tmp = tempfile::tempdir().unwrap();
+    let nominal = scenario(tmp.path(), "nominal.toml", 5, "");
+    let args = [
+        "diagnose",
+        "--self-test",
+        "2",
+        "--seed",
+        "1",
+        "--sim",
+        &nominal,
+        "--reality",
+        "varied",
+        "--only",
+        "lidar_incidence_angle",
+    ];
+    let out = hilsim(tmp.path(), &args);
+    let text = stdout(&out);
+    assert!(text.contains("on the varied reality"), "{text}");
+    assert!(text.contains("named correctly: 2/2"), "{text}");
+    let out = hilsim(tmp.path(), &[&args[..], &["--trial", "1"]].concat());
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}{}", stderr(&out));
+    let form = text
+        .lines()
+        .find_map(|l| l.strip_prefix("form: lidar_incidence_angle: "))
+        .unwrap_or_else(|| panic!("no form in {text}"));
+    assert!(!form.contains("tan θ") || form.contains("onset"), "{form}");
+}
+
 /// The self-test on a log: one trial in full on a run of the room, held against the room's own
 /// world (a world built from the log is the library's tests'); a log that is not there is
 /// refused with one line naming it.

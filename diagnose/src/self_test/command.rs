@@ -58,6 +58,7 @@ impl Plan {
         }
         let reality = match flags.reality {
             "independent" => Reality::Independent,
+            "varied" => Reality::Varied,
             _ => Reality::Hilsim,
         };
         let only = match flags.only {
@@ -93,7 +94,7 @@ impl Plan {
         let entries = Effect::entries();
         match name {
             "none" => Some(0),
-            _ if name == OUTSIDE && reality == Reality::Independent => Some(1 + entries.len()),
+            _ if name == OUTSIDE && reality.independent() => Some(1 + entries.len()),
             _ => entries.iter().position(|x| *x == name).map(|k| 1 + k),
         }
     }

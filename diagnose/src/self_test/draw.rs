@@ -6,6 +6,10 @@ use hilsim_sim::Scenario;
 use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 use rand_xoshiro::SplitMix64;
 
+use hilsim_reality::form::{
+    Blend, Curve, DriveResponse, EchoPick, IncidenceGrowth, LossBy, ReflectivityWalk, Settling,
+    Traction, RANGE_CURVE_SPAN_M,
+};
 use hilsim_reality::{Concealed, Nuisances, Stream};
 
 use crate::catalogue::{range_bias, DrawSource, SelfTestRange, Sensor, REFERENCE_REFLECTIVITY};
@@ -57,6 +61,8 @@ pub struct Drawn {
     pub outside: bool,
     /// Every effect concealed, as the independent reality takes it.
     pub concealed: Vec<Concealed>,
+    /// Each concealed catalogued effect's form, where the varied reality drew one.
+    pub forms: Vec<String>,
     /// Draws of the trial discarded before this one: their robot would have passed through an
     /// obstacle (the independent reality only).
     pub redrawn: usize,
@@ -101,30 +107,40 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
         Effect::LidarIncidenceAngle => Concealed::LidarIncidence {
             coefficient: p(0),
             collimated_m: p(1),
+            growth: IncidenceGrowth::Tangent,
         },
         Effect::LidarReflectivity => Concealed::LidarReflectivity {
             coefficient_m: p(0),
             reference: REFERENCE_REFLECTIVITY,
+            walk: ReflectivityWalk::Inverse,
         },
         Effect::LidarMixedPixels => Concealed::LidarMixedPixels {
             half_width_deg: p(0),
+            blend: Blend::TopHatHarmonic,
         },
         Effect::LidarMotionSkew => Concealed::LidarMotionSkew,
         Effect::LidarWarmupDrift => Concealed::LidarWarmup {
             coefficient_per_m: p(0),
             time_constant_s: p(1),
             offset_m: p(2),
+            settling: Settling::Exponential,
         },
         Effect::SonarBeamWidth => Concealed::SonarBeamWidth {
             half_angle_deg: p(0),
+            pick: EchoPick::Nearest,
         },
         Effect::SonarSpeedOfSound => Concealed::SonarSpeedOfSound {
             air_temperature_c: p(0),
             calibrated_at_c: 20.0,
         },
-        Effect::OdometerWheelSlip => Concealed::WheelSlip { gain_s: p(0) },
+        Effect::OdometerWheelSlip => Concealed::WheelSlip {
+            gain_s: p(0),
+            braking_share: p(1),
+            traction: Traction::Linear,
+        },
         Effect::DriveMotorLag => Concealed::MotorLag {
             time_constant_s: p(0),
+            response: DriveResponse::FirstOrder,
         },
         Effect::LidarMountOffset => Concealed::LidarMountOffset {
             yaw_deg: p(0),
@@ -157,6 +173,7 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
             half_loss_range_m: p(0),
             log_power_sd: p(1) * std::f64::consts::PI / 3f64.sqrt(),
             reference: REFERENCE_REFLECTIVITY,
+            loss: LossBy::Power,
         },
         Effect::LidarRangeBias => {
             let [c, s, q] = range_bias(values).coefficients();
@@ -168,6 +185,262 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
             }
         }
     }
+}
+
+/// `c`, a catalogued mechanism in the catalogue's form, in a form the catalogue does not write
+/// (the varied reality), with the form's name. Where a mechanism has a variable to shape, on a
+/// fair coin a random smooth monotone curve of it ([`Curve::random`]), else one of the
+/// physical forms of [`hilsim_reality::form`] other than the catalogue's. A mechanism with no
+/// shape to vary (a mount, a delay, a scale, the speed of sound's, a skew, a constant echo
+/// delay) is kept.
+pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Concealed, &'static str) {
+    let curve = d.unit() < 0.5;
+    let pick = d.unit();
+    let mut unit = || d.unit();
+    match c {
+        Concealed::LidarIncidence {
+            coefficient,
+            collimated_m,
+            ..
+        } => {
+            let (growth, name) = if curve {
+                let c = Curve::random(0.0, 80f64.to_radians(), &mut unit);
+                (
+                    IncidenceGrowth::Curve(c),
+                    "a random curve of the incidence angle",
+                )
+            } else if pick < 0.5 {
+                (IncidenceGrowth::Secant, "sec θ − 1")
+            } else {
+                let onset = (20.0 + 18.0 * unit()).to_radians();
+                (
+                    IncidenceGrowth::Onset { onset_rad: onset },
+                    "tan θ past an onset angle",
+                )
+            };
+            (
+                Concealed::LidarIncidence {
+                    coefficient,
+                    collimated_m,
+                    growth,
+                },
+                name,
+            )
+        }
+        Concealed::LidarReflectivity {
+            coefficient_m,
+            reference,
+            ..
+        } => {
+            let (walk, name) = if curve {
+                let c = Curve::random(-1.0, 3.0, &mut unit);
+                (ReflectivityWalk::Curve(c), "a random curve of ln(ρ_ref/ρ)")
+            } else {
+                (ReflectivityWalk::Logarithmic, "log₂(ρ_ref/ρ)")
+            };
+            (
+                Concealed::LidarReflectivity {
+                    coefficient_m,
+                    reference,
+                    walk,
+                },
+                name,
+            )
+        }
+        Concealed::LidarMixedPixels { half_width_deg, .. } => {
+            let (blend, name) = if curve {
+                let c = Curve::random(0.0, 1.0, &mut unit);
+                let harmonic = pick < 0.5;
+                (
+                    Blend::Profile { curve: c, harmonic },
+                    "a footprint of a random profile",
+                )
+            } else {
+                (Blend::GaussianMean, "a Gaussian footprint's mean range")
+            };
+            (
+                Concealed::LidarMixedPixels {
+                    half_width_deg,
+                    blend,
+                },
+                name,
+            )
+        }
+        Concealed::LidarWarmup {
+            coefficient_per_m,
+            time_constant_s,
+            offset_m,
+            ..
+        } => {
+            let (settling, name) = if curve {
+                let c = Curve::random(0.0, 4.0, &mut unit);
+                (Settling::Curve(c), "a random settling curve")
+            } else if pick < 0.5 {
+                let share = 0.3 + 0.4 * unit();
+                (
+                    Settling::TwoMasses { fast_share: share },
+                    "two thermal masses",
+                )
+            } else {
+                (Settling::Ramp, "a thermostat's ramp")
+            };
+            (
+                Concealed::LidarWarmup {
+                    coefficient_per_m,
+                    time_constant_s,
+                    offset_m,
+                    settling,
+                },
+                name,
+            )
+        }
+        Concealed::SonarBeamWidth { half_angle_deg, .. } => {
+            let (pick, name) = if pick < 0.5 {
+                (
+                    EchoPick::BeamCentroid,
+                    "the echoes' centroid across the beam",
+                )
+            } else {
+                (EchoPick::Threshold, "a detection threshold across the lobe")
+            };
+            (
+                Concealed::SonarBeamWidth {
+                    half_angle_deg,
+                    pick,
+                },
+                name,
+            )
+        }
+        Concealed::WheelSlip { gain_s, .. } => {
+            // Speeding up and braking apart: the braking share anywhere in [−1, 1].
+            let braking_share = 2.0 * unit() - 1.0;
+            let top = largest_acceleration(nominal);
+            let (traction, name) = if curve {
+                let c = Curve::random(0.0, top, &mut unit);
+                (
+                    Traction::Curve {
+                        top_mps2: top,
+                        curve: c,
+                    },
+                    "a random curve of the acceleration",
+                )
+            } else {
+                let accel = top * (0.1 + 0.5 * unit());
+                (
+                    Traction::Saturating {
+                        accel_mps2: accel,
+                        top_mps2: top,
+                    },
+                    "a saturating tyre",
+                )
+            };
+            (
+                Concealed::WheelSlip {
+                    gain_s,
+                    braking_share,
+                    traction,
+                },
+                name,
+            )
+        }
+        Concealed::MotorLag {
+            time_constant_s, ..
+        } => {
+            let (response, name) = if pick < 1.0 / 3.0 {
+                let damping = 0.5 + 0.5 * unit();
+                (DriveResponse::SecondOrder { damping }, "second order")
+            } else if pick < 2.0 / 3.0 {
+                // The largest step reaches 1 − 1/e at τ.
+                let accel = (1.0 - (-1.0f64).exp()) * top_speed(nominal) / time_constant_s;
+                (
+                    DriveResponse::SlewLimited { accel_mps2: accel },
+                    "a slew-rate limit",
+                )
+            } else {
+                let share = 0.3 + 0.4 * unit();
+                (DriveResponse::DeadTime { share }, "a dead time and a lag")
+            };
+            (
+                Concealed::MotorLag {
+                    time_constant_s,
+                    response,
+                },
+                name,
+            )
+        }
+        Concealed::LidarTriangulation { .. } if curve => {
+            // The same error at 2 m and mean slope as the catalogue's draw.
+            let (at_2m, slope) = range_at_2m_and_scale(c);
+            let curve = Curve::random(0.0, RANGE_CURVE_SPAN_M, &mut unit);
+            (
+                Concealed::LidarRangeCurve {
+                    at_2m_m: at_2m,
+                    slope,
+                    curve,
+                },
+                "a random curve of the range",
+            )
+        }
+        Concealed::LidarTriangulation { .. } => (c, "a triangulation unit's geometry"),
+        Concealed::LidarWeakReturns {
+            half_loss_range_m,
+            log_power_sd,
+            reference,
+            ..
+        } if curve => {
+            let c = Curve::random(-1.5, 1.5, &mut unit);
+            (
+                Concealed::LidarWeakReturns {
+                    half_loss_range_m,
+                    log_power_sd,
+                    reference,
+                    loss: LossBy::RangeCurve(c),
+                },
+                "a random curve of the range",
+            )
+        }
+        // The catalogue writes a logistic in the log power; this, a probit.
+        Concealed::LidarWeakReturns { .. } => (c, "a log-normal power threshold"),
+        other => (other, "its only form"),
+    }
+}
+
+/// A triangulation unit's range error at 2 m and its scale error (`1/r − 1`, its baseline's).
+fn range_at_2m_and_scale(c: Concealed) -> (f64, f64) {
+    match c {
+        Concealed::LidarTriangulation {
+            origin_m,
+            baseline_ratio,
+            pointing_per_m,
+        } => (
+            origin_m + 2.0 / (baseline_ratio + 2.0 * pointing_per_m) - 2.0,
+            1.0 / baseline_ratio - 1.0,
+        ),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// The largest wheel speed the nominal drive commands, m/s: each wheel's `speed_mps` on a
+/// straight step, half the base times the turn rate on a turn.
+fn top_speed(nominal: &Scenario) -> f64 {
+    let turn = nominal.robot.turn_rate_deg_s.to_radians() * nominal.robot.wheel_base_m / 2.0;
+    nominal
+        .drive
+        .iter()
+        .map(|s| s.speed_mps.map_or(turn, f64::abs))
+        .fold(0.0, f64::max)
+        .max(1e-3)
+}
+
+/// The largest acceleration the encoders see between two samples: the top speed reached
+/// within one sample period.
+fn largest_acceleration(nominal: &Scenario) -> f64 {
+    let rate = nominal
+        .sensors
+        .odometer
+        .as_ref()
+        .map_or(50.0, |o| o.rate_hz);
+    top_speed(nominal) * rate
 }
 
 /// The effect of catalogue entry `k` (0-based, [`Effect::entries`] order): `sensor_latency`
@@ -226,12 +499,14 @@ pub(crate) fn draw_classes(d: &mut Draws, nominal: &Scenario, only: Option<usize
 
 /// The concealment of `classes` in the independent reality: each effect's parameters (the
 /// periodic range error outside the catalogue: amplitude ±[1, 4] cm × strength, period
-/// [0.3, 1] m), and the run's nuisances.
+/// [0.3, 1] m), in a form the catalogue does not write where `varied` ([`vary`]), and the
+/// run's nuisances.
 pub(crate) fn draw_independent(
     classes: &Classes,
     d: &mut Draws,
     strength: f64,
     nominal: &Scenario,
+    varied: bool,
 ) -> (Drawn, Nuisances) {
     let mut drawn = Drawn {
         effect: None,
@@ -241,6 +516,7 @@ pub(crate) fn draw_independent(
         second: None,
         outside: classes.outside,
         concealed: Vec::new(),
+        forms: Vec::new(),
         redrawn: 0,
     };
     for (k, e) in classes.effects.iter().enumerate() {
@@ -253,7 +529,14 @@ pub(crate) fn draw_independent(
         } else {
             drawn.second = Some((*e, truth));
         }
-        drawn.concealed.push(concealed(*e, &values));
+        let mechanism = concealed(*e, &values);
+        if varied {
+            let (mechanism, form) = vary(mechanism, d, nominal);
+            drawn.concealed.push(mechanism);
+            drawn.forms.push(format!("{}: {form}", e.name()));
+        } else {
+            drawn.concealed.push(mechanism);
+        }
         for (spec, v) in specs.iter().zip(&values) {
             drawn
                 .params
@@ -294,6 +577,7 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
             second: None,
             outside: false,
             concealed: Vec::new(),
+            forms: Vec::new(),
             redrawn: 0,
         };
     };
@@ -312,6 +596,7 @@ pub(crate) fn draw(d: &mut Draws, strength: f64, nominal: &Scenario, only: Optio
         second: None,
         outside: false,
         concealed: vec![concealed(effect, &values)],
+        forms: Vec::new(),
         redrawn: 0,
     }
 }
@@ -378,4 +663,79 @@ pub(crate) fn real_scenario(
     real.effects = drawn.effects.clone();
     real.seed = d.next() >> 1;
     (real, drawn)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use hilsim_fixtures::rooms::ROOM_4X3;
+
+    use super::*;
+
+    fn room() -> Scenario {
+        let robot = "[robot]\nstart = { x = 1.0, y = 1.0 }\nwheel_base_m = 0.23\n";
+        let sensors = "[sensors.odometer]\nnoise_m = 0.001\n";
+        Scenario::from_toml(
+            &format!("name = \"room\"\nduration_s = 4.0\n{ROOM_4X3}{robot}{sensors}"),
+            Path::new("room.toml"),
+        )
+        .expect("the test's scenario")
+    }
+
+    /// The varied reality never conceals a shaped mechanism in the catalogue's form, and draws
+    /// a random curve in about half of them: 400 draws per mechanism, a curve's share within
+    /// 0.35–0.65 (a fair coin's 400 tosses stay within it with probability 1 − 10⁻⁹).
+    #[test]
+    fn the_varied_reality_draws_forms_the_catalogue_does_not_write() {
+        let nominal = room();
+        for effect in [
+            Effect::LidarIncidenceAngle,
+            Effect::LidarReflectivity,
+            Effect::LidarMixedPixels,
+            Effect::LidarWarmupDrift,
+            Effect::SonarBeamWidth,
+            Effect::OdometerWheelSlip,
+            Effect::DriveMotorLag,
+            Effect::LidarRangeBias,
+            Effect::LidarDropout,
+        ] {
+            let mut d = Draws::new(5, 0);
+            let mut curves = 0;
+            for _ in 0..400 {
+                let values = draw_values(effect, &mut d, 1.0, &nominal);
+                let (varied, form) = vary(concealed(effect, &values), &mut d, &nominal);
+                for catalogue_form in [
+                    "Tangent",
+                    "Inverse",
+                    "TopHatHarmonic",
+                    "Exponential",
+                    "Nearest",
+                    "Linear",
+                    "FirstOrder",
+                ] {
+                    assert!(
+                        !format!("{varied:?}").contains(catalogue_form),
+                        "{effect:?}: {varied:?}"
+                    );
+                }
+                curves += usize::from(form.contains("random"));
+            }
+            let curved = [
+                Effect::LidarIncidenceAngle,
+                Effect::LidarReflectivity,
+                Effect::LidarMixedPixels,
+                Effect::LidarWarmupDrift,
+                Effect::OdometerWheelSlip,
+                Effect::LidarRangeBias,
+                Effect::LidarDropout,
+            ]
+            .contains(&effect);
+            if curved {
+                assert!((140..=260).contains(&curves), "{effect:?}: {curves}/400");
+            } else {
+                assert_eq!(curves, 0, "{effect:?}");
+            }
+        }
+    }
 }

@@ -30,6 +30,10 @@ pub enum Reality {
     /// nuisances, two effects at once in a fifth of the trials and an effect outside the
     /// catalogue.
     Independent,
+    /// The independent reality with each concealed mechanism in a form the catalogue does not
+    /// write: a random smooth monotone curve of its variable on a fair coin, else one of the
+    /// physical forms of `hilsim_reality::form` other than the catalogue's.
+    Varied,
 }
 
 impl Reality {
@@ -39,6 +43,14 @@ impl Reality {
         match self {
             Self::Hilsim => "hilsim",
             Self::Independent => "independent",
+            Self::Varied => "varied",
         }
+    }
+
+    /// Whether it is the independent generator (with its nuisances, two effects at once and an
+    /// effect outside the catalogue), in the catalogue's forms or varied ones.
+    #[must_use]
+    pub fn independent(self) -> bool {
+        self != Self::Hilsim
     }
 }

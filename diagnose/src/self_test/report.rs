@@ -30,6 +30,7 @@ impl SelfTest {
                     "unexplained": o.unexplained,
                     "param_errors": o.param_errors.iter().map(|(e, v)| (e.name().to_string(), json!(v.is_finite().then_some(*v)))).collect::<serde_json::Map<_, _>>(),
                     "drawn": o.drawn.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                    "forms": o.forms,
                     "verdict": verdict_label(&o.verdict),
                     "refusal": o.verdict.as_ref().err(),
                     "fitted": o.fitted.iter().copied().filter(|v| v.is_finite()).collect::<Vec<_>>(),
@@ -138,7 +139,12 @@ impl SelfTest {
                 } else {
                     String::new()
                 };
-                format!("trial {}: {truth} → {answer}{extra}", o.index)
+                let forms = if o.forms.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [{}]", o.forms.join("; "))
+                };
+                format!("trial {}: {truth}{forms} → {answer}{extra}", o.index)
             })
             .collect();
         if !misses.is_empty() {
@@ -215,7 +221,8 @@ impl SelfTest {
             s.without_effect,
             match self.reality {
                 Reality::Hilsim => "recordings without an effect not `none`",
-                Reality::Independent => "trials naming an effect that was not there",
+                Reality::Independent | Reality::Varied =>
+                    "trials naming an effect that was not there",
             },
             pct(s.false_alarm_share()),
             verdict(1)
@@ -227,7 +234,7 @@ impl SelfTest {
                 s.two_named, s.two
             )?;
         }
-        if self.reality == Reality::Independent {
+        if self.reality.independent() {
             writeln!(
                 out,
                 "outside the catalogue: {}/{} unexplained ({}; goal ≥ 90 %): {}",
@@ -288,7 +295,7 @@ impl SelfTest {
             } else {
                 "—".to_string()
             },
-            if self.reality == Reality::Independent {
+            if self.reality.independent() {
                 // `Score::measured`: the independent reality's nuisances are not the declared
                 // noise, so its floor is no goal.
                 "no goal on the independent reality"

@@ -125,6 +125,7 @@ impl TrialRun {
             "index": self.index,
             "truth": self.drawn.label(),
             "drawn": self.drawn.params.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "forms": self.drawn.forms,
             "redrawn": self.drawn.redrawn,
         });
         j
@@ -146,6 +147,9 @@ impl TrialRun {
             self.drawn.label(),
             drawn_text.join(", ")
         );
+        for form in &self.drawn.forms {
+            let _ = writeln!(out, "form: {form}");
+        }
         if self.drawn.redrawn > 0 {
             let _ = writeln!(
                 out,

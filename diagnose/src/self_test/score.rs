@@ -84,7 +84,7 @@ impl Score {
         // verdict.
         let classes: Vec<&'static str> = std::iter::once("none")
             .chain(Effect::entries())
-            .chain((reality == Reality::Independent).then_some(OUTSIDE))
+            .chain((reality.independent()).then_some(OUTSIDE))
             .collect();
         let columns: Vec<&'static str> = std::iter::once("none")
             .chain(Effect::entries())
@@ -120,7 +120,7 @@ impl Score {
                     .count();
                 (alarms, without.len())
             }
-            Reality::Independent => (
+            Reality::Independent | Reality::Varied => (
                 outcomes.iter().filter(|o| o.names_absent()).count(),
                 outcomes.len(),
             ),

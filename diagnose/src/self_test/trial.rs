@@ -24,6 +24,8 @@ pub struct Outcome {
     /// Whether an effect outside the catalogue was concealed.
     pub outside: bool,
     pub drawn: Vec<(String, f64)>,
+    /// The concealed effects' forms, where the varied reality drew them.
+    pub forms: Vec<String>,
     pub verdict: Result<Verdict, String>,
     /// Every effect named.
     pub named: Vec<Effect>,
@@ -81,13 +83,14 @@ fn concealing(nominal: &Scenario, plan: Plan, i: u64) -> (Drawn, Result<Recordin
                 .map_err(|e| e.to_string());
             (drawn, recording)
         }
-        Reality::Independent => {
+        Reality::Independent | Reality::Varied => {
             let mut d = Draws::new(plan.seed, i);
             let classes = draw_classes(&mut d, nominal, plan.only);
+            let varied = plan.reality == Reality::Varied;
             let mut redrawn = 0;
             loop {
                 let (mut drawn, nuisances) =
-                    draw_independent(&classes, &mut d, plan.strength, nominal);
+                    draw_independent(&classes, &mut d, plan.strength, nominal, varied);
                 let seed = d.next() >> 1;
                 let recording = hilsim_reality::record(nominal, &drawn.concealed, nuisances, seed);
                 if redrawn < MAX_REDRAWS && drives_through_obstacle(nominal, &recording) {
@@ -132,6 +135,7 @@ impl Outcome {
             second: drawn.second.map(|s| s.0),
             outside: drawn.outside,
             drawn: drawn.params.clone(),
+            forms: drawn.forms.clone(),
             verdict: Err(String::new()),
             named: Vec::new(),
             unexplained: 0,

@@ -134,7 +134,10 @@ fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
 /// periodic one, `A sin(2π d/λ)`, outside the catalogue) whose slow part its polynomial took
 /// up, and that error is not the unit's calibration. A ripple much shorter than the range's
 /// bins averages out in each bin's mean and shows as their spread instead, which a bias moves
-/// not at all.
+/// not at all. A spread left against the range counts only where it is the range's: stronger
+/// than the spread left against any other variable. A ripple in d shows against the range
+/// first; an excess of the spread everywhere (a noise heavier than declared) shows against
+/// every variable a run's path ties to the range (time, speed, bearing) about as strongly.
 pub(crate) fn leaves_range_structure(
     c: &CandidateFit,
     nominal: &[Evidence],
@@ -150,17 +153,25 @@ pub(crate) fn leaves_range_structure(
         .iter()
         .find(|e| against_range(e, TestKind::SpreadAgainst))
         .map_or(f64::INFINITY, |e| e.size_m);
+    let counted: Vec<&Evidence> = left
+        .iter()
+        .filter(|l| l.sensor == sensor)
+        .flat_map(|l| l.evidence.iter())
+        .filter(|e| e.counts(threshold, floors))
+        .collect();
+    // The strongest spread left against another variable than the range.
+    let spread_elsewhere = counted
+        .iter()
+        .filter(|e| e.test == TestKind::SpreadAgainst && e.covariate != Some(Covariate::Range))
+        .map(|e| e.score)
+        .fold(0.0, f64::max);
     matches!(c.effect, Effect::LidarRangeBias | Effect::SonarRangeBias)
-        && left
-            .iter()
-            .filter(|l| l.sensor == sensor)
-            .flat_map(|l| l.evidence.iter())
-            .filter(|e| e.counts(threshold, floors))
-            .any(|e| {
-                against_range(&e, TestKind::BiasAgainst)
-                    || (against_range(&e, TestKind::SpreadAgainst)
-                        && e.size_m > MAX_MAIN_SIZE_LEFT * spread_before)
-            })
+        && counted.iter().any(|e| {
+            against_range(e, TestKind::BiasAgainst)
+                || (against_range(e, TestKind::SpreadAgainst)
+                    && e.size_m > MAX_MAIN_SIZE_LEFT * spread_before
+                    && e.score > spread_elsewhere)
+        })
 }
 
 /// Share of a sensor's main structure's size (metres) its named effects may leave, and of its
@@ -216,6 +227,7 @@ fn select_in(
     options: &Options,
 ) -> Vec<CandidateFit> {
     let cone = declared_cone(ctx);
+    let alone = pool.clone();
     let mut chosen: Vec<CandidateFit> = Vec::new();
     while chosen.len() < MAX_PER_SENSOR {
         let Some(k) = pool
@@ -236,11 +248,54 @@ fn select_in(
         if pool.is_empty() || chosen.len() == MAX_PER_SENSOR {
             break;
         }
-        let under = on_top_of(base, &chosen);
-        pool = pool
+        pool = on_top_of_chosen(ctx, data, base, &chosen, &pool, options);
+        if pool.iter().any(|c| earns_place(c, cone, options)) {
+            continue;
+        }
+        // Not the lidar's against a path estimated from the lidar: its fits there are on a path
+        // that took up part of each effect, and what one leaves is the path's to give back
+        // (the named effect's rounds), not another effect's.
+        if ctx.estimated && data.sensor == Sensor::Lidar {
+            break;
+        }
+        // None gains on top of those chosen, their parameters held. Where two effects'
+        // parameters trade (a sonar's offset and its scale over a room's ranges), the first
+        // named took up part of the other, which then still gains on top of it, but too
+        // little to earn its place: each such candidate that earned its place on its own is
+        // refitted jointly with those chosen, and taken when every effect of the joint fit
+        // earns its place against the others. (One that gains nothing at all on top of them
+        // mimics them and is not tried: each joint refit costs several fits.)
+        let Some(joint) = pool
             .par_iter()
-            .map(|c| explain::fit_candidate(ctx, data, &under, c.effect, options.max_fit_rows))
-            .collect();
+            .filter(|c| c.heldout_gain > 0.0)
+            .filter_map(|c| {
+                let own = alone.iter().find(|a| a.effect == c.effect)?;
+                if !earns_place(own, cone, options) {
+                    return None;
+                }
+                // From its fit on top of them: its own fit took up the others' part too.
+                let trial: Vec<CandidateFit> = chosen.iter().cloned().chain([c.clone()]).collect();
+                let joint = explain::refit_jointly(ctx, data, &trial, base, options.max_fit_rows);
+                joint
+                    .iter()
+                    .all(|j| earns_place(j, cone, options))
+                    .then_some(joint)
+            })
+            .max_by(|a, b| {
+                let last =
+                    |j: &[CandidateFit]| j.last().map_or(f64::NEG_INFINITY, |c| c.heldout_gain);
+                last(a).total_cmp(&last(b))
+            })
+        else {
+            break;
+        };
+        let added = joint.last().map(|c| c.effect);
+        pool.retain(|c| Some(c.effect) != added);
+        chosen = joint;
+        if pool.is_empty() {
+            break;
+        }
+        pool = on_top_of_chosen(ctx, data, base, &chosen, &pool, options);
     }
     // Jointly; an effect the others make redundant is dropped and the rest refitted.
     while chosen.len() >= 2 {
@@ -266,6 +321,21 @@ fn select_in(
         chosen = kept;
     }
     chosen
+}
+
+/// Each of `pool` fitted again on top of `base` and the effects `chosen`.
+fn on_top_of_chosen(
+    ctx: &Context<'_>,
+    data: &SensorData,
+    base: &Hypothesis,
+    chosen: &[CandidateFit],
+    pool: &[CandidateFit],
+    options: &Options,
+) -> Vec<CandidateFit> {
+    let under = on_top_of(base, chosen);
+    pool.par_iter()
+        .map(|c| explain::fit_candidate(ctx, data, &under, c.effect, options.max_fit_rows))
+        .collect()
 }
 
 /// The effects to name in `data`, with every candidate fitted on its own.

@@ -169,7 +169,10 @@ impl Simulation {
             lag: scenario
                 .effects
                 .drive_motor_lag
-                .map(|lag| MotorLag::new(lag.time_constant_s)),
+                .map(|lag| match lag.damping {
+                    Some(damping) => MotorLag::second_order(lag.time_constant_s, damping),
+                    None => MotorLag::new(lag.time_constant_s),
+                }),
         }
     }
 

@@ -314,14 +314,22 @@ impl Effect {
             )
             .form(),
         ];
-        const LAG: [ParamSpec; 1] = [log(
-            "time_constant_s",
-            "s",
-            (0.005, 5.0),
-            13,
-            R::uniform(0.1, 0.4).at_most(10.0),
-        )
-        .searched_from_zero()];
+        // The lag's response time, and its form as the inverse of a second-order response's
+        // damping over [0, 2.5] on a 0.5 grid: 0 the first-order lag (a second order's limit as
+        // its damping grows at the same response time), 1 critical damping, 2.5 a wheel that
+        // overshoots by 52 % (ζ = 0.4). The form, which the self-test's catalogue reality keeps
+        // first order.
+        const LAG: [ParamSpec; 2] = [
+            log(
+                "time_constant_s",
+                "s",
+                (0.005, 5.0),
+                13,
+                R::uniform(0.1, 0.4).at_most(10.0),
+            )
+            .searched_from_zero(),
+            lin("underdamping", "", (0.0, 2.5), 6, R::zero()).form(),
+        ];
         // The mount's yaw is searched over ±8° (a unit bolted visibly crooked is past it) on
         // a 2° grid: a wall seen 2° off moves by 3.5 % of its range, which the likelihood
         // follows smoothly; its position over ±0.1 m on a coarse grid, Nelder–Mead refining
@@ -485,7 +493,8 @@ impl Effect {
     }
 
     /// The parameters that set its form, not its size (indices into [`Effect::params`]): the
-    /// warm-up's time constant, the incidence's power of `tan θ` and the slip's braking share. A path estimated from the
+    /// warm-up's time constant, the incidence's power of `tan θ`, the slip's braking share and
+    /// the motor lag's underdamping. A path estimated from the
     /// lidar takes up part of an effect's size, not of its form, so the realignment follows the
     /// size alone to its fixed point.
     #[must_use]
@@ -493,7 +502,7 @@ impl Effect {
         match self {
             Effect::LidarWarmupDrift => &[1],
             Effect::LidarIncidenceAngle => &[2],
-            Effect::OdometerWheelSlip => &[1],
+            Effect::OdometerWheelSlip | Effect::DriveMotorLag => &[1],
             _ => &[],
         }
     }
@@ -560,6 +569,7 @@ impl Effect {
             Effect::OdometerWheelRadius => vec![1.0, 1.0],
             Effect::DriveWheelBase => vec![1.0],
             Effect::OdometerWheelSlip => vec![0.0, 1.0],
+            Effect::DriveMotorLag => vec![0.0, 0.0],
             // Half the returns lost only at the search's far end.
             Effect::LidarDropout => vec![50.0, 0.3],
             _ => vec![0.0],

@@ -85,6 +85,7 @@ impl Effect {
                     coefficient_per_m: p(0),
                     time_constant_s: p(1).max(1e-3),
                     offset_m: p(2),
+                    stretch: 1.0,
                 });
             }
             Effect::SonarBeamWidth => {
@@ -107,8 +108,12 @@ impl Effect {
                 });
             }
             Effect::DriveMotorLag => {
+                // The underdamping 1/ζ; under 0.1 (ζ past 10) the response is the first-order
+                // lag's to a tenth of a percent.
+                let underdamping = p(1);
                 e.drive_motor_lag = (p(0) > 0.0).then_some(scenario::DriveMotorLag {
                     time_constant_s: p(0),
+                    damping: (underdamping >= 0.1).then(|| 1.0 / underdamping),
                 });
             }
             Effect::LidarMountOffset => {

@@ -58,6 +58,17 @@ impl Effect {
                 p(0)
             ),
             Effect::OdometerWheelSlip => slip_sentence(p(0), params.get(1).copied()),
+            Effect::DriveMotorLag if p(1) >= 0.1 => format!(
+                "The simulated wheels reach a commanded speed at once; the real ones reach \
+                 1 − 1/e of a step in {:.2} s through a second-order response of damping {:.2}{}.",
+                p(0),
+                1.0 / p(1),
+                if p(1) > 1.0 {
+                    ", overshooting before they settle"
+                } else {
+                    ""
+                }
+            ),
             Effect::DriveMotorLag => format!(
                 "The simulated wheels reach a commanded speed at once; the real ones follow it \
                  with a first-order lag of {:.2} s.",

@@ -193,7 +193,7 @@ pub(crate) fn concealed(effect: Effect, values: &[f64]) -> Concealed {
 /// physical forms of [`hilsim_reality::form`] other than the catalogue's. A mechanism with no
 /// shape to vary (a mount, a delay, a scale, the speed of sound's, a skew, a constant echo
 /// delay) is kept.
-pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Concealed, &'static str) {
+pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Concealed, String) {
     let curve = d.unit() < 0.5;
     let pick = d.unit();
     let mut unit = || d.unit();
@@ -207,15 +207,15 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                 let c = Curve::random(0.0, 80f64.to_radians(), &mut unit);
                 (
                     IncidenceGrowth::Curve(c),
-                    "a random curve of the incidence angle",
+                    "a random curve of the incidence angle".to_string(),
                 )
             } else if pick < 0.5 {
-                (IncidenceGrowth::Secant, "sec θ − 1")
+                (IncidenceGrowth::Secant, "sec θ − 1".to_string())
             } else {
                 let onset = (20.0 + 18.0 * unit()).to_radians();
                 (
                     IncidenceGrowth::Onset { onset_rad: onset },
-                    "tan θ past an onset angle",
+                    format!("tan θ past an onset at {:.0}°", onset.to_degrees()),
                 )
             };
             (
@@ -234,9 +234,12 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
         } => {
             let (walk, name) = if curve {
                 let c = Curve::random(-1.0, 3.0, &mut unit);
-                (ReflectivityWalk::Curve(c), "a random curve of ln(ρ_ref/ρ)")
+                (
+                    ReflectivityWalk::Curve(c),
+                    "a random curve of ln(ρ_ref/ρ)".to_string(),
+                )
             } else {
-                (ReflectivityWalk::Logarithmic, "log₂(ρ_ref/ρ)")
+                (ReflectivityWalk::Logarithmic, "log₂(ρ_ref/ρ)".to_string())
             };
             (
                 Concealed::LidarReflectivity {
@@ -253,10 +256,13 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                 let harmonic = pick < 0.5;
                 (
                     Blend::Profile { curve: c, harmonic },
-                    "a footprint of a random profile",
+                    "a footprint of a random profile".to_string(),
                 )
             } else {
-                (Blend::GaussianMean, "a Gaussian footprint's mean range")
+                (
+                    Blend::GaussianMean,
+                    "a Gaussian footprint's mean range".to_string(),
+                )
             };
             (
                 Concealed::LidarMixedPixels {
@@ -274,15 +280,15 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
         } => {
             let (settling, name) = if curve {
                 let c = Curve::random(0.0, 4.0, &mut unit);
-                (Settling::Curve(c), "a random settling curve")
+                (Settling::Curve(c), "a random settling curve".to_string())
             } else if pick < 0.5 {
                 let share = 0.3 + 0.4 * unit();
                 (
                     Settling::TwoMasses { fast_share: share },
-                    "two thermal masses",
+                    format!("two thermal masses, {:.0} % of it fast", 100.0 * share),
                 )
             } else {
-                (Settling::Ramp, "a thermostat's ramp")
+                (Settling::Ramp, "a thermostat's ramp".to_string())
             };
             (
                 Concealed::LidarWarmup {
@@ -298,10 +304,13 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
             let (pick, name) = if pick < 0.5 {
                 (
                     EchoPick::BeamCentroid,
-                    "the echoes' centroid across the beam",
+                    "the echoes' centroid across the beam".to_string(),
                 )
             } else {
-                (EchoPick::Threshold, "a detection threshold across the lobe")
+                (
+                    EchoPick::Threshold,
+                    "a detection threshold across the lobe".to_string(),
+                )
             };
             (
                 Concealed::SonarBeamWidth {
@@ -322,7 +331,7 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                         top_mps2: top,
                         curve: c,
                     },
-                    "a random curve of the acceleration",
+                    "a random curve of the acceleration".to_string(),
                 )
             } else {
                 let accel = top * (0.1 + 0.5 * unit());
@@ -331,7 +340,7 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                         accel_mps2: accel,
                         top_mps2: top,
                     },
-                    "a saturating tyre",
+                    format!("a saturating tyre (a_s {accel:.1} m/s²)"),
                 )
             };
             (
@@ -348,17 +357,23 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
         } => {
             let (response, name) = if pick < 1.0 / 3.0 {
                 let damping = 0.5 + 0.5 * unit();
-                (DriveResponse::SecondOrder { damping }, "second order")
+                (
+                    DriveResponse::SecondOrder { damping },
+                    format!("second order, damping {damping:.2}"),
+                )
             } else if pick < 2.0 / 3.0 {
                 // The largest step reaches 1 − 1/e at τ.
                 let accel = (1.0 - (-1.0f64).exp()) * top_speed(nominal) / time_constant_s;
                 (
                     DriveResponse::SlewLimited { accel_mps2: accel },
-                    "a slew-rate limit",
+                    "a slew-rate limit".to_string(),
                 )
             } else {
                 let share = 0.3 + 0.4 * unit();
-                (DriveResponse::DeadTime { share }, "a dead time and a lag")
+                (
+                    DriveResponse::DeadTime { share },
+                    format!("a dead time of {:.0} % of τ and a lag", 100.0 * share),
+                )
             };
             (
                 Concealed::MotorLag {
@@ -378,10 +393,10 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                     slope,
                     curve,
                 },
-                "a random curve of the range",
+                "a random curve of the range".to_string(),
             )
         }
-        Concealed::LidarTriangulation { .. } => (c, "a triangulation unit's geometry"),
+        Concealed::LidarTriangulation { .. } => (c, "a triangulation unit's geometry".to_string()),
         Concealed::LidarWeakReturns {
             half_loss_range_m,
             log_power_sd,
@@ -396,12 +411,12 @@ pub(crate) fn vary(c: Concealed, d: &mut Draws, nominal: &Scenario) -> (Conceale
                     reference,
                     loss: LossBy::RangeCurve(c),
                 },
-                "a random curve of the range",
+                "a random curve of the range".to_string(),
             )
         }
         // The catalogue writes a logistic in the log power; this, a probit.
-        Concealed::LidarWeakReturns { .. } => (c, "a log-normal power threshold"),
-        other => (other, "its only form"),
+        Concealed::LidarWeakReturns { .. } => (c, "a log-normal power threshold".to_string()),
+        other => (other, "its only form".to_string()),
     }
 }
 

@@ -165,6 +165,7 @@ fn warmup_drift_settles_exponentially() {
         coefficient_per_m: k,
         time_constant_s: tau,
         offset_m: c,
+        stretch: 1.0,
     });
     let (a, b) = (lidar(&long), lidar(&warm));
     assert_eq!(a.len(), b.len());

@@ -175,6 +175,9 @@ pub struct LidarWarmupDrift {
     /// The constant part of the range error at power-on, metres; default 0.
     #[serde(default)]
     pub offset_m: f64,
+    /// β of the settling `e^{−(t/τ)^β}`; default 1, one thermal mass.
+    #[serde(default = "one")]
+    pub stretch: f64,
 }
 
 /// `[effects.sonar_beam_width]`: the sonar's real cone.
@@ -223,12 +226,15 @@ impl OdometerWheelSlip {
 }
 
 /// `[effects.drive_motor_lag]`: each wheel's speed follows its command through a first-order
-/// lag.
+/// lag, or a second-order response of the same response time.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveMotorLag {
-    /// The lag's time constant τ, seconds.
+    /// The lag's time constant τ, seconds: the time a step takes to reach `1 − 1/e` of itself.
     pub time_constant_s: f64,
+    /// The second-order response's damping ζ (absent: first order).
+    #[serde(default)]
+    pub damping: Option<f64>,
 }
 
 /// `[effects.lidar_mount_offset]`: the lidar's real mount is its declared one (`[sensors.lidar]

@@ -85,6 +85,7 @@ pub(super) fn validate(s: &Scenario) -> Check {
         )?;
         positive_up_to(p("time_constant_s"), x.time_constant_s, 3600.0, "seconds")?;
         within(p("offset_m"), x.offset_m, -0.5, 0.5, "an offset in metres")?;
+        within(p("stretch"), x.stretch, 0.1, 10.0, "an exponent")?;
     }
     if let Some(x) = e.sonar_beam_width {
         let p = |k: &'static str| key_path!["effects", "sonar_beam_width", k];
@@ -122,6 +123,11 @@ pub(super) fn validate(s: &Scenario) -> Check {
     if let Some(x) = e.drive_motor_lag {
         let p = |k: &'static str| key_path!["effects", "drive_motor_lag", k];
         positive_up_to(p("time_constant_s"), x.time_constant_s, 10.0, "seconds")?;
+        if let Some(damping) = x.damping {
+            // Below 0.1 a wheel rings for tens of periods; past 10 the response is the
+            // first-order lag's to within a tenth of a percent.
+            within(p("damping"), damping, 0.1, 10.0, "a damping ratio")?;
+        }
     }
     // The bounds below are far beyond any real unit (a lidar 45° off its mount, a wheel half
     // again as large, a second of latency): values outside them are typos.

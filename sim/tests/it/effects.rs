@@ -65,6 +65,10 @@ fn bad_effect_tables_are_refused_at_their_line() {
             "[effects.drive_motor_lag]\ntime_constant_s = -0.1\n",
             "s.toml:7: effects.drive_motor_lag.time_constant_s: expected seconds in (0, 10], found -0.1",
         ),
+        (
+            "[effects.drive_motor_lag]\ntime_constant_s = 0.3\ndamping = 0.05\n",
+            "s.toml:8: effects.drive_motor_lag.damping: expected a damping ratio in 0.1..=10, found 0.05",
+        ),
         // An unknown effect: serde names the key.
         ("[effects.lidar_fog]\ndensity = 1.0\n", "s.toml:6: unknown field `lidar_fog`"),
         // A typo inside a table.

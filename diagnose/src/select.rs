@@ -252,10 +252,11 @@ fn select_in(
         if pool.iter().any(|c| earns_place(c, cone, options)) {
             continue;
         }
-        // Not the lidar's against a path estimated from the lidar: its fits there are on a path
-        // that took up part of each effect, and what one leaves is the path's to give back
-        // (the named effect's rounds), not another effect's.
-        if ctx.estimated && data.sensor == Sensor::Lidar {
+        // Not against a path estimated from the lidar: it took up part of each lidar effect,
+        // which the named effect's rounds give back, and its own error shows in every sensor
+        // judged along it, which two effects that trade would share out between them (wheels
+        // that slip at every change of speed and a radius a percent short).
+        if ctx.estimated {
             break;
         }
         // None gains on top of those chosen, their parameters held. Where two effects'

@@ -66,11 +66,11 @@ impl MotorLag {
     /// let go = WheelCommand { left_mps: 0.2, right_mps: 0.2 };
     /// let mut lag = MotorLag::second_order(0.3, 0.5);
     /// let speeds: Vec<f64> = (0..200)
-///     .map(|_| {
-///         lag.step(go, 0.01);
-///         lag.speeds().left_mps
-///     })
-///     .collect();
+    ///     .map(|_| {
+    ///         lag.step(go, 0.01);
+    ///         lag.speeds().left_mps
+    ///     })
+    ///     .collect();
     /// // 1 − 1/e of the step at τ = 0.3 s (the 30th step); an overshoot of e^{−πζ/√(1−ζ²)}, 16 %.
     /// assert!((speeds[29] - 0.2 * (1.0 - (-1.0f64).exp())).abs() < 0.004, "{}", speeds[29]);
     /// let peak = speeds.iter().copied().fold(0.0, f64::max);

@@ -9,7 +9,7 @@ use hilsim_recording::{Recording, TruthSample};
 
 use crate::catalogue::{Effect, Sensor};
 use crate::error::MismatchError;
-use crate::estimate::{estimate_trajectory, DeadReckoning, Uncertainty};
+use crate::estimate::{estimate_trajectory, DeadReckoning, Estimate};
 use crate::physics::{Hypothesis, Physics};
 use crate::sparse_truth;
 use crate::trajectory::{wrap, Trajectory};
@@ -58,6 +58,8 @@ pub(crate) struct Aligned {
     pub yaw_sd_rad: f64,
     /// What an estimate followed between the lidar's corrections (`None` for `truth.csv`).
     pub reckoned: Option<DeadReckoning>,
+    /// With [`DeadReckoning::Scans`], the matches smoothed along the encoders between them.
+    pub smoothed: Option<Trajectory>,
     /// What the path the drive is judged against followed between the lidar's corrections,
     /// when the drive is judged against an estimate (`None` otherwise).
     pub drive_reckoned: Option<DeadReckoning>,
@@ -113,6 +115,7 @@ pub(crate) fn align(
                 .into(),
         ));
     }
+    let mut first_smoothed = None;
     let (trajectory, alignment, position_sd_m, yaw_sd_rad, reckoned) = match &recording.truth {
         Some(truth) if !truth.is_empty() => (
             truth_trajectory(truth, recording, declared.wheel_base_m, &mut notes)?,
@@ -129,13 +132,19 @@ pub(crate) fn align(
                         .into(),
                 ));
             }
-            let (trajectory, sd, reckoned) = estimate_trajectory(
+            let Estimate {
+                trajectory,
+                uncertainty: sd,
+                reckoned,
+                smoothed,
+            } = estimate_trajectory(
                 physics,
                 recording,
                 end_s,
                 &Hypothesis::nominal(),
                 DeadReckoning::Commands,
             )?;
+            first_smoothed = smoothed;
             notes.push(format!(
                 "no truth.csv: the trajectory is estimated by matching the lidar to the \
                  scenario's world (position s.d. {:.1} mm, heading {:.2} mrad); every sensor is \
@@ -179,6 +188,7 @@ pub(crate) fn align(
         position_sd_m,
         yaw_sd_rad,
         reckoned,
+        smoothed: first_smoothed,
         drive_reckoned: None,
         replayed: Hypothesis::nominal(),
         notes,
@@ -222,7 +232,6 @@ pub(crate) struct Estimates(Mutex<Vec<(EstimateKey, Estimate)>>);
 
 /// The effects (sorted, parameters bit for bit) and the dead reckoning followed.
 type EstimateKey = (Vec<(Effect, Vec<u64>)>, DeadReckoning);
-type Estimate = (Trajectory, Uncertainty, DeadReckoning);
 
 /// Estimates kept at most (each a trajectory of the recording's length).
 const MAX_ESTIMATES: usize = 16;
@@ -291,27 +300,22 @@ pub(crate) fn realign(
         .filter(|(e, _)| e.sensor() == Sensor::Drive)
         .fold(Hypothesis::nominal(), |h, (e, p)| h.and(*e, p.clone()));
     let preferred = aligned.reckoned.unwrap_or(DeadReckoning::Commands);
-    let (trajectory, sd, reckoned) =
+    let estimate =
         estimates.get_or_estimate(physics, recording, aligned.end_s, &full, preferred)?;
-    Ok(aligned.estimated_again(trajectory, sd, reckoned, replayed))
+    Ok(aligned.estimated_again(estimate, replayed))
 }
 
 impl Aligned {
     /// This run aligned by another estimate of its trajectory.
-    fn estimated_again(
-        &self,
-        trajectory: Trajectory,
-        sd: Uncertainty,
-        reckoned: DeadReckoning,
-        replayed: Hypothesis,
-    ) -> Self {
+    fn estimated_again(&self, estimate: Estimate, replayed: Hypothesis) -> Self {
         Self {
-            trajectory,
+            trajectory: estimate.trajectory,
             alignment: self.alignment,
             end_s: self.end_s,
-            position_sd_m: sd.position_m,
-            yaw_sd_rad: sd.yaw_rad,
-            reckoned: Some(reckoned),
+            position_sd_m: estimate.uncertainty.position_m,
+            yaw_sd_rad: estimate.uncertainty.yaw_rad,
+            reckoned: Some(estimate.reckoned),
+            smoothed: estimate.smoothed,
             drive_reckoned: self.drive_reckoned,
             replayed,
             notes: self.notes.clone(),
@@ -333,14 +337,15 @@ pub(crate) fn along_encoders(
     if recording.odometry.as_ref().is_none_or(|o| o.len() < 2) {
         return Ok(None);
     }
-    let (trajectory, sd, reckoned) = estimate_trajectory(
+    let estimate = estimate_trajectory(
         physics,
         recording,
         aligned.end_s,
         &Hypothesis::nominal(),
         DeadReckoning::Encoders,
     )?;
-    Ok(reckoned
+    Ok(estimate
+        .reckoned
         .follows_the_encoders()
-        .then(|| aligned.estimated_again(trajectory, sd, reckoned, Hypothesis::nominal())))
+        .then(|| aligned.estimated_again(estimate, Hypothesis::nominal())))
 }

@@ -6,6 +6,7 @@ use hilsim_recording::Recording;
 use crate::align::{self, Aligned, Alignment, Estimates};
 use crate::catalogue::{Effect, SearchLimits, Sensor};
 use crate::conclude::{conclude, declared_cone, Conclusion, Left, Nominal};
+use crate::crab;
 use crate::dropout;
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
@@ -143,24 +144,57 @@ pub fn diagnose_with_progress(
         }
         None => named,
     };
+    // Against the scans' own path, a lidar turned on its mount moves the path sideways, which
+    // the wheels cannot (`crab.rs`).
+    let crabbed = crab_mount(
+        final_ctx,
+        realigned.as_ref().unwrap_or(&aligned),
+        &named,
+        &mut candidates,
+        options,
+    )?;
+    let crab_ctx = crabbed.as_ref().map(|(_, a)| along(&ctx, a));
+    let final_ctx = crab_ctx.as_ref().unwrap_or(final_ctx);
+    let named = match (&crabbed, &crab_ctx) {
+        (Some((fit, _)), Some(along)) => {
+            let (mut named, again) =
+                rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
+            nominal = again;
+            named.push(fit.clone());
+            named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+            named
+        }
+        _ => named,
+    };
+    let path_so_far = crabbed
+        .as_ref()
+        .map(|(_, a)| a)
+        .or(realigned.as_ref())
+        .unwrap_or(&aligned);
     // A lidar mount offset or delay the estimated path took up, seen by the sonar and the
-    // encoders (the mount tried first; a delay when no mount is named).
-    let mut seen_through = None;
+    // encoders: whichever gains more where both are found (a mount of a decimetre and degrees
+    // mimics a delay of a fifth of a second on a drive that turns as it speeds up).
+    let mut seen_through: Option<(CandidateFit, Aligned)> = None;
     for effect in [
         Effect::LidarMountOffset,
         Effect::SensorLatency(Sensor::Lidar),
     ] {
-        seen_through = through_path(
+        let found = through_path(
             effect,
             final_ctx,
-            realigned.as_ref().unwrap_or(&aligned),
+            path_so_far,
             &named,
             &mut candidates,
             &data,
             options,
         )?;
-        if seen_through.is_some() {
-            break;
+        if let Some(found) = found {
+            if seen_through
+                .as_ref()
+                .is_none_or(|(fit, _)| found.0.heldout_gain > fit.heldout_gain)
+            {
+                seen_through = Some(found);
+            }
         }
     }
     let through_effect = seen_through.as_ref().map(|(fit, _)| fit.effect);
@@ -961,9 +995,11 @@ fn through_path(
         best.param_sd = param_sd;
         Some((gain, best))
     };
+    // The sonar's and the encoders' own effects (a lidar mount read from the path's sideways
+    // motion was scored there, but is the lidar's).
     let beside: Vec<CandidateFit> = named
         .iter()
-        .filter(|c| looking_from_robot(c.sensor))
+        .filter(|c| looking_from_robot(c.sensor) && looking_from_robot(c.effect.sensor()))
         .cloned()
         .collect();
     let explained: f64 = beside.iter().map(|c| c.heldout_gain).sum();
@@ -984,32 +1020,122 @@ fn through_path(
     let Some((_, best)) = found else {
         return Ok(None);
     };
+    // A fit stopped at its search's edge is not this effect's size (it is not named).
+    if effect
+        .params()
+        .iter()
+        .zip(&best.params)
+        .any(|(spec, &value)| SearchLimits::at_limit(spec, value))
+    {
+        return Ok(None);
+    }
     let again = match (effect, best.params.as_slice()) {
         // The path the delay was fitted along: the estimate put back by it.
         (Effect::SensorLatency(Sensor::Lidar), &[delay_s]) => Aligned {
             trajectory: aligned.trajectory.delayed(delay_s),
             ..aligned.clone()
         },
-        _ => {
-            let lidar_named: Vec<CandidateFit> = named
-                .iter()
-                .filter(|c| c.effect.sensor() == Sensor::Lidar)
-                .cloned()
-                .collect();
-            let hypothesis = hypothesis_of(&lidar_named).and(effect, best.params.clone());
-            align::realign(
-                ctx.physics,
-                ctx.recording,
-                ctx.estimates,
-                aligned,
-                &hypothesis,
-            )?
-        }
+        _ => estimated_under(ctx, aligned, named, effect, &best.params)?,
     };
     if let Some(c) = candidates.iter_mut().find(|c| c.effect == effect) {
         *c = best.clone();
     }
     Ok(Some((best, again)))
+}
+
+/// The range a mount's yaw is sized at, metres: the catalogue's reference range for the
+/// lidar's errors (a range bias's `at_2m_m`).
+const CRAB_SIZE_RANGE_M: f64 = 2.0;
+/// How many standard errors from the declared mount a yaw read from the path's sideways motion
+/// must lie: 3, as the halves of a log are compared.
+const CRAB_MIN_SD: f64 = 3.0;
+
+/// The yaw of a lidar turned on its mount, against a path that is the lidar's own matches
+/// ([`DeadReckoning::Scans`]: a log with encoders and no commands), read from the path moving
+/// sideways ([`crab`]). It is named when it gains on the held-out steps by
+/// [`Options::min_gain`], lies [`CRAB_MIN_SD`] standard errors from the declared mount, and
+/// turns a reading at [`CRAB_SIZE_RANGE_M`] by more than the lidar's practical floor. Returns
+/// it with the path estimated again under it and the named lidar effects.
+fn crab_mount(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    named: &[CandidateFit],
+    candidates: &mut Vec<CandidateFit>,
+    options: &Options,
+) -> Result<Option<(CandidateFit, Aligned)>, MismatchError> {
+    let effect = Effect::LidarMountOffset;
+    if aligned.reckoned != Some(DeadReckoning::Scans)
+        || !options.effects.contains(&effect)
+        || named.iter().any(|c| c.effect == effect)
+    {
+        return Ok(None);
+    }
+    let Some(c) = crab::fit(aligned.smoothed.as_ref().unwrap_or(&aligned.trajectory)) else {
+        return Ok(None);
+    };
+    let size_m = CRAB_SIZE_RANGE_M * c.yaw_rad.tan().abs();
+    let floor_m = options.floors.lidar_m;
+    let fit = CandidateFit {
+        effect,
+        sensor: Sensor::Odometer,
+        params: vec![c.yaw_rad.to_degrees(), 0.0, 0.0],
+        param_sd: vec![c.yaw_sd_rad.to_degrees(), f64::NAN, f64::NAN],
+        train_gain: c.train_gain,
+        heldout_gain: c.heldout_gain,
+        bic_gain: 2.0 * c.train_gain - (c.train_n as f64).ln(),
+        rmse_before: c.rmse_before_m,
+        rmse_after: c.rmse_after_m,
+        noise_floor: c.noise_m,
+        heldout_n: c.heldout_n,
+        rmse_given_past: false,
+        heldout_ll_per_reading: c.heldout_gain / c.heldout_n.max(1) as f64,
+        size_m,
+        size_noise_m: floor_m,
+        floor_multiple: size_m / floor_m.max(f64::MIN_POSITIVE),
+        scaled_rmse: (
+            c.rmse_before_m / c.noise_m.max(f64::MIN_POSITIVE),
+            c.rmse_after_m / c.noise_m.max(f64::MIN_POSITIVE),
+        ),
+        seen_until_s: aligned.end_s,
+    };
+    match candidates.iter_mut().find(|x| x.effect == effect) {
+        Some(x) => *x = fit.clone(),
+        None => candidates.push(fit.clone()),
+    }
+    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    let earns = fit.heldout_gain > options.min_gain
+        && fit.bic_gain > 0.0
+        && c.yaw_rad.abs() > CRAB_MIN_SD * c.yaw_sd_rad
+        && size_m > floor_m;
+    if !earns {
+        return Ok(None);
+    }
+    let again = estimated_under(ctx, aligned, named, effect, &fit.params)?;
+    Ok(Some((fit, again)))
+}
+
+/// `aligned` (an estimate) estimated again under the named lidar effects and `effect` at
+/// `params`.
+fn estimated_under(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    named: &[CandidateFit],
+    effect: Effect,
+    params: &[f64],
+) -> Result<Aligned, MismatchError> {
+    let lidar_named: Vec<CandidateFit> = named
+        .iter()
+        .filter(|c| c.effect.sensor() == Sensor::Lidar)
+        .cloned()
+        .collect();
+    let hypothesis = hypothesis_of(&lidar_named).and(effect, params.to_vec());
+    align::realign(
+        ctx.physics,
+        ctx.recording,
+        ctx.estimates,
+        aligned,
+        &hypothesis,
+    )
 }
 
 /// Against an estimated trajectory a lidar effect was partly absorbed into the scan matching

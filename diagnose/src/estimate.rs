@@ -33,13 +33,9 @@ const HUBER_K: f64 = 2.0;
 /// Halvings of a Gauss–Newton step tried before the revolution's match stops.
 const HALVINGS: usize = 4;
 
-/// Huber's loss of a normalised residual `r` (quadratic within [`HUBER_K`], linear beyond).
+/// Huber's loss of a normalised residual `r` with [`HUBER_K`].
 fn huber(r: f64) -> f64 {
-    if r.abs() <= HUBER_K {
-        0.5 * r * r
-    } else {
-        HUBER_K * (r.abs() - 0.5 * HUBER_K)
-    }
+    crate::stats::huber(r, HUBER_K)
 }
 
 /// What an estimated trajectory follows between the lidar's corrections.
@@ -54,6 +50,12 @@ pub enum DeadReckoning {
     /// The scenario's own path (a twin's, built by `hilsim world` from the encoders matched to
     /// the log's scans): the encoders' motion without a long run's drift.
     DeclaredPath,
+    /// Each revolution's own match and nothing else, straight between revolutions: a log with
+    /// encoders but no commands is matched along the encoders (or a twin's path), and its path
+    /// is then taken from the matches alone, so that the encoders can be judged against the
+    /// lidar (their radii, base and slip; a lidar delay or mount through them), as Censi et al.
+    /// calibrate a robot's odometry against its scan matching (IEEE T-RO 29(2), 2013).
+    Scans,
 }
 
 impl DeadReckoning {
@@ -64,6 +66,7 @@ impl DeadReckoning {
             Self::Commands => "lidar-estimated path (commands between scans)",
             Self::Encoders => "lidar-estimated path (encoders between scans)",
             Self::DeclaredPath => "lidar-estimated path (the scenario's path between scans)",
+            Self::Scans => "lidar-estimated path (each scan's own match, straight between scans)",
         }
     }
 
@@ -208,7 +211,7 @@ pub(crate) fn estimate_trajectory(
     end_s: f64,
     hypothesis: &Hypothesis,
     preferred: DeadReckoning,
-) -> Result<(Trajectory, Uncertainty, DeadReckoning), MismatchError> {
+) -> Result<Estimate, MismatchError> {
     let Some(lidar) = recording.lidar.as_ref().filter(|l| !l.is_empty()) else {
         return Err(MismatchError::Refused(
             "the recording has no truth.csv and no lidar readings to estimate its trajectory with"
@@ -217,6 +220,30 @@ pub(crate) fn estimate_trajectory(
     };
     let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
     let estimate = matched(physics, lidar, &base, hypothesis)?;
+    // Without commands, a path that follows the encoders would leave them nothing to be judged
+    // against: the matches alone are the path then (unless the encoders' own path is asked
+    // for).
+    let scans_only = preferred != DeadReckoning::Encoders
+        && recording.commands.is_empty()
+        && recording.odometry.as_ref().is_some_and(|o| o.len() >= 2);
+    let finish = |m: Matched, reckoned: DeadReckoning| -> Estimate {
+        match m.scans {
+            Some((trajectory, uncertainty)) if scans_only && reckoned.follows_the_encoders() => {
+                Estimate {
+                    trajectory,
+                    uncertainty,
+                    reckoned: DeadReckoning::Scans,
+                    smoothed: Some(m.trajectory),
+                }
+            }
+            _ => Estimate {
+                trajectory: m.trajectory,
+                uncertainty: m.uncertainty,
+                reckoned,
+                smoothed: None,
+            },
+        }
+    };
     // A twin's path is the encoders already matched to these scans by `hilsim world`: the same
     // motion without the drift that the encoders' bare integration gathers over a long run, or
     // that commands replayed on wheels of another size turn away by, faster than a revolution's
@@ -232,15 +259,23 @@ pub(crate) fn estimate_trajectory(
                 _ => 0.0,
             };
             if along_path.matched_share >= estimate.matched_share + margin {
-                return Ok((
-                    along_path.trajectory,
-                    along_path.uncertainty,
-                    DeadReckoning::DeclaredPath,
-                ));
+                return Ok(finish(along_path, DeadReckoning::DeclaredPath));
             }
         }
     }
-    Ok((estimate.trajectory, estimate.uncertainty, reckoned))
+    Ok(finish(estimate, reckoned))
+}
+
+/// An estimated trajectory, its uncertainty and what it followed between the lidar's matches.
+#[derive(Debug, Clone)]
+pub(crate) struct Estimate {
+    pub trajectory: Trajectory,
+    pub uncertainty: Uncertainty,
+    pub reckoned: DeadReckoning,
+    /// With [`DeadReckoning::Scans`], the same matches smoothed along the encoders between
+    /// them (a random walk of corrections): less of each match's own noise, for what reads the
+    /// path's shape over short steps (`crab.rs`).
+    pub smoothed: Option<Trajectory>,
 }
 
 /// How many more of the readings (within Huber's k of their prediction at the match) a twin's
@@ -257,6 +292,9 @@ struct Matched {
     uncertainty: Uncertainty,
     /// The share of the matched readings within Huber's k of their prediction at the match.
     matched_share: f64,
+    /// The revolutions' own matches, unsmoothed, straight between revolutions, with their
+    /// uncertainty ([`DeadReckoning::Scans`]); `None` with fewer than two.
+    scans: Option<(Trajectory, Uncertainty)>,
 }
 
 /// `base` corrected revolution by revolution by matching `lidar` to the world.
@@ -288,6 +326,7 @@ fn matched(
             used += fit.used;
         }
     }
+    let scans = scans_only(base, &knots, &variances);
     let (knots, variances) = smooth_corrections(base, &knots, &variances);
     if knots.is_empty() {
         return Err(MismatchError::Refused(
@@ -301,7 +340,34 @@ fn matched(
         trajectory: Trajectory::new(&samples)?,
         uncertainty: uncertainty(&variances),
         matched_share: near as f64 / used.max(1) as f64,
+        scans,
     })
+}
+
+/// The path of the revolutions' own matches: `base` at each knot with the knot's correction,
+/// straight between knots, and its uncertainty from the matches' own variances.
+fn scans_only(
+    base: &Trajectory,
+    knots: &[Knot],
+    variances: &[[f64; 3]],
+) -> Option<(Trajectory, Uncertainty)> {
+    let samples: Vec<TruthSample> = knots
+        .iter()
+        .map(|&(t, c)| {
+            let p = base.pose_at(t);
+            TruthSample {
+                t_s: t,
+                x_m: p.x + c[0],
+                y_m: p.y + c[1],
+                yaw_rad: wrap(p.yaw + c[2]),
+            }
+        })
+        .collect();
+    if samples.len() < 2 {
+        return None;
+    }
+    let trajectory = Trajectory::new(&samples).ok()?;
+    Some((trajectory, uncertainty(variances)))
 }
 
 /// The scenario's declared path, when it has one of two poses or more.

@@ -20,6 +20,7 @@
 pub mod align;
 mod catalogue;
 mod conclude;
+mod crab;
 mod diagnosis;
 mod dropout;
 mod error;

@@ -59,6 +59,18 @@ pub fn ljung_box(x: &[f64], lags: usize, min_var: f64) -> (f64, usize) {
     (q * n as f64 * (n as f64 + 2.0), lags)
 }
 
+/// Huber's loss of a normalised residual `r` with threshold `k`: quadratic within `k`, linear
+/// beyond (Huber, "Robust estimation of a location parameter", 1964), so that a few gross
+/// residuals do not carry a fit.
+#[must_use]
+pub fn huber(r: f64, k: f64) -> f64 {
+    if r.abs() <= k {
+        0.5 * r * r
+    } else {
+        k * (r.abs() - 0.5 * k)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -211,6 +211,9 @@ impl Stream {
 struct Stamped {
     t: f64,
     pose: Pose,
+    /// An `ODOM` pose's dead reckoning restarted here since the pose before it (a corrected
+    /// log's reset to the scan's pose): its travel is measured from this pose.
+    from: Option<Pose>,
 }
 
 /// One line's fields, read in order.
@@ -315,6 +318,9 @@ pub fn read_carmen(
     let mut last_scan_start = 0;
     let mut mount: Option<Mount> = None;
     let mut front_offset: Option<f64> = None;
+    // The pose an ODOM line restarted the dead reckoning at, until the next ODOM line taken.
+    let mut reset: Option<Pose> = None;
+    let mut resets = 0usize;
     for (n, line) in text.lines().enumerate() {
         if n >= MAX_LINES {
             return Err(LogError::TooManyLines {
@@ -346,13 +352,21 @@ pub fn read_carmen(
                     fields.number(what)?;
                 }
                 let t = fields.tail(options.clock)?;
-                Ok(Read::Odom(Stamped { t, pose }))
+                Ok(Read::Odom(Stamped {
+                    t,
+                    pose,
+                    from: None,
+                }))
             })(),
             "TRUEPOS" => (|| {
                 let pose = fields.pose("true pose")?;
                 fields.pose("odometry pose")?;
                 let t = fields.tail(options.clock)?;
-                Ok(Read::True(Stamped { t, pose }))
+                Ok(Read::True(Stamped {
+                    t,
+                    pose,
+                    from: None,
+                }))
             })(),
             "PARAM" => {
                 if fields.it.next() == Some("robot_frontlaser_offset") {
@@ -412,13 +426,27 @@ pub fn read_carmen(
                 }
                 revs += 1;
                 mount = mount.or(m);
-                poses.push(Stamped { t: t_s, pose });
+                poses.push(Stamped {
+                    t: t_s,
+                    pose,
+                    from: None,
+                });
+            }
+            // A corrected log's odometry restarts at each scan's corrected pose (an ODOM line
+            // with the scan's very pose, stamped 0 in the Radish logs): the jump to it is the
+            // SLAM's correction, not the wheels' travel.
+            Read::Odom(s) if poses.last().is_some_and(|p| p.pose == s.pose) => {
+                reset = Some(s.pose);
+                resets += 1;
             }
             Read::Odom(s) => {
-                put(&mut odom_stream, &mut odoms, t_s, s.pose, number);
+                let stamped = Stamped { from: reset, ..s };
+                if put(&mut odom_stream, &mut odoms, stamped, number) {
+                    reset = None;
+                }
             }
             Read::True(s) => {
-                put(&mut truth_stream, &mut truths, t_s, s.pose, number);
+                put(&mut truth_stream, &mut truths, s, number);
             }
             Read::Nothing => {}
         }
@@ -516,6 +544,13 @@ pub fn read_carmen(
             })
             .collect()
     };
+    if resets > 0 && !odoms.is_empty() {
+        notes.push(format!(
+            "{origin}: {resets} ODOM line(s) restart the odometry at a scan line's pose (a \
+             corrected log's, reset to each corrected pose): the jumps to them are corrections, \
+             left out of the wheel travel"
+        ));
+    }
     let mut odometry = |v: &[Stamped], what: &str| -> Vec<OdometrySample> {
         let (odometry, sideways_m) = wheel_travel(v, options.wheel_base_m);
         // A millimetre: below the poses' printed precision in CARMEN logs.
@@ -548,16 +583,20 @@ pub fn read_carmen(
     Ok((rec, notes))
 }
 
-/// Puts a pose at `t` into `stream`'s table, or not.
-fn put(stream: &mut Stream, table: &mut Vec<Stamped>, t: f64, pose: Pose, line: usize) {
-    match stream.take(t, line) {
-        Take::No => return,
+/// Puts `pose` into `stream`'s table, or not: whether it was put. One put instead of the last
+/// keeps the last one's restart.
+fn put(stream: &mut Stream, table: &mut Vec<Stamped>, pose: Stamped, line: usize) -> bool {
+    let mut pose = pose;
+    match stream.take(pose.t, line) {
+        Take::No => return false,
         Take::InsteadOfLast => {
-            table.pop();
+            let dropped = table.pop();
+            pose.from = pose.from.or(dropped.and_then(|d| d.from));
         }
         Take::Yes => {}
     }
-    table.push(Stamped { t, pose });
+    table.push(pose);
+    true
 }
 
 /// The wheel travel that [`Pose::drive`] turns back into `poses` (the inverse of dead
@@ -568,7 +607,7 @@ fn wheel_travel(poses: &[Stamped], wheel_base_m: f64) -> (Vec<OdometrySample>, f
     let (mut left, mut right, mut sideways) = (0.0, 0.0, 0.0f64);
     let mut previous: Option<Pose> = None;
     for s in poses {
-        if let Some(p) = previous {
+        if let Some(p) = s.from.or(previous) {
             let turn = wrap_angle(s.pose.yaw - p.yaw);
             let (sin, cos) = (p.yaw + turn / 2.0).sin_cos();
             let (dx, dy) = (s.pose.x - p.x, s.pose.y - p.y);

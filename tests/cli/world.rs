@@ -174,9 +174,10 @@ right_scale = 0.96
 
 /// A log without truth diagnosed against its own twin: the twin's path (the encoders already
 /// matched to the scans) carries the trajectory's estimate where the commands' replay loses the
-/// robot, and where the log has no commands. Along the commands the diagnosis named a lidar
-/// mount at its search's bound. The lidar is as declared: no physics is named (at most a
-/// mismatch within the map's cells).
+/// robot. Along the commands the diagnosis named a lidar mount at its search's bound. The
+/// lidar is as declared: along the commands no physics is named (at most a mismatch within
+/// the map's cells); where the log has no commands, the path is the scans' own matches and the
+/// encoders judged against it show the wheels.
 #[test]
 fn a_twins_path_carries_the_estimate_where_the_commands_lose_the_robot() {
     let tmp = tempfile::tempdir().unwrap();
@@ -230,25 +231,41 @@ fn a_twins_path_carries_the_estimate_where_the_commands_lose_the_robot() {
     );
     without_commands("rec", "no-commands");
     let without_commands_json = diagnose("no-commands");
-    // Another run in the same room, held against this run's twin: its path is not this run's,
-    // and the estimate follows the encoders.
+    // Another run in the same room, held against this run's twin: its path is not this run's.
     record(tmp.path());
     without_commands("rec", "other-run");
     let other_run = diagnose("other-run");
-    assert_eq!(
-        other_run["references"]["lidar"],
-        "lidar-estimated path (encoders between scans)"
-    );
-    for json in [along_commands, without_commands_json] {
-        let effect = json["effect"].as_str().unwrap();
-        assert!(
-            ["none", "world_mismatch"].contains(&effect),
-            "{effect}: {}",
-            json["explanation"]
-        );
-        assert_eq!(
-            json["references"]["lidar"], "lidar-estimated path (the scenario's path between scans)",
-            "{json}"
-        );
+    // Without commands the path is the scans' own matches, so that the encoders are judged
+    // against the lidar rather than against themselves.
+    let scans_only = "lidar-estimated path (each scan's own match, straight between scans)";
+    for json in [&other_run, &without_commands_json] {
+        assert_eq!(json["references"]["lidar"], scans_only, "{json}");
+        assert_eq!(json["references"]["odometer"], scans_only, "{json}");
     }
+    assert_eq!(
+        along_commands["references"]["lidar"],
+        "lidar-estimated path (the scenario's path between scans)"
+    );
+    let effect = along_commands["effect"].as_str().unwrap();
+    assert!(
+        ["none", "world_mismatch"].contains(&effect),
+        "{effect}: {}",
+        along_commands["explanation"]
+    );
+    // Judged against the scans, the encoders show the wheels' real radii (106 % and 96 %),
+    // within a percent: the path's length is the lidar's, which is as declared.
+    let wheels = without_commands_json["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["effect"] == "odometer_wheel_radius")
+        .unwrap_or_else(|| panic!("{without_commands_json}"));
+    let (left, right) = (
+        wheels["params"]["left_scale"].as_f64().unwrap(),
+        wheels["params"]["right_scale"].as_f64().unwrap(),
+    );
+    assert!(
+        (left - 1.06).abs() < 0.01 && (right - 0.96).abs() < 0.01,
+        "{left} {right}"
+    );
 }

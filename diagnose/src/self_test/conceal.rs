@@ -255,29 +255,64 @@ fn wheel_speed(odometry: &[OdometrySample], i: usize) -> [f64; 2] {
     [(b.left_m - a.left_m) / dt, (b.right_m - a.right_m) / dt]
 }
 
+/// The wheels' mechanisms a log without truth does not show apart from the lidar's, and why.
+const NOT_CONCEALED_WITHOUT_TRUTH: [(&str, &str); 2] = [
+    (
+        "sensor_latency (odometer)",
+        "without truth only the lidar's delay relative to the encoders shows, which the \
+         diagnosis names the lidar's",
+    ),
+    (
+        "odometer_wheel_slip",
+        "without truth a lead of the encoders on the speed's changes is the encoders running \
+         early against the lidar, which the diagnosis names the lidar's delay",
+    ),
+];
+
+fn has_truth(recording: &Recording) -> bool {
+    recording.truth.as_ref().is_some_and(|t| !t.is_empty())
+}
+
+fn has_encoders(recording: &Recording) -> bool {
+    recording.odometry.as_ref().is_some_and(|o| !o.is_empty())
+}
+
 /// The mechanisms that can be concealed in `recording`: the lidar's with a lidar; the wheels'
-/// with encoders judged against a truth (without one, the only path to judge the encoders
-/// against is estimated from the encoders themselves).
+/// radii and base with encoders judged against a truth or the lidar (a log without truth is
+/// diagnosed along the scans' own matches); their slip and delay only against a truth
+/// ([`not_concealed`]).
 #[must_use]
 pub fn concealable(recording: &Recording) -> Vec<Effect> {
     let mut effects = Vec::new();
-    if recording.lidar.as_ref().is_some_and(|l| !l.is_empty()) {
+    let has_lidar = recording.lidar.as_ref().is_some_and(|l| !l.is_empty());
+    if has_lidar {
         effects.extend([
             Effect::LidarWarmupDrift,
             Effect::LidarMountOffset,
             Effect::SensorLatency(Sensor::Lidar),
         ]);
     }
-    let has_truth = recording.truth.as_ref().is_some_and(|t| !t.is_empty());
-    if has_truth && recording.odometry.as_ref().is_some_and(|o| !o.is_empty()) {
+    if has_encoders(recording) && (has_truth(recording) || has_lidar) {
+        effects.extend([Effect::OdometerWheelRadius, Effect::DriveWheelBase]);
+    }
+    if has_encoders(recording) && has_truth(recording) {
         effects.extend([
-            Effect::OdometerWheelRadius,
-            Effect::DriveWheelBase,
             Effect::OdometerWheelSlip,
             Effect::SensorLatency(Sensor::Odometer),
         ]);
     }
     effects
+}
+
+/// The catalogue's mechanisms not concealed in `recording`, and why: [`NOT_CONCEALED`], and a
+/// log's wheels' slip and delay without truth.
+#[must_use]
+pub fn not_concealed(recording: &Recording) -> Vec<(&'static str, &'static str)> {
+    let mut out = NOT_CONCEALED.to_vec();
+    if has_encoders(recording) && !has_truth(recording) {
+        out.extend(NOT_CONCEALED_WITHOUT_TRUTH);
+    }
+    out
 }
 
 /// The lidar's first and last stamps in `recording`, seconds.

@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use serde_json::{json, Value};
 
-use super::conceal::{Concealment, NOT_CONCEALED};
+use super::conceal::Concealment;
 use super::on_log::{
     Answer, LogSelfTest, GOAL_FALSE_ON_LOG, GOAL_NAMED_ON_LOG, GOAL_PARAMS_ON_LOG, HALVES_WITHIN_SD,
 };
@@ -89,7 +89,7 @@ impl LogSelfTest {
             "command": command,
             "world": self.world,
             "concealable": self.concealable.iter().map(|e| e.label()).collect::<Vec<_>>(),
-            "not_concealed": NOT_CONCEALED.iter().map(|(e, why)| json!({"effect": e, "why": why})).collect::<Vec<_>>(),
+            "not_concealed": self.not_concealed.iter().map(|(e, why)| json!({"effect": e, "why": why})).collect::<Vec<_>>(),
             "untouched": answer_json(&b.whole),
             "halves": b.halves.as_ref().map(|h| h.iter().map(answer_json).collect::<Vec<_>>()),
             "halves_stable": b.stable(),
@@ -153,7 +153,7 @@ impl LogSelfTest {
             writeln!(out, "  {:<30} {named:>3}/{concealed}", e.label())?;
         }
         writeln!(out, "not concealed:")?;
-        for (e, why) in NOT_CONCEALED {
+        for (e, why) in &self.not_concealed {
             writeln!(out, "  {e}: {why}")?;
         }
         let pct = |a: usize, n: usize| {

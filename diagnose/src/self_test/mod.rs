@@ -21,7 +21,7 @@ mod trial;
 pub const MAX_TRIALS: u64 = 100_000;
 
 pub use command::Flags;
-pub use conceal::{Concealment, NOT_CONCEALED};
+pub use conceal::{not_concealed, Concealment, NOT_CONCEALED};
 pub use draw::Drawn;
 pub use draw::OUTSIDE;
 pub use log_report::trial_text;

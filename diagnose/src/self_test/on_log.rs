@@ -12,7 +12,7 @@ use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
 use rayon::prelude::*;
 
-use super::conceal::{concealable, draw, Concealment};
+use super::conceal::{concealable, draw, not_concealed, Concealment};
 use super::draw::Draws;
 use crate::{Diagnosis, Effect, MismatchError, Options, SimPhysics, Verdict};
 
@@ -104,6 +104,9 @@ pub struct Answer {
     pub named: Vec<NamedSize>,
     /// Located mismatches no named effect explains.
     pub unexplained: usize,
+    /// Every effect fitted, named or not: the log's own value of a mechanism too small to name
+    /// is still its best estimate, which a concealment adds to.
+    pub fitted: Vec<NamedSize>,
 }
 
 /// A named effect's fitted parameters and its scored size ([`Effect::scored`]) with its
@@ -116,6 +119,25 @@ pub struct NamedSize {
     pub size_sd: f64,
 }
 
+impl NamedSize {
+    fn of(fit: &crate::CandidateFit) -> Self {
+        let e = fit.effect;
+        let sd = |i: usize| fit.param_sd.get(i).copied().unwrap_or(f64::NAN);
+        let size_sd = e
+            .size_terms()
+            .iter()
+            .map(|&(i, w)| (w * sd(i)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        Self {
+            effect: e,
+            params: fit.params.clone(),
+            size: e.scored(&fit.params),
+            size_sd,
+        }
+    }
+}
+
 impl Answer {
     fn of(diagnosis: &Result<Diagnosis, String>) -> Self {
         match diagnosis {
@@ -123,32 +145,28 @@ impl Answer {
                 verdict: Err(e.clone()),
                 named: Vec::new(),
                 unexplained: 0,
+                fitted: Vec::new(),
             },
             Ok(d) => Self {
                 verdict: Ok(d.verdict),
-                named: d
-                    .effects
-                    .iter()
-                    .map(|n| {
-                        let e = n.fit.effect;
-                        let sd = |i: usize| n.fit.param_sd.get(i).copied().unwrap_or(f64::NAN);
-                        let size_sd = e
-                            .size_terms()
-                            .iter()
-                            .map(|&(i, w)| (w * sd(i)).powi(2))
-                            .sum::<f64>()
-                            .sqrt();
-                        NamedSize {
-                            effect: e,
-                            params: n.fit.params.clone(),
-                            size: e.scored(&n.fit.params),
-                            size_sd,
-                        }
-                    })
-                    .collect(),
+                named: d.effects.iter().map(|n| NamedSize::of(&n.fit)).collect(),
                 unexplained: d.unexplained.len(),
+                fitted: d
+                    .candidates
+                    .iter()
+                    .filter(|c| c.effect.scored(&c.params).is_finite())
+                    .map(NamedSize::of)
+                    .collect(),
             },
         }
+    }
+
+    /// The log's own size of `e`: named, else fitted without being named, else none.
+    #[must_use]
+    pub fn own_size(&self, e: Effect) -> f64 {
+        self.get(e)
+            .or_else(|| self.fitted.iter().find(|n| n.effect == e))
+            .map_or(0.0, |n| n.size)
     }
 
     /// The named effect `e`, if named.
@@ -209,7 +227,7 @@ pub struct LogOutcome {
     /// The diagnosis of the concealed log.
     pub answer: Answer,
     /// For each concealed mechanism named, |fitted − true| / |true| of its scored size, the
-    /// fitted size taken less the untouched log's when that names it too.
+    /// fitted size taken less the untouched log's own ([`Answer::own_size`]).
     pub param_errors: Vec<(Effect, f64)>,
     pub seconds: f64,
 }
@@ -247,6 +265,8 @@ pub struct LogSelfTest {
     pub world: String,
     /// The mechanisms this log allows to be concealed.
     pub concealable: Vec<Effect>,
+    /// The catalogue's others, and why each is not.
+    pub not_concealed: Vec<(&'static str, &'static str)>,
     pub baseline: Baseline,
     pub outcomes: Vec<LogOutcome>,
 }
@@ -406,7 +426,7 @@ fn trial(
         .iter()
         .filter_map(|c| {
             let e = c.effect();
-            let got = answer.get(e)?.size - baseline.get(e).map_or(0.0, |b| b.size);
+            let got = answer.get(e)?.size - baseline.own_size(e);
             Some((e, (got - c.scored()).abs() / c.scored().abs()))
         })
         .collect();
@@ -456,6 +476,7 @@ pub fn run_on_log(
         plan: plan.clone(),
         world: world.describe(),
         concealable: pool,
+        not_concealed: not_concealed(recording),
         baseline,
         outcomes,
     })

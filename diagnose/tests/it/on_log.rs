@@ -4,13 +4,15 @@
 //! figures are in docs/diagnose.md, with the commands that make them); each diagnosis tries the
 //! concealed mechanism's sensor's effects, which keeps a debug build's test time to a minute.
 
+use std::path::Path;
 use std::sync::OnceLock;
 
 use hilsim_diagnose::self_test::on_log::{
     baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan,
 };
-use hilsim_diagnose::self_test::Concealment;
-use hilsim_diagnose::{Diagnosis, Options, Sensor};
+use hilsim_diagnose::self_test::{not_concealed, Concealment};
+use hilsim_diagnose::{Diagnosis, Effect, Options, Sensor};
+use hilsim_fixtures::rooms::ROOM_4X3;
 use hilsim_lidar_emulator::Emulation;
 use hilsim_recording::Recording;
 use hilsim_sim::Scenario;
@@ -160,11 +162,60 @@ fn a_trials_draws_are_its_own_and_only_what_the_log_allows() {
         "some trials conceal nothing"
     );
     assert!(drawn.iter().any(|c| c.len() == 2), "some conceal two");
-    // Without truth the encoders have nothing to be judged against: only the lidar's.
+    // Without truth the encoders are judged against the lidar: their radii and base are
+    // concealed, their slip and delay (only relative to the lidar's) are not, and are listed.
     recording.truth = None;
-    for i in 0..50 {
-        for c in concealments(&recording, &plan, i) {
-            assert_eq!(c.effect().sensor(), Sensor::Lidar, "{c:?}");
-        }
-    }
+    let drawn: Vec<Effect> = (0..50)
+        .flat_map(|i| concealments(&recording, &plan, i))
+        .map(|c| c.effect())
+        .collect();
+    assert!(drawn.contains(&Effect::DriveWheelBase), "{drawn:?}");
+    assert!(
+        !drawn.contains(&Effect::OdometerWheelSlip)
+            && !drawn.contains(&Effect::SensorLatency(Sensor::Odometer)),
+        "{drawn:?}"
+    );
+    let listed: Vec<&str> = not_concealed(&recording).iter().map(|(e, _)| *e).collect();
+    assert!(listed.contains(&"odometer_wheel_slip"), "{listed:?}");
+}
+
+/// A run without truth and without commands is diagnosed along its scans' own matches: a
+/// lidar turned 3° on its mount moves that path sideways, and is named from it within the
+/// self-test's 20 %. The drive goes three times round a 1.5 m by 1 m loop: the sideways motion
+/// is read over the path's travel (15 m here), in steps of 15 cm.
+#[test]
+fn without_truth_or_commands_a_turned_lidar_is_named_from_the_path_moving_sideways() {
+    let side = |m: f64| {
+        format!("[[drive]]\nspeed_mps = 0.3\ndistance_m = {m}\n[[drive]]\nturn_deg = 90.0\n")
+    };
+    let text = format!(
+        "name = \"loops\"\nseed = 7\n\n{ROOM_4X3}\n[robot]\nstart = {{ x = 0.8, y = 0.8, yaw_deg = 0.0 }}\n\
+         wheel_base_m = 0.23\nturn_rate_deg_s = 60.0\n\n{}\n[sensors.lidar]\n\
+         noise = [0.003, 0.0, 0.002]\n[sensors.odometer]\nnoise_m = 0.002\n",
+        [side(1.5), side(1.0)].concat().repeat(6)
+    );
+    let loops = Scenario::from_toml(&text, Path::new("loops.toml")).expect("the test's scenario");
+    let mut recording = Emulation::new(&loops, 7)
+        .expect("the emulation")
+        .run()
+        .recording;
+    recording.truth = None;
+    recording.commands.clear();
+    let concealed = Concealment::MountYaw { yaw_deg: 3.0 };
+    let (_, d) = conceal_and_diagnose(
+        &recording,
+        &GivenWorld(loops),
+        &[concealed],
+        &trying(Sensor::Lidar),
+        "t",
+    )
+    .expect("a diagnosis");
+    assert_eq!(
+        d.sensors
+            .iter()
+            .find(|s| s.sensor == Sensor::Odometer)
+            .map(|s| s.reference),
+        Some("lidar-estimated path (each scan's own match, straight between scans)")
+    );
+    assert_named_within_a_fifth(&d, concealed);
 }

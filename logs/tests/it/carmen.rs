@@ -225,3 +225,38 @@ fn a_log_of_nothing_readable_is_refused() {
     .unwrap_err();
     assert!(matches!(err, LogError::Empty { .. }), "{err}");
 }
+
+/// A corrected log's odometry restarts at each scan's corrected pose (an ODOM line with the
+/// scan's very pose, stamped 0, as in the Radish logs): the jump to it is the correction, and
+/// the wheels' travel is only the dead reckoning on either side of it.
+#[test]
+fn a_corrected_logs_restart_at_the_scans_pose_is_not_wheel_travel() {
+    let corrected = [2.0, 1.05, 0.0];
+    let text = [
+        odom(1.0, 1.0, 0.0, 1.0),
+        odom(1.1, 1.0, 0.0, 1.5),
+        odom(1.2, 1.0, 0.0, 2.0),
+        flaser(1.0, corrected, 2.0),
+        // The restart: the scan's pose, stamped 0 (out of time order).
+        odom(corrected[0], corrected[1], corrected[2], 0.0),
+        odom(2.1, 1.05, 0.0, 2.5),
+        odom(2.2, 1.05, 0.0, 3.0),
+    ]
+    .join("\n");
+    let (rec, notes) = read_carmen(&text, "corrected.log", &CarmenOptions::default()).unwrap();
+    let odometry = rec.odometry.unwrap();
+    let last = odometry.last().unwrap();
+    // Four steps of 0.1 m straight ahead; the 0.8 m and 5 cm sideways jump to the scan's pose
+    // is not in it.
+    assert!(
+        (last.left_m - 0.4).abs() < 1e-9 && (last.right_m - 0.4).abs() < 1e-9,
+        "{odometry:?}"
+    );
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("1 ODOM line(s) restart the odometry")),
+        "{notes:?}"
+    );
+    assert!(!notes.iter().any(|n| n.contains("sideways")), "{notes:?}");
+}

@@ -10,7 +10,7 @@ use crate::crab;
 use crate::dropout;
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
-use crate::explain::{self, CandidateFit};
+use crate::explain::{self, CandidateFit, RmseOver};
 use crate::health;
 use crate::locate::{self, Evidence, TestKind};
 use crate::outcome::{
@@ -1087,7 +1087,7 @@ fn crab_mount(
         rmse_after: c.rmse_after_m,
         noise_floor: c.noise_m,
         heldout_n: c.heldout_n,
-        rmse_given_past: false,
+        rmse_over: RmseOver::PathSteps,
         heldout_ll_per_reading: c.heldout_gain / c.heldout_n.max(1) as f64,
         size_m,
         size_noise_m: floor_m,
@@ -1423,7 +1423,7 @@ mod tests {
             rmse_after: 0.0025,
             noise_floor: 0.0025,
             heldout_n: 1000,
-            rmse_given_past: true,
+            rmse_over: crate::RmseOver::ReadingsGivenPast,
             heldout_ll_per_reading: 4.0,
             size_m: 0.05,
             size_noise_m: 0.002,

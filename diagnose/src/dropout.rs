@@ -191,7 +191,7 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
         rmse_after,
         noise_floor,
         heldout_n: n,
-        rmse_given_past: false,
+        rmse_over: crate::explain::RmseOver::Readings,
         heldout_ll_per_reading: held_ll / n as f64,
         size_m: size,
         size_noise_m: f64::NAN,

@@ -35,12 +35,10 @@ pub struct CandidateFit {
     pub rmse_after: f64,
     /// The noise floor there: RMS of the predicted standard deviations after the fit, metres.
     pub noise_floor: f64,
-    /// Held-out readings the RMSEs are over.
+    /// Held-out readings (or steps, [`RmseOver::PathSteps`]) the RMSEs are over.
     pub heldout_n: usize,
-    /// Whether the RMSEs are of each reading predicted given the readings before it (the
-    /// encoders along a path estimated from the lidar, whose error they share), not of the
-    /// physics' prediction alone: what the report's residual plots show.
-    pub rmse_given_past: bool,
+    /// What the RMSEs are over: what the report says and its residual plots show.
+    pub rmse_over: RmseOver,
     /// The mean log-likelihood of every held-out reading under the fit, nats a reading: how
     /// fits along different estimated paths (which may keep a few readings near a range limit
     /// in one and not another) compare on the same readings.
@@ -67,6 +65,19 @@ pub struct CandidateFit {
     /// The latest reading scored, seconds from the recording's start (a warm-up's clock):
     /// how long a drift could be seen to settle.
     pub seen_until_s: f64,
+}
+
+/// What a fit's held-out RMSEs are over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RmseOver {
+    /// Each reading against the physics' prediction alone.
+    Readings,
+    /// Each reading predicted given the readings before it (the encoders along a path estimated
+    /// from the lidar, whose error they share).
+    ReadingsGivenPast,
+    /// The sideways motion of the lidar-matched path's steps, which wheels cannot make (a
+    /// lidar's mount yaw read from it: `crab.rs`).
+    PathSteps,
 }
 
 /// Readings the size of an effect is measured over: this share of the held-out ones, at
@@ -262,7 +273,11 @@ pub(crate) fn score(
         rmse_after,
         noise_floor,
         heldout_n,
-        rmse_given_past: ctx.conditions(data),
+        rmse_over: if ctx.conditions(data) {
+            RmseOver::ReadingsGivenPast
+        } else {
+            RmseOver::Readings
+        },
         heldout_ll_per_reading: heldout_ll / after.len().max(1) as f64,
         size_m,
         size_noise_m,

@@ -46,7 +46,7 @@ pub use align::Alignment;
 pub use catalogue::{DrawSource, Effect, ParamSpec, SearchLimits, SelfTestRange, Sensor};
 pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
-pub use explain::CandidateFit;
+pub use explain::{CandidateFit, RmseOver};
 pub use floor::{ParseFloorError, SensorFloor};
 pub use hilsim_recording::Pose;
 pub use locate::{Evidence, Floors, TestKind};

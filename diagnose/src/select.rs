@@ -383,7 +383,7 @@ mod tests {
             rmse_after: 0.02,
             noise_floor: 0.02,
             heldout_n: 10_000,
-            rmse_given_past: false,
+            rmse_over: crate::explain::RmseOver::Readings,
             heldout_ll_per_reading: 2.0,
             size_m: 0.02,
             size_noise_m: 0.01,

@@ -2,6 +2,8 @@
 
 pub(super) use hilsim_report::svg::{escape, fmt_sig};
 
+use crate::explain::RmseOver;
+
 /// Metres as millimetres with one decimal, "—" when not finite.
 pub(super) fn mm(v: f64) -> String {
     if v.is_finite() {
@@ -41,12 +43,22 @@ pub(super) fn fit_size(f: &crate::explain::CandidateFit) -> String {
     }
 }
 
-/// What a fit's RMSEs are of, when it is not the plain residual: " (each reading given the
-/// readings before)" for the encoders along an estimated path.
-pub(super) fn given_past(f: &crate::explain::CandidateFit) -> &'static str {
-    if f.rmse_given_past {
-        " (each reading given the readings before)"
-    } else {
-        ""
+/// What a fit's RMSEs are of, when it is not the plain residual: each reading given the
+/// readings before (the encoders along an estimated path), or the path's sideways motion.
+pub(super) fn rmse_of(f: &crate::explain::CandidateFit) -> &'static str {
+    match f.rmse_over {
+        RmseOver::Readings => "",
+        RmseOver::ReadingsGivenPast => " (each reading given the readings before)",
+        RmseOver::PathSteps => {
+            " (the lidar-matched path's sideways motion, which wheels cannot make)"
+        }
+    }
+}
+
+/// What the held-out RMSEs are counted over.
+pub(super) fn heldout_unit(f: &crate::explain::CandidateFit) -> &'static str {
+    match f.rmse_over {
+        RmseOver::PathSteps => "steps",
+        RmseOver::Readings | RmseOver::ReadingsGivenPast => "readings",
     }
 }

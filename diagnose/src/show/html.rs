@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{escape, fit_metric, fit_value, fmt_sig, given_past, mm};
+use super::format::{escape, fit_metric, fit_value, fmt_sig, heldout_unit, mm, rmse_of};
 use crate::locate::Evidence;
 use crate::outcome::{Diagnosis, Verdict};
 
@@ -145,14 +145,15 @@ fn fix(s: &mut String, d: &Diagnosis) {
         }
         let _ = writeln!(
             s,
-            "</table><p>Held-out {} {}{}: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} readings the fit never saw).</p>",
+            "</table><p>Held-out {} {}{}: <b>{}</b> before, <b>{}</b> after; the noise floor is {} ({} {} the fit never saw).</p>",
             f.sensor,
             escape(fit_metric(f)),
-            given_past(f),
+            rmse_of(f),
             fit_value(f, f.rmse_before),
             fit_value(f, f.rmse_after),
             fit_value(f, f.noise_floor),
-            f.heldout_n
+            f.heldout_n,
+            heldout_unit(f)
         );
     }
 }

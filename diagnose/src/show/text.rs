@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::format::{fit_metric, fit_size, fit_value, fmt_sig, given_past, mm};
+use super::format::{fit_metric, fit_size, fit_value, fmt_sig, heldout_unit, mm, rmse_of};
 use crate::outcome::Diagnosis;
 
 /// The diagnosis for people: a few lines.
@@ -45,15 +45,16 @@ pub fn summary(d: &Diagnosis) -> String {
         }
         let _ = writeln!(
             s,
-            "  held-out {} {}{}: {} before, {} after (noise floor {}, {} readings; gain {:.1} nats; \
+            "  held-out {} {}{}: {} before, {} after (noise floor {}, {} {}; gain {:.1} nats; \
              changes the readings by {})",
             f.sensor,
             fit_metric(f),
-            given_past(f),
+            rmse_of(f),
             fit_value(f, f.rmse_before),
             fit_value(f, f.rmse_after),
             fit_value(f, f.noise_floor),
             f.heldout_n,
+            heldout_unit(f),
             f.heldout_gain,
             fit_size(f)
         );

@@ -282,7 +282,9 @@ pub struct ReportArgs {
 #[derive(Debug, clap::Args)]
 pub struct DiagnoseArgs {
     /// The scenario the recording is a run of (for `--self-test`: the nominal scenario, default
-    /// the built-in `scenarios/diagnose-room.toml`).
+    /// the built-in `scenarios/diagnose-room.toml`). Without it, `--real` is judged in the world
+    /// built from its own scans as `hilsim world` builds it (built again under the lidar's
+    /// named delay and mount when the path is the recording's truth).
     #[arg(long, value_name = "SCENARIO")]
     pub sim: Option<PathBuf>,
     /// The real recording (a directory in the recording format).

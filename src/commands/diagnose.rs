@@ -1,5 +1,5 @@
-//! `hilsim diagnose --sim SCENARIO --real RECORDING [--calibration FILE] [--json] [--report DIR]`
-//! and `hilsim diagnose --self-test N [--seed S] [--sim SCENARIO] [--json]`.
+//! `hilsim diagnose [--sim SCENARIO] --real RECORDING [--calibration FILE] [--json] [--report DIR]`
+//! (without `--sim`, in the world built from the recording's own scans) and `hilsim diagnose --self-test N [--seed S] [--sim SCENARIO] [--json]`.
 //!
 //! Exit codes: 0 when a verdict is reached (`none`, an effect, or `unexplained`: each is an
 //! answer; with `--fail-on-mismatch` only `none`, else 1); 2 on bad input, including a recording
@@ -25,8 +25,8 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(n) = args.self_test {
         return self_test(args, n, out);
     }
-    let (Some(sim), Some(real)) = (&args.sim, &args.real) else {
-        bail!("expected --sim SCENARIO and --real RECORDING (or --self-test N)");
+    let Some(real) = &args.real else {
+        bail!("expected --real RECORDING, with --sim SCENARIO or without (or --self-test N)");
     };
     let floors = Floors::from_flags(&args.floors, args.floor_noise_share)?;
     let options = Options {
@@ -36,6 +36,9 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
     if let Some(dir) = &args.report {
         check_report_dir(dir, &[show::MAP_FILE])?;
     }
+    let Some(sim) = &args.sim else {
+        return diagnose_in_own_world(args, real, &options, out);
+    };
     let mut scenario = hilsim_scenarios::builtin::load_or_default(Some(sim), None)?;
     if let Some(path) = &args.calibration {
         let calibration = hilsim_calibrator::Calibration::read(path)?;
@@ -53,14 +56,60 @@ pub fn diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<ExitCode> {
         })
         .with_context(|| real.display().to_string())?;
     drop(status);
+    finish(args, (sim, &scenario), (real, &recording), &diagnosis, out)
+}
+
+/// What a report calls the world built from the log itself.
+const BUILT_FROM_THE_LOG: &str = "<built from the log>";
+
+/// `hilsim diagnose --real RECORDING` without a scenario: the world built from the recording's
+/// own scans as `hilsim world` builds it, and built again under the lidar's named delay and
+/// mount when its path is a truth's (`on_log::diagnosed_in`).
+fn diagnose_in_own_world(
+    args: &DiagnoseArgs,
+    real: &Path,
+    options: &Options,
+    out: &mut dyn Write,
+) -> Result<ExitCode> {
+    if args.calibration.is_some() {
+        bail!("--calibration needs --sim SCENARIO: the world built from the log declares what the log's meta.toml does");
+    }
+    let recording = Recording::read_dir(real)?;
+    let status = Progress::on_stderr(true, None, "{spinner} diagnose: {msg} ({elapsed})").ticking();
+    status.message("building the world from the log's scans and judging it".to_string());
+    let (scenario, diagnosis) = on_log::diagnosed_in(
+        &on_log::BuiltWorld::default(),
+        &recording,
+        &real.display().to_string(),
+        options,
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    drop(status);
+    finish(
+        args,
+        (Path::new(BUILT_FROM_THE_LOG), &scenario),
+        (real, &recording),
+        &diagnosis,
+        out,
+    )
+}
+
+/// Writes `diagnosis` as the flags ask (its report, JSON or text) and gives the exit code.
+fn finish(
+    args: &DiagnoseArgs,
+    sim: (&Path, &Scenario),
+    real: (&Path, &Recording),
+    diagnosis: &hilsim_diagnose::Diagnosis,
+    out: &mut dyn Write,
+) -> Result<ExitCode> {
     if let Some(dir) = &args.report {
-        let files = show::report_files_of(&diagnosis, (sim, &scenario), (real, &recording));
+        let files = show::report_files_of(diagnosis, sim, real);
         hilsim_report::write_report_files(dir, &files)?;
     }
     if args.json {
-        writeln!(out, "{}", show::to_json(&diagnosis))?;
+        writeln!(out, "{}", show::to_json(diagnosis))?;
     } else {
-        out.write_all(show::summary(&diagnosis).as_bytes())?;
+        out.write_all(show::summary(diagnosis).as_bytes())?;
         if let Some(dir) = &args.report {
             writeln!(out, "report: {}", dir.join("index.html").display())?;
         }
@@ -168,18 +217,18 @@ fn self_test_on_log(
         None => Box::new(on_log::BuiltWorld::default()),
     };
     if let Some(i) = args.trial {
-        let (concealed, real, diagnosis) = on_log::trial_run(&recording, world.as_ref(), &plan, i)
+        let on_log::TrialRun {
+            concealed,
+            real,
+            scenario,
+            diagnosis,
+        } = on_log::trial_run(&recording, world.as_ref(), &plan, i)
             .map_err(|e| anyhow!("{}: {e}", log.display()))?;
         if let Some(dir) = args.report.as_deref() {
             let rec_dir = dir.join("recording");
             real.write_dir(&rec_dir)?;
-            let scenario = world
-                .scenario(&real, "the report")
-                .map_err(|e| anyhow!("{}: {e}", log.display()))?;
             let sim = (
-                args.sim
-                    .as_deref()
-                    .unwrap_or(Path::new("<built from the log>")),
+                args.sim.as_deref().unwrap_or(Path::new(BUILT_FROM_THE_LOG)),
                 &scenario,
             );
             let files = show::report_files_of(&diagnosis, sim, (&rec_dir, &real));

@@ -5,10 +5,10 @@
 //! concealed mechanism's sensor's effects, which keeps a debug build's test time to a minute.
 
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use hilsim_diagnose::self_test::on_log::{
-    baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan,
+    baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan, TrialWorld,
 };
 use hilsim_diagnose::self_test::{not_concealed, Concealment};
 use hilsim_diagnose::{Diagnosis, Effect, Options, Sensor};
@@ -82,10 +82,87 @@ fn wheels_and_a_late_lidar_concealed_in_the_log_are_named_with_their_sizes() {
             Sensor::Lidar,
         ),
     ] {
-        let (_, d) = conceal_and_diagnose(&recording, &world, &[concealed], &trying(sensor), "t")
-            .expect("a diagnosis");
+        let d = conceal_and_diagnose(&recording, &world, &[concealed], &trying(sensor), "t")
+            .expect("a diagnosis")
+            .diagnosis;
         assert_named_within_a_fifth(&d, concealed);
     }
+}
+
+/// A world whose map moves with the lidar's named delay or mount (as one built from the log's
+/// own scans at its truth's poses does) is built again under what the first judgement named,
+/// and the log judged against it: a lidar stamped 50 ms late is named, the world is asked again
+/// under that delay, and the delay is named against it with its size within the self-test's
+/// 20 %. A world that does not move (the user's scenario) is judged once.
+#[test]
+fn a_late_lidar_is_judged_again_in_the_world_rebuilt_under_it() {
+    /// The room, rebuilt as the room, counting how often and under which delay.
+    struct Rebuilt(Scenario, Mutex<Vec<f64>>);
+    impl TrialWorld for Rebuilt {
+        fn scenario(&self, _: &Recording, _: &str) -> Result<Scenario, String> {
+            Ok(self.0.clone())
+        }
+        fn describe(&self) -> String {
+            "the room, rebuilt".to_string()
+        }
+        fn rebuilt(
+            &self,
+            _: &Recording,
+            _: &str,
+            scenario: &Scenario,
+            diagnosis: &Diagnosis,
+        ) -> Option<Result<Scenario, String>> {
+            let delay = diagnosis
+                .effects
+                .iter()
+                .find(|e| e.fit.effect == Effect::SensorLatency(Sensor::Lidar))?;
+            self.1.lock().expect("the log").push(delay.fit.params[0]);
+            Some(Ok(scenario.clone()))
+        }
+    }
+    let (room, recording) = log();
+    let concealed = Concealment::Restamp {
+        sensor: Sensor::Lidar,
+        delay_s: 0.05,
+    };
+    let world = Rebuilt(room.clone(), Mutex::new(Vec::new()));
+    let run = conceal_and_diagnose(
+        &recording,
+        &world,
+        &[concealed],
+        &trying(Sensor::Lidar),
+        "t",
+    )
+    .expect("a diagnosis");
+    let asked = world.1.lock().expect("the log").clone();
+    assert_eq!(asked.len(), 1, "{asked:?}");
+    assert!((asked[0] - 0.05).abs() < 0.01, "{asked:?}");
+    let d = &run.diagnosis;
+    assert!(
+        d.notes
+            .iter()
+            .any(|n| n.contains("then again with each scan placed under the lidar's delay of")),
+        "{:?}",
+        d.notes
+    );
+    assert_named_within_a_fifth(d, concealed);
+    let once = conceal_and_diagnose(
+        &recording,
+        &GivenWorld(room),
+        &[concealed],
+        &trying(Sensor::Lidar),
+        "t",
+    )
+    .expect("a diagnosis");
+    assert!(
+        !once
+            .diagnosis
+            .notes
+            .iter()
+            .any(|n| n.contains("built again")),
+        "{:?}",
+        once.diagnosis.notes
+    );
 }
 
 /// `d` names `concealed`'s entry with its size within the self-test's 20 %.
@@ -128,8 +205,9 @@ fn against_a_sparse_truth_the_encoders_are_judged_over_its_spans() {
         right_scale: 1.0,
     };
     let options = trying(Sensor::Odometer);
-    let (_, faithful) =
-        conceal_and_diagnose(&recording, &world, &[], &options, "t").expect("a diagnosis");
+    let faithful = conceal_and_diagnose(&recording, &world, &[], &options, "t")
+        .expect("a diagnosis")
+        .diagnosis;
     assert!(faithful.effects.is_empty(), "{}", faithful.explanation);
     assert!(
         faithful
@@ -139,8 +217,9 @@ fn against_a_sparse_truth_the_encoders_are_judged_over_its_spans() {
         "{:?}",
         faithful.notes
     );
-    let (_, d) =
-        conceal_and_diagnose(&recording, &world, &[concealed], &options, "t").expect("a diagnosis");
+    let d = conceal_and_diagnose(&recording, &world, &[concealed], &options, "t")
+        .expect("a diagnosis")
+        .diagnosis;
     assert_named_within_a_fifth(&d, concealed);
 }
 
@@ -202,14 +281,15 @@ fn without_truth_or_commands_a_turned_lidar_is_named_from_the_path_moving_sidewa
     recording.truth = None;
     recording.commands.clear();
     let concealed = Concealment::MountYaw { yaw_deg: 3.0 };
-    let (_, d) = conceal_and_diagnose(
+    let d = conceal_and_diagnose(
         &recording,
         &GivenWorld(loops),
         &[concealed],
         &trying(Sensor::Lidar),
         "t",
     )
-    .expect("a diagnosis");
+    .expect("a diagnosis")
+    .diagnosis;
     assert_eq!(
         d.sensors
             .iter()

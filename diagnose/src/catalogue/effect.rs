@@ -199,6 +199,14 @@ impl Effect {
         self != Effect::LidarDropout
     }
 
+    /// Whether a second cause of it adds its scored size to the first's (two delays add, two
+    /// radius errors multiply to about their sum): every entry but the lidar's dropout, whose
+    /// losses compose as chances do, not as half-loss ranges add.
+    #[must_use]
+    pub fn sizes_add(self) -> bool {
+        self != Effect::LidarDropout
+    }
+
     /// Its parameters, in the order a [`super::Hypothesis`] holds them.
     ///
     /// The fit's ranges are wide enough for any plausible unit (several times the self-test's

@@ -4,10 +4,12 @@
 //!
 //! Only what can be concealed *exactly* in a log is: a sensor's stamps (a late driver), the
 //! encoders' travel (the wheels' radii and base, slip driven by the log's own changes of speed),
-//! the lidar's ranges (a warm-up drift, which needs only each reading's range and time) and its
-//! beams' angles (a turned mount). [`NOT_CONCEALED`] lists the rest and why.
+//! the lidar's ranges (a warm-up drift, which needs only each reading's range and time; returns
+//! lost by range) and its beams' angles (a turned mount). [`NOT_CONCEALED`] lists the rest and why.
 
 use hilsim_recording::{LidarSample, OdometrySample, Recording};
+use rand_xoshiro::rand_core::{RngCore, SeedableRng};
+use rand_xoshiro::SplitMix64;
 
 use super::draw::Draws;
 use crate::{Effect, Sensor};
@@ -46,6 +48,16 @@ pub enum Concealment {
     /// The lidar turned on its mount by `yaw_deg` (counter-clockwise, seen from above): a wall
     /// the robot sees at bearing φ is read at the unit's angle φ − yaw.
     MountYaw { yaw_deg: f64 },
+    /// Returns lost by range: each reading at range `d` is lost (flagged invalid, range 0, as a
+    /// unit reports a return too weak to range) with chance `1 / (1 + (R/d)^k)`, half at `R`,
+    /// drawn from a stream seeded by `seed`. By range alone, as a vendor's datasheet gives a
+    /// unit's loss: the catalogue's logistic in the returned power head-on, without its fall
+    /// with incidence and reflectivity.
+    LidarLoss {
+        half_loss_range_m: f64,
+        steepness: f64,
+        seed: u64,
+    },
 }
 
 /// The catalogue's mechanisms that are not concealed in a real log, and why: each would need
@@ -85,6 +97,7 @@ impl Concealment {
             Self::WheelSlip { .. } => Effect::OdometerWheelSlip,
             Self::LidarWarmup { .. } => Effect::LidarWarmupDrift,
             Self::MountYaw { .. } => Effect::LidarMountOffset,
+            Self::LidarLoss { .. } => Effect::LidarDropout,
         }
     }
 
@@ -108,6 +121,13 @@ impl Concealment {
                 time_constant_s,
             } => vec![coefficient_per_m, time_constant_s, offset_m],
             Self::MountYaw { yaw_deg } => vec![yaw_deg, 0.0, 0.0],
+            // Head-on the catalogue's logistic in log power with spread s is `1 / (1 + (R/d)^(2/s))`
+            // (power falls as d⁻²).
+            Self::LidarLoss {
+                half_loss_range_m,
+                steepness,
+                ..
+            } => vec![half_loss_range_m, 2.0 / steepness],
         }
     }
 
@@ -181,6 +201,21 @@ impl Concealment {
             Self::MountYaw { yaw_deg } => {
                 for s in recording.lidar.iter_mut().flatten() {
                     s.angle_deg = (s.angle_deg - yaw_deg).rem_euclid(360.0);
+                }
+            }
+            Self::LidarLoss {
+                half_loss_range_m,
+                steepness,
+                seed,
+            } => {
+                let mut stream = SplitMix64::seed_from_u64(seed);
+                for s in recording.lidar.iter_mut().flatten().filter(|s| reads(s)) {
+                    let lost = 1.0 / (1.0 + (half_loss_range_m / s.range_m).powf(steepness));
+                    let u = (stream.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+                    if u < lost {
+                        s.invalid = true;
+                        s.range_m = 0.0;
+                    }
                 }
             }
         }
@@ -290,6 +325,7 @@ pub fn concealable(recording: &Recording) -> Vec<Effect> {
             Effect::LidarWarmupDrift,
             Effect::LidarMountOffset,
             Effect::SensorLatency(Sensor::Lidar),
+            Effect::LidarDropout,
         ]);
     }
     if has_encoders(recording) && (has_truth(recording) || has_lidar) {
@@ -380,10 +416,41 @@ pub(crate) fn draw(
                 time_constant_s,
             }
         }
+        Effect::LidarDropout => {
+            // Half lost at a range between the log's median reading and its 90th percentile, so
+            // that both sides of it are well read; the loss rising from 12 % to 88 % over a
+            // factor of 1.5 to 4 of range (the logistic's ±ln 7.33 = ±1.99 about its middle).
+            let (median_m, far_m) = reading_quantiles(recording);
+            let half_loss_range_m = median_m * (far_m / median_m).powf(d.unit());
+            let factor = d.between(1.5, 4.0);
+            Concealment::LidarLoss {
+                half_loss_range_m,
+                steepness: 2.0 * 7.33_f64.ln() / factor.ln(),
+                seed: d.next(),
+            }
+        }
         _ => Concealment::MountYaw {
             yaw_deg: signed(d, 1.0, 3.0),
         },
     }
+}
+
+/// The median and the 90th percentile of the ranges `recording`'s lidar read, metres (a
+/// metre each when it read none).
+fn reading_quantiles(recording: &Recording) -> (f64, f64) {
+    let mut ranges: Vec<f64> = recording
+        .lidar
+        .iter()
+        .flatten()
+        .filter(|s| reads(s))
+        .map(|s| s.range_m)
+        .collect();
+    if ranges.is_empty() {
+        return (1.0, 1.0);
+    }
+    ranges.sort_by(f64::total_cmp);
+    let at = |q: f64| ranges[((ranges.len() - 1) as f64 * q).round() as usize];
+    (at(0.5), at(0.9))
 }
 
 #[cfg(test)]
@@ -403,6 +470,53 @@ mod tests {
                     .collect(),
             ),
             ..Recording::default()
+        }
+    }
+
+    /// Half lost at 5 m: about 1 % of the readings at 2 m, half at 5 m and 99 % at 12 m are
+    /// lost (steepness 5), each flagged invalid with range 0; the same seed loses the same.
+    #[test]
+    fn returns_are_lost_by_range_about_half_at_the_half_loss_range() {
+        let at = |range_m: f64| -> Vec<LidarSample> {
+            (0..4000)
+                .map(|i| LidarSample {
+                    t_s: f64::from(i) * 0.001,
+                    rev: 0,
+                    angle_deg: 0.0,
+                    range_m,
+                    strength: 0,
+                    invalid: false,
+                    warning: false,
+                    true_range_m: None,
+                })
+                .collect()
+        };
+        let loss = Concealment::LidarLoss {
+            half_loss_range_m: 5.0,
+            steepness: 5.0,
+            seed: 3,
+        };
+        for (range_m, expected) in [(2.0, 0.0102), (5.0, 0.5), (12.0, 0.9875)] {
+            let mut r = Recording {
+                lidar: Some(at(range_m)),
+                ..Recording::default()
+            };
+            loss.apply(&mut r);
+            let lidar = r.lidar.expect("the scans");
+            let lost = lidar
+                .iter()
+                .filter(|s| s.invalid && s.range_m == 0.0)
+                .count();
+            // 4,000 Bernoulli draws: a share's standard error is at most 0.8 %; 3 % is beyond
+            // four of them.
+            let share = lost as f64 / 4000.0;
+            assert!((share - expected).abs() < 0.03, "{range_m} m: {share}");
+            let mut again = Recording {
+                lidar: Some(at(range_m)),
+                ..Recording::default()
+            };
+            loss.apply(&mut again);
+            assert_eq!(again.lidar, Some(lidar));
         }
     }
 
@@ -499,5 +613,27 @@ mod tests {
             braking_gain_s: 0.0,
         };
         assert_eq!(c.catalogue_params(), vec![0.05, 0.0]);
+        // A loss by range is the catalogue's head-on on its reference surface.
+        let c = Concealment::LidarLoss {
+            half_loss_range_m: 5.0,
+            steepness: 4.0,
+            seed: 0,
+        };
+        let params = c.catalogue_params();
+        assert_eq!(params, vec![5.0, 0.5]);
+        let catalogue = hilsim_sim::scenario::LidarDropout {
+            half_loss_range_m: params[0],
+            log_power_spread: params[1],
+            reference: 0.8,
+        };
+        for range_m in [2.0, 5.0, 9.0] {
+            let by_range = 1.0 / (1.0 + (5.0_f64 / range_m).powf(4.0));
+            let head_on =
+                hilsim_lidar_emulator::effects::dropout_probability(&catalogue, range_m, 1.0, 0.8);
+            assert!(
+                (by_range - head_on).abs() < 1e-12,
+                "{range_m}: {by_range} {head_on}"
+            );
+        }
     }
 }

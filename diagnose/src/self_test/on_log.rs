@@ -257,9 +257,13 @@ impl Answer {
         }
     }
 
-    /// The log's own size of `e`: named, else fitted without being named, else none.
+    /// The log's own size of `e`: named, else fitted without being named, else none; none for
+    /// an entry whose sizes do not add ([`Effect::sizes_add`]).
     #[must_use]
     pub fn own_size(&self, e: Effect) -> f64 {
+        if !e.sizes_add() {
+            return 0.0;
+        }
         self.get(e)
             .or_else(|| self.fitted.iter().find(|n| n.effect == e))
             .map_or(0.0, |n| n.size)

@@ -116,6 +116,23 @@ fn the_run_held_against_its_own_twin_names_no_sensor_physics() {
         verdict == "verdict: none" || verdict == "verdict: world_mismatch",
         "{said}"
     );
+    // Without a scenario the log is held against the same world, built in one step, and
+    // nothing is written beside it.
+    let before = std::fs::read_dir(tmp.path()).unwrap().count();
+    let one_step = hilsim(tmp.path(), &["diagnose", "--real", "rec"]);
+    assert!(one_step.status.success(), "{}", stderr(&one_step));
+    assert_eq!(
+        stdout(&one_step).lines().next().unwrap_or_default(),
+        verdict,
+        "{}",
+        stdout(&one_step)
+    );
+    assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), before);
+    let err = assert_bad_input(&hilsim(
+        tmp.path(),
+        &["diagnose", "--real", "rec", "--calibration", "robot.json"],
+    ));
+    assert!(err.contains("--calibration needs --sim"), "{err}");
 }
 
 #[test]

@@ -29,14 +29,21 @@ pub struct Overlay {
 #[must_use]
 pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
     let scenario = view.inputs.scenario;
-    let paths: Vec<(f64, f64)> = view
-        .truth
-        .poses()
-        .iter()
-        .chain(view.odometry.poses())
-        .chain(view.calibrated_odometry.poses())
-        .map(|p| (p.x, p.y))
-        .collect();
+    // The world and the true (or estimated) path frame the page; the odometry's dead reckoning,
+    // which drifts without bound over a long log (tens of metres over a building's 45 minutes),
+    // is drawn clipped to them. Without either it frames the page itself.
+    let framed_by_odometry = view.truth.is_empty() && scenario.is_none();
+    let odometry_points = || {
+        view.odometry
+            .poses()
+            .iter()
+            .chain(view.calibrated_odometry.poses())
+            .map(|p| (p.x, p.y))
+    };
+    let mut paths: Vec<(f64, f64)> = view.truth.poses().iter().map(|p| (p.x, p.y)).collect();
+    if framed_by_odometry {
+        paths.extend(odometry_points());
+    }
     let revs = chosen_revolutions(view);
     let scans: Vec<Scan> = revs.iter().map(|&rev| scan(view, rev)).collect();
     let mut xs: Vec<f64> = paths.iter().map(|p| p.0).collect();
@@ -54,6 +61,12 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
     }
     let x = Span::of(xs).padded(0.06);
     let y = Span::of(ys).padded(0.06);
+    let inside = |(px, py): (f64, f64)| (x.lo..=x.hi).contains(&px) && (y.lo..=y.hi).contains(&py);
+    let clipped = if odometry_points().all(inside) {
+        ""
+    } else {
+        ", clipped to the frame"
+    };
     let mut chart = Chart::to_scale("map", 900.0, 760.0, x, y);
     chart.axes("The world, the paths and the scans", "x (m)", "y (m)");
     if let Some(s) = scenario {
@@ -86,14 +99,17 @@ pub fn map(view: &View<'_>, overlay: Option<&Overlay>) -> (String, Vec<u64>) {
     if !view.odometry.is_empty() {
         let stroke = Stroke::dashed(colours::ODOMETRY, 2.0);
         chart.line(&line(&view.odometry), stroke);
-        keys.push(Key::Line(stroke, "path from the odometry".into()));
+        keys.push(Key::Line(
+            stroke,
+            format!("path from the odometry{clipped}"),
+        ));
     }
     if !view.calibrated_odometry.is_empty() {
         let stroke = Stroke::dashed(colours::CALIBRATED_ODOMETRY, 2.0);
         chart.line(&line(&view.calibrated_odometry), stroke);
         keys.push(Key::Line(
             stroke,
-            "path from the odometry, wheels calibrated".into(),
+            format!("path from the odometry, wheels calibrated{clipped}"),
         ));
     }
     if !view.truth.is_empty() {

@@ -31,6 +31,7 @@ mod health;
 pub mod locate;
 mod optimize;
 mod outcome;
+pub mod own_world;
 mod physics;
 mod plot;
 mod residuals;

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{anyhow, bail, Context, Result};
 use hilsim_diagnose::self_test::{self, on_log, Plan};
-use hilsim_diagnose::{show, Floors, Options, SimPhysics};
+use hilsim_diagnose::{own_world, show, Floors, Options, SimPhysics};
 use hilsim_recording::Recording;
 use hilsim_report::check_report_dir;
 use hilsim_sim::Scenario;
@@ -64,7 +64,7 @@ const BUILT_FROM_THE_LOG: &str = "<built from the log>";
 
 /// `hilsim diagnose --real RECORDING` without a scenario: the world built from the recording's
 /// own scans as `hilsim world` builds it, and built again under the lidar's named delay and
-/// mount when its path is a truth's (`on_log::diagnosed_in`).
+/// mount when its path is a truth's (`own_world::diagnosed_in`).
 fn diagnose_in_own_world(
     args: &DiagnoseArgs,
     real: &Path,
@@ -77,8 +77,8 @@ fn diagnose_in_own_world(
     let recording = Recording::read_dir(real)?;
     let status = Progress::on_stderr(true, None, "{spinner} diagnose: {msg} ({elapsed})").ticking();
     status.message("building the world from the log's scans and judging it".to_string());
-    let (scenario, diagnosis) = on_log::diagnosed_in(
-        &on_log::BuiltWorld::default(),
+    let (scenario, diagnosis) = own_world::diagnosed_in(
+        &own_world::BuiltWorld::default(),
         &recording,
         &real.display().to_string(),
         options,
@@ -212,12 +212,12 @@ fn self_test_on_log(
     if args.without_truth {
         recording.truth = None;
     }
-    let world: Box<dyn on_log::TrialWorld> = match &args.sim {
-        Some(path) => Box::new(on_log::GivenWorld(Scenario::load(path)?)),
-        None => Box::new(on_log::BuiltWorld::default()),
+    let world: Box<dyn own_world::LogWorld> = match &args.sim {
+        Some(path) => Box::new(own_world::GivenWorld(Scenario::load(path)?)),
+        None => Box::new(own_world::BuiltWorld::default()),
     };
     if let Some(i) = args.trial {
-        let on_log::TrialRun {
+        let on_log::LogTrialRun {
             concealed,
             real,
             scenario,

@@ -152,11 +152,7 @@ impl Concealment {
     pub fn apply(&self, recording: &mut Recording) {
         match *self {
             Self::Restamp { sensor, delay_s } => match sensor {
-                Sensor::Lidar => {
-                    for s in recording.lidar.iter_mut().flatten() {
-                        s.t_s += delay_s;
-                    }
-                }
+                Sensor::Lidar => crate::own_world::restamp_lidar(recording, delay_s),
                 _ => {
                     for s in recording.odometry.iter_mut().flatten() {
                         s.t_s += delay_s;

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::sync::{Mutex, OnceLock};
 
 use hilsim_diagnose::self_test::on_log::{
-    baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan, TrialWorld,
+    baseline, conceal_and_diagnose, concealments, BuiltWorld, GivenWorld, LogPlan, LogWorld,
 };
 use hilsim_diagnose::self_test::{not_concealed, Concealment};
 use hilsim_diagnose::{Diagnosis, Effect, Options, Sensor};
@@ -98,7 +98,7 @@ fn wheels_and_a_late_lidar_concealed_in_the_log_are_named_with_their_sizes() {
 fn a_late_lidar_is_judged_again_in_the_world_rebuilt_under_it() {
     /// The room, rebuilt as the room, counting how often and under which delay.
     struct Rebuilt(Scenario, Mutex<Vec<f64>>);
-    impl TrialWorld for Rebuilt {
+    impl LogWorld for Rebuilt {
         fn scenario(&self, _: &Recording, _: &str) -> Result<Scenario, String> {
             Ok(self.0.clone())
         }

@@ -156,6 +156,7 @@ fn evidence(sensor: Sensor, place: &str, detail: String) -> Evidence {
         detail,
         range: None,
         size_m: f64::NAN,
+        median_m: f64::NAN,
         noise_m: f64::NAN,
         world_m: 0.0,
         beyond_world_m: f64::NAN,

@@ -21,6 +21,7 @@ pub mod align;
 mod catalogue;
 mod conclude;
 mod crab;
+mod crisp_map;
 mod diagnosis;
 mod dropout;
 mod error;

@@ -8,6 +8,10 @@ use hilsim_recording::Recording;
 use hilsim_sim::scenario::Effects;
 use hilsim_sim::Scenario;
 
+use hilsim_sim::scenario::LidarMountOffset;
+
+use crate::catalogue::MOUNT_YAW_RESOLUTION_DEG;
+use crate::crisp_map::crispest_mount_yaw_deg;
 use crate::{Diagnosis, Effect, Options, Sensor, SimPhysics};
 
 /// Where a log's world comes from.
@@ -25,6 +29,20 @@ pub trait LogWorld: Sync {
     /// whole log starts, so the log's second half is not a run of it.
     fn takes_parts(&self) -> bool {
         true
+    }
+    /// `scenario` with its map built again from `recording`'s scans turned by the mount yaw
+    /// they agree on best, when that departs from the declared one, and that yaw (degrees
+    /// from the declared mount); `None` when the world does not move with the lidar's mount.
+    ///
+    /// # Errors
+    /// The world cannot be made again, in one line.
+    fn sharpened(
+        &self,
+        _recording: &Recording,
+        _label: &str,
+        _scenario: &Scenario,
+    ) -> Option<Result<(Scenario, f64), String>> {
+        None
     }
     /// The scenario to judge `recording` against again once `diagnosis` (against `scenario`)
     /// has named what moves where its scans land; `None` when the world does not move with it.
@@ -86,6 +104,38 @@ impl LogWorld for BuiltWorld {
     }
     fn describe(&self) -> String {
         "the world built from each recording's own scans".to_string()
+    }
+    /// A map built from scans placed at a truth's poses through a turned lidar is smeared
+    /// (each scan turned about the place it was seen from), and judged against it the turn is
+    /// partly the map's. The scans are placed at the mount yaw at which they agree best
+    /// ([`crispest_mount_yaw_deg`]); when it departs from the declared one by the least yaw
+    /// the catalogue names, the map is built from them so placed, while the scenario still
+    /// declares the recorded mount, so that the turn shows against it. Without a truth the
+    /// path is matched from the scans and turns with them: nothing is done.
+    fn sharpened(
+        &self,
+        recording: &Recording,
+        label: &str,
+        scenario: &Scenario,
+    ) -> Option<Result<(Scenario, f64), String>> {
+        let yaw_deg = crispest_mount_yaw_deg(recording, self.options.max_range_m)?;
+        if yaw_deg.abs() < MOUNT_YAW_RESOLUTION_DEG {
+            return None;
+        }
+        let turned = Effects {
+            lidar_mount_offset: Some(LidarMountOffset {
+                yaw_deg,
+                x_m: 0.0,
+                y_m: 0.0,
+            }),
+            ..Effects::default()
+        };
+        let placed = placed_under(recording, &turned)?;
+        Some(self.scenario(&placed, label).map(|again| {
+            let mut judged = scenario.clone();
+            judged.files.map.clone_from(&again.files.map);
+            (judged, yaw_deg)
+        }))
     }
     /// A map built from scans placed at a truth's poses takes in the lidar's delay and mount:
     /// each scan lands where the robot was at its stamp, seen through the declared mount, so a
@@ -172,6 +222,47 @@ fn placed_under(recording: &Recording, placement: &Effects) -> Option<Recording>
     Some(placed)
 }
 
+/// `recording` (named `label`) judged by `judged` against `world`'s scenario for it, or
+/// against that scenario with its map built from the scans turned by the mount yaw at which
+/// they agree best ([`LogWorld::sharpened`]) when judged against it the lidar shows a turn the
+/// same way: the scenario, its judgement, whether its map is of the turned scans, and the note
+/// saying what was found (which the judgement holds too). A map of turned scans in which the lidar shows no such turn (a short run's few
+/// points, a range error that smears walls as a turn does) is not kept, and a note says so.
+fn judged_in_the_crispest_map(
+    world: &dyn LogWorld,
+    recording: &Recording,
+    label: &str,
+    judged: &dyn Fn(&Scenario) -> Result<Diagnosis, String>,
+) -> Result<(Scenario, Diagnosis, bool, Option<String>), String> {
+    let scenario = world.scenario(recording, label)?;
+    let Some(crisper) = world.sharpened(recording, label, &scenario) else {
+        let first = judged(&scenario)?;
+        return Ok((scenario, first, false, None));
+    };
+    let (crisper, yaw_deg) = crisper?;
+    let mut turned = judged(&crisper)?;
+    let shows_the_turn = named_placement(&turned)
+        .lidar_mount_offset
+        .is_some_and(|m| m.yaw_deg * yaw_deg > 0.0);
+    if shows_the_turn {
+        let note = format!(
+            "the map was built from the scans turned {yaw_deg:+.2}° from the declared mount, \
+             where placed at the truth's poses they agree best (the crispest map); the lidar is \
+             judged against it as declared"
+        );
+        turned.notes.push(note.clone());
+        return Ok((crisper, turned, true, Some(note)));
+    }
+    let mut first = judged(&scenario)?;
+    let note = format!(
+        "the scans placed at the truth's poses agree best turned {yaw_deg:+.2}° from the \
+         declared mount, but judged against the map built from them so turned the lidar showed \
+         no such turn: it is judged against the map built from the scans as recorded"
+    );
+    first.notes.push(note.clone());
+    Ok((scenario, first, false, Some(note)))
+}
+
 /// `recording` (named `label` in an error) diagnosed against `world`'s scenario for it, and
 /// again against the world rebuilt under what the first diagnosis named, when it moves the
 /// world ([`LogWorld::rebuilt`]): the scenario judged against last, and its diagnosis.
@@ -188,13 +279,19 @@ pub fn diagnosed_in(
         let physics = SimPhysics::new(scenario).map_err(|e| format!("{label}: {e:#}"))?;
         crate::diagnose(&physics, recording, options).map_err(|e| format!("{label}: {e}"))
     };
-    let scenario = world.scenario(recording, label)?;
-    let first = judged(&scenario)?;
+    let (scenario, first, turned, crisp_note) =
+        judged_in_the_crispest_map(world, recording, label, &judged)?;
     let Some(rebuilt) = world.rebuilt(recording, label, &scenario, &first) else {
         return Ok((scenario, first));
     };
     let rebuilt = rebuilt?;
     let mut again = judged(&rebuilt)?;
+    let built_first = if turned {
+        "turned as above"
+    } else {
+        "as recorded"
+    };
+    again.notes.extend(crisp_note);
     let placement = placement_text(&named_placement(&first));
     // The second map is right only if judged against it the lidar still shows what it was
     // built under: a judgement that no longer names the delay or the mount it placed the scans
@@ -216,10 +313,10 @@ pub fn diagnosed_in(
         return Ok((scenario, first));
     }
     again.notes.push(format!(
-        "the map was built from the scans as recorded, then again with each scan placed under \
-         {placement}, as the first judgement named them: a late or turned lidar smears a map \
-         built from its own scans at a truth's poses; the recording is judged against the \
-         second map"
+        "the map was built from the scans {built_first}, then again with each scan placed \
+         under {placement}, as the first judgement named them: a late or turned lidar smears \
+         a map built from its own scans at a truth's poses; the recording is judged against \
+         the second map"
     ));
     Ok((rebuilt, again))
 }

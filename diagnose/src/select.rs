@@ -443,6 +443,7 @@ mod tests {
             detail: String::new(),
             range: None,
             size_m,
+            median_m: size_m,
             noise_m: 0.01,
             world_m: 0.0,
             beyond_world_m: size_m,

@@ -46,6 +46,10 @@ pub enum Effect {
     LidarDropout,
 }
 
+/// The least mount yaw named, degrees: 5 mm at 2 m, the world's own tolerance (see
+/// [`Effect::departs`]).
+pub(crate) const MOUNT_YAW_RESOLUTION_DEG: f64 = 0.15;
+
 impl Effect {
     /// The whole catalogue, in `interfaces.md` order (`sensor_latency` once per sensor it
     /// concerns).
@@ -627,7 +631,7 @@ impl Effect {
         };
         match self {
             Effect::LidarMountOffset => {
-                return beyond(0, 0.15) || beyond(1, 0.005) || beyond(2, 0.005);
+                return beyond(0, MOUNT_YAW_RESOLUTION_DEG) || beyond(1, 0.005) || beyond(2, 0.005);
             }
             Effect::OdometerWheelRadius => return beyond(0, 0.003) || beyond(1, 0.003),
             Effect::LidarWarmupDrift => return beyond(0, 0.000_25) || beyond(2, 0.001),

@@ -13,6 +13,7 @@ mod sensor;
 mod sentences;
 
 pub use effect::Effect;
+pub(crate) use effect::MOUNT_YAW_RESOLUTION_DEG;
 pub use params::{DrawSource, ParamSpec, SearchLimits, SelfTestRange};
 pub(crate) use scenario::{mounted, range_bias, REFERENCE_REFLECTIVITY};
 pub use sensor::Sensor;

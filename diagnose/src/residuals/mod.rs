@@ -19,6 +19,8 @@ mod sensors;
 
 pub(crate) use self::clusters::shared_error_clusters;
 pub use self::data::Covariate;
+#[cfg(test)]
+pub(crate) use self::data::Queries;
 pub(crate) use self::data::{Context, Predictive, SensorData};
 pub(crate) use self::dropout_rows::{dropout_rows, DropoutRows};
 pub(crate) use self::likelihood::{fits, log_likelihood, rmse, Fit};

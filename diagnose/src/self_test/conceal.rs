@@ -8,8 +8,6 @@
 //! lost by range) and its beams' angles (a turned mount). [`NOT_CONCEALED`] lists the rest and why.
 
 use hilsim_recording::{LidarSample, OdometrySample, Recording};
-use rand_xoshiro::rand_core::{RngCore, SeedableRng};
-use rand_xoshiro::SplitMix64;
 
 use super::draw::Draws;
 use crate::{Effect, Sensor};
@@ -204,11 +202,10 @@ impl Concealment {
                 steepness,
                 seed,
             } => {
-                let mut stream = SplitMix64::seed_from_u64(seed);
+                let mut stream = Draws::from_seed(seed);
                 for s in recording.lidar.iter_mut().flatten().filter(|s| reads(s)) {
                     let lost = 1.0 / (1.0 + (half_loss_range_m / s.range_m).powf(steepness));
-                    let u = (stream.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-                    if u < lost {
+                    if stream.unit() < lost {
                         s.invalid = true;
                         s.range_m = 0.0;
                     }

@@ -24,6 +24,11 @@ impl Draws {
             seed ^ trial.wrapping_mul(0xd1b5_4a32_d192_ed03).rotate_left(17),
         ))
     }
+    /// A stream started from `seed` alone: a concealment's own draws, made again from its
+    /// parameters.
+    pub(crate) fn from_seed(seed: u64) -> Self {
+        Self(SplitMix64::seed_from_u64(seed))
+    }
     pub(crate) fn next(&mut self) -> u64 {
         self.0.next_u64()
     }

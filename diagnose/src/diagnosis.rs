@@ -20,6 +20,7 @@ use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, Covariate, SensorData};
 use crate::select::{self, hypothesis_of, Selection};
+use crate::stamps;
 use hilsim_report::svg::fmt_sig;
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
@@ -84,6 +85,14 @@ pub fn diagnose_with_progress(
     progress(Stage::Aligning);
     let aligned = align::align(physics, recording)?;
     let mut options = options.against(&aligned);
+    // Encoders stamped no better than this show no lead of theirs within it (`stamps.rs`).
+    if let Some(scatter_s) = recording
+        .odometry
+        .as_deref()
+        .and_then(stamps::encoder_scatter_s)
+    {
+        options.encoder_timing_s = options.encoder_timing_s.max(scatter_s);
+    }
     // A world known only to a map's cells: a lidar departure within them is as likely the
     // map's as the lidar's.
     let world_m = physics
@@ -251,6 +260,7 @@ pub fn diagnose_with_progress(
         left = structure_left(final_ctx, &data, &nominal, &named);
     }
     nominal_where_none_named(&mut left, &named, &nominal);
+    notes.extend(lead_within_the_stamps(&candidates, options));
     if final_ctx.estimated {
         let before = named.len();
         named = within_the_paths_scale(&left, named, nominal.threshold, options, &mut notes);
@@ -557,6 +567,27 @@ fn rejudge_along(
         replace_effects(named, candidates, again, |s| s != Sensor::Lidar)
     };
     Ok((named, nominal_evidence(along, aligned, data, options)))
+}
+
+/// A note for an encoder delay or wheel slip that gained its place on held-out data but whose
+/// lead is within the scatter of the encoders' own stamps ([`Options::encoder_timing_s`]), so
+/// was not named: the log cannot tell it.
+fn lead_within_the_stamps(candidates: &[CandidateFit], options: &Options) -> Option<String> {
+    let within = candidates.iter().find(|c| {
+        matches!(
+            c.effect,
+            Effect::SensorLatency(Sensor::Odometer) | Effect::OdometerWheelSlip
+        ) && c.heldout_gain > options.min_gain
+            && c.params.first().is_some_and(|lead| {
+                lead.abs() <= options.encoder_timing_s && lead.abs() > options.path_timing_s
+            })
+    })?;
+    Some(format!(
+        "the encoders' stamps scatter by ±{:.0} ms about their neighbours' at speed: an encoder          delay or a wheel slip whose lead is within that is not identifiable from this log, so          {} (fitted at {:.0} ms) is not named",
+        options.encoder_timing_s * 1000.0,
+        within.effect.label(),
+        within.params[0] * 1000.0
+    ))
 }
 
 /// The drive judged again, and its effects chosen again, along a path that follows the

@@ -41,6 +41,7 @@ pub mod self_test;
 pub mod show;
 mod sim_physics;
 mod sparse_truth;
+mod stamps;
 pub mod stats;
 mod trajectory;
 

@@ -35,6 +35,11 @@ pub struct Options {
     /// `truth.csv`; the diagnosis sets [`ESTIMATED_PATH_TIMING_S`] against a path estimated
     /// from the lidar.
     pub path_timing_s: f64,
+    /// How well the encoders' stamps give when each reading was counted, seconds: a delay of
+    /// theirs, or a wheel slip's gain, within it is not told from the stamps' own scatter (see
+    /// `stamps.rs`). 0 by default; the diagnosis raises it to the recording's measured scatter
+    /// of its encoders' stamps.
+    pub encoder_timing_s: f64,
     /// The least offset of its position a lidar mount must have to be named, metres: 0 against
     /// `truth.csv` (the mount's own departure decides); the diagnosis sets
     /// [`ESTIMATED_MOUNT_MIN_M`] against a path estimated from the lidar.
@@ -73,6 +78,7 @@ impl Default for Options {
             max_fit_rows: 6_000,
             misaligned_share: 0.5,
             path_timing_s: 0.0,
+            encoder_timing_s: 0.0,
             mount_min_m: 0.0,
             dropout_min_share: 0.05,
         }

@@ -13,7 +13,8 @@
 //! ([`crate::locate::Floors`]) where it changes them most, in metres or in units of their noise: a small difference between the recording and the simulation
 //! that some effect can mimic is not that effect. Against a path estimated from the lidar, a
 //! delay of the sonar or the encoders must also exceed the path's own timing
-//! ([`Options::path_timing_s`]). A range bias must leave nothing of its sensor's error
+//! ([`Options::path_timing_s`]), and a delay or slip of the encoders their stamps' own scatter
+//! ([`Options::encoder_timing_s`]). A range bias must leave nothing of its sensor's error
 //! clustered by range ([`leaves_range_structure`]).
 
 use rayon::prelude::*;
@@ -114,14 +115,17 @@ pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
 /// ([`Options::path_timing_s`]): of a sensor judged along it (the sonar, the encoders), or of the
 /// lidar it was estimated from (told only through the other two); or a wheel slip's gain, the
 /// mirror of such a delay (encoders leading the path by `g v`, as ones stamped early would).
+/// The encoders' delay and slip are held against their own stamps' scatter too
+/// ([`Options::encoder_timing_s`]).
 fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
-    matches!(
-        c.effect,
-        Effect::SensorLatency(_) | Effect::OdometerWheelSlip
-    ) && c
-        .params
-        .first()
-        .is_some_and(|d| d.abs() <= options.path_timing_s)
+    let timing_s = match c.effect {
+        Effect::SensorLatency(Sensor::Odometer) | Effect::OdometerWheelSlip => {
+            options.path_timing_s.max(options.encoder_timing_s)
+        }
+        Effect::SensorLatency(_) => options.path_timing_s,
+        _ => return false,
+    };
+    c.params.first().is_some_and(|d| d.abs() <= timing_s)
 }
 
 /// Whether `c` is a range bias (the lidar's or the sonar's) whose sensor's error, under the
@@ -429,6 +433,25 @@ mod tests {
             assert!(!earns_place(&short, 15.0, &estimated()), "{effect:?}");
             assert!(earns_place(&fitted(effect, vec![0.03]), 15.0, &estimated()));
         }
+    }
+
+    /// Encoders whose stamps scatter by 60 ms do not show a delay or a slip's lead of 50 ms
+    /// (against truth too); the lidar's delay is not theirs.
+    #[test]
+    fn the_encoders_lead_within_their_stamps_scatter_is_not_named() {
+        let scattered = Options {
+            encoder_timing_s: 0.06,
+            ..Options::default()
+        };
+        for effect in [
+            Effect::SensorLatency(Sensor::Odometer),
+            Effect::OdometerWheelSlip,
+        ] {
+            assert!(!earns_place(&fitted(effect, vec![0.05]), 15.0, &scattered));
+            assert!(earns_place(&fitted(effect, vec![0.08]), 15.0, &scattered));
+        }
+        let lidar = fitted(Effect::SensorLatency(Sensor::Lidar), vec![0.05]);
+        assert!(earns_place(&lidar, 15.0, &scattered));
     }
 
     /// A test of the lidar's residuals against `covariate`, of `size_m`, scored 50 (beyond any

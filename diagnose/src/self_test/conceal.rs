@@ -10,7 +10,7 @@
 use hilsim_recording::{LidarSample, OdometrySample, Recording};
 
 use super::draw::Draws;
-use crate::{Effect, Sensor};
+use crate::{DrawSource, Effect, Sensor};
 
 /// One mechanism concealed in a log, with its true values.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -305,12 +305,13 @@ fn has_encoders(recording: &Recording) -> bool {
     recording.odometry.as_ref().is_some_and(|o| !o.is_empty())
 }
 
-/// The mechanisms that can be concealed in `recording`: the lidar's with a lidar; the wheels'
-/// radii and base with encoders judged against a truth or the lidar (a log without truth is
-/// diagnosed along the scans' own matches); their slip and delay only against a truth
-/// ([`not_concealed`]).
+/// The mechanisms that can be concealed in `recording` at the draws' `strength`: the lidar's
+/// with a lidar; the wheels' radii and base with encoders judged against a truth or the lidar (a
+/// log without truth is diagnosed along the scans' own matches); their slip and delay only
+/// against a truth, and only when the encoders' stamps scatter by less than the largest lead
+/// drawn ([`not_concealed`]).
 #[must_use]
-pub fn concealable(recording: &Recording) -> Vec<Effect> {
+pub fn concealable(recording: &Recording, strength: f64) -> Vec<Effect> {
     let mut effects = Vec::new();
     let has_lidar = recording.lidar.as_ref().is_some_and(|l| !l.is_empty());
     if has_lidar {
@@ -325,21 +326,58 @@ pub fn concealable(recording: &Recording) -> Vec<Effect> {
         effects.extend([Effect::OdometerWheelRadius, Effect::DriveWheelBase]);
     }
     if has_encoders(recording) && has_truth(recording) {
-        effects.extend([
-            Effect::OdometerWheelSlip,
-            Effect::SensorLatency(Sensor::Odometer),
-        ]);
+        effects.extend(
+            ENCODER_LEADS
+                .into_iter()
+                .filter(|e| leads_beyond_stamps(recording, *e, strength).is_none()),
+        );
     }
     effects
 }
 
-/// The catalogue's mechanisms not concealed in `recording`, and why: [`NOT_CONCEALED`], and a
-/// log's wheels' slip and delay without truth.
+/// The encoders' mechanisms told by a lead on their count over the wheels' changes of speed.
+const ENCODER_LEADS: [Effect; 2] = [
+    Effect::OdometerWheelSlip,
+    Effect::SensorLatency(Sensor::Odometer),
+];
+
+/// Why `effect`, a lead of the encoders, is not identifiable from `recording` at the draws'
+/// `strength`: its encoders' stamps scatter (`stamps.rs`) by at least the largest lead the
+/// self-test draws (the delay's, or the slip's gain), so the diagnosis would not name any it
+/// could conceal. `None` when they scatter less.
+fn leads_beyond_stamps(recording: &Recording, effect: Effect, strength: f64) -> Option<String> {
+    let scatter_s = recording
+        .odometry
+        .as_deref()
+        .and_then(crate::stamps::encoder_scatter_s)?;
+    let range = effect.params().first()?.self_test;
+    let DrawSource::Uniform { hi, .. } = range.source else {
+        return None;
+    };
+    let largest_s = if range.scaled { hi * strength } else { hi };
+    (scatter_s >= largest_s).then(|| {
+        format!(
+            "not identifiable from this log: its encoders' stamps scatter by ±{:.0} ms about \
+             their neighbours' at speed, at least the largest lead drawn ({:.0} ms)",
+            scatter_s * 1000.0,
+            largest_s * 1000.0
+        )
+    })
+}
+
+/// The catalogue's mechanisms not concealed in `recording` at the draws' `strength`, and why:
+/// [`NOT_CONCEALED`], a log's wheels' slip and delay without truth, and those its encoders'
+/// stamps scatter too much to show.
 #[must_use]
-pub fn not_concealed(recording: &Recording) -> Vec<(&'static str, &'static str)> {
-    let mut out = NOT_CONCEALED.to_vec();
+pub fn not_concealed(recording: &Recording, strength: f64) -> Vec<(String, String)> {
+    let owned = |(e, why): (&str, &str)| (e.to_string(), why.to_string());
+    let mut out: Vec<(String, String)> = NOT_CONCEALED.into_iter().map(owned).collect();
     if has_encoders(recording) && !has_truth(recording) {
-        out.extend(NOT_CONCEALED_WITHOUT_TRUTH);
+        out.extend(NOT_CONCEALED_WITHOUT_TRUTH.into_iter().map(owned));
+    } else if has_encoders(recording) {
+        out.extend(ENCODER_LEADS.into_iter().filter_map(|e| {
+            leads_beyond_stamps(recording, e, strength).map(|why| (e.label(), why))
+        }));
     }
     out
 }

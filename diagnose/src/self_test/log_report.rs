@@ -90,6 +90,7 @@ impl LogSelfTest {
             "world": self.world,
             "concealable": self.concealable.iter().map(|e| e.label()).collect::<Vec<_>>(),
             "not_concealed": self.not_concealed.iter().map(|(e, why)| json!({"effect": e, "why": why})).collect::<Vec<_>>(),
+            "encoder_stamp_scatter_s": self.encoder_scatter_s,
             "untouched": answer_json(&b.whole),
             "halves": b.halves.as_ref().map(|h| h.iter().map(answer_json).collect::<Vec<_>>()),
             "halves_stable": b.stable(),
@@ -132,6 +133,13 @@ impl LogSelfTest {
             "self-test on a log: {} blind trials, seed {}, strength {}, {} ({wall_s:.0} s)",
             s.trials, self.plan.seed, self.plan.strength, self.world
         )?;
+        if let Some(scatter_s) = self.encoder_scatter_s {
+            writeln!(
+                out,
+                "the encoders' stamps scatter by ±{:.0} ms: a delay or slip of theirs within that is not identifiable",
+                scatter_s * 1000.0
+            )?;
+        }
         writeln!(out, "untouched: {}", answer_text(&b.whole))?;
         match &b.halves {
             Some([first, second]) => {

@@ -206,7 +206,10 @@ pub struct LogSelfTest {
     /// The mechanisms this log allows to be concealed.
     pub concealable: Vec<Effect>,
     /// The catalogue's others, and why each is not.
-    pub not_concealed: Vec<(&'static str, &'static str)>,
+    pub not_concealed: Vec<(String, String)>,
+    /// The scatter of the log's encoders' stamps, seconds (`stamps.rs`; `None`: no encoders, or
+    /// too few readings taken while moving).
+    pub encoder_scatter_s: Option<f64>,
     pub baseline: Baseline,
     pub outcomes: Vec<LogOutcome>,
 }
@@ -288,7 +291,7 @@ pub fn baseline(
 #[must_use]
 pub fn concealments(recording: &Recording, plan: &LogPlan, index: u64) -> Vec<Concealment> {
     let mut d = Draws::new(plan.seed, index);
-    let mut pool = concealable(recording);
+    let mut pool = concealable(recording, plan.strength);
     if pool.is_empty() {
         return Vec::new();
     }
@@ -411,7 +414,7 @@ pub fn run_on_log(
             plan.trials
         )));
     }
-    let pool = concealable(recording);
+    let pool = concealable(recording, plan.strength);
     if pool.is_empty() {
         return Err(MismatchError::Input(
             "nothing to conceal: the recording has no lidar, and no encoders with a truth".into(),
@@ -430,7 +433,11 @@ pub fn run_on_log(
         plan: plan.clone(),
         world: world.describe(),
         concealable: pool,
-        not_concealed: not_concealed(recording),
+        not_concealed: not_concealed(recording, plan.strength),
+        encoder_scatter_s: recording
+            .odometry
+            .as_deref()
+            .and_then(crate::stamps::encoder_scatter_s),
         baseline,
         outcomes,
     })

@@ -14,7 +14,7 @@ use hilsim_diagnose::self_test::{not_concealed, Concealment};
 use hilsim_diagnose::{Diagnosis, Effect, Options, Sensor};
 use hilsim_fixtures::rooms::ROOM_4X3;
 use hilsim_lidar_emulator::Emulation;
-use hilsim_recording::Recording;
+use hilsim_recording::{OdometrySample, Recording};
 use hilsim_sim::Scenario;
 
 use crate::catalogue::{of, room};
@@ -287,8 +287,65 @@ fn a_trials_draws_are_its_own_and_only_what_the_log_allows() {
             && !drawn.contains(&Effect::SensorLatency(Sensor::Odometer)),
         "{drawn:?}"
     );
-    let listed: Vec<&str> = not_concealed(&recording).iter().map(|(e, _)| *e).collect();
-    assert!(listed.contains(&"odometer_wheel_slip"), "{listed:?}");
+    let listed: Vec<String> = not_concealed(&recording, 1.0)
+        .into_iter()
+        .map(|(e, _)| e)
+        .collect();
+    assert!(
+        listed.contains(&"odometer_wheel_slip".to_string()),
+        "{listed:?}"
+    );
+}
+
+/// Encoders whose stamps scatter by more than the largest lead drawn (stamped by a logger
+/// that delivers them a few tenths of a second off, as a CARMEN log's `ODOM` lines are) have
+/// neither their delay nor their slip concealed, and both are listed as not identifiable; at
+/// five times the strength the leads drawn reach past the scatter, and both are concealed.
+#[test]
+fn encoder_leads_within_their_stamps_scatter_are_not_concealed() {
+    let (_, mut recording) = log();
+    let plan = |strength: f64| LogPlan {
+        trials: 60,
+        seed: 3,
+        strength,
+        options: Options::default(),
+    };
+    let drawn = |recording: &Recording, strength: f64| -> Vec<Effect> {
+        (0..60)
+            .flat_map(|i| concealments(recording, &plan(strength), i))
+            .map(|c| c.effect())
+            .collect()
+    };
+    let leads = [
+        Effect::OdometerWheelSlip,
+        Effect::SensorLatency(Sensor::Odometer),
+    ];
+    assert!(leads.iter().all(|e| drawn(&recording, 1.0).contains(e)));
+    // Read at 10 Hz, each reading stamped off by a fixed pattern of up to ±0.25 s, and kept in
+    // the order of its stamps.
+    let odometry = recording.odometry.as_mut().expect("encoders");
+    let mut logged: Vec<_> = odometry
+        .iter()
+        .step_by(5)
+        .enumerate()
+        .map(|(k, s)| OdometrySample {
+            t_s: s.t_s + [0.0, 0.25, -0.2, 0.1, -0.15, 0.2, -0.25][k % 7],
+            ..*s
+        })
+        .collect();
+    logged.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    *odometry = logged;
+    let listed: Vec<(String, String)> = not_concealed(&recording, 1.0);
+    for e in leads {
+        assert!(!drawn(&recording, 1.0).contains(&e), "{e:?} {listed:?}");
+        assert!(
+            listed
+                .iter()
+                .any(|(name, why)| *name == e.label() && why.contains("not identifiable")),
+            "{listed:?}"
+        );
+        assert!(drawn(&recording, 5.0).contains(&e), "{e:?}");
+    }
 }
 
 /// A run without truth and without commands is diagnosed along its scans' own matches: a

@@ -117,6 +117,33 @@ pub trait Entry: Sync {
     /// The explanatory variables its mechanism acts through.
     fn variables(&self) -> &'static [Variable];
 
+    /// Whether its size (its first parameter, seconds) is a delay of its sensor against the
+    /// path, or the mirror of one: a path whose own timing is off by as much passes for it.
+    fn sized_as_a_delay(&self) -> bool {
+        false
+    }
+
+    /// Whether it is its sensor's calibration of the range (a polynomial in the range alone),
+    /// which fitted to an error of its own shape leaves nothing against the range.
+    fn is_range_calibration(&self) -> bool {
+        false
+    }
+
+    /// Whether a fit of `params` settles within `span_s`: an effect that settles with a time
+    /// constant does where that is at most `span_s`; any other does.
+    fn settles_within(&self, params: &[f64], span_s: f64) -> bool {
+        let _ = (params, span_s);
+        true
+    }
+
+    /// Whether, taken up by a path estimated from the lidar, it shows in the sensors that look
+    /// from the robot (the sonar, the encoders) on a path whose headings span
+    /// `heading_span_rad`, and is fitted through them.
+    fn seen_through_path(&self, heading_span_rad: f64) -> bool {
+        let _ = heading_span_rad;
+        false
+    }
+
     /// Its parameters, in the order a [`crate::Hypothesis`] holds them.
     ///
     /// The fit's ranges are wide enough for any plausible unit (several times the self-test's
@@ -178,6 +205,12 @@ pub trait Entry: Sync {
     /// Whether the best of [`Entry::shapes`] is refined with all parameters free.
     fn shapes_refined_together(&self) -> bool {
         true
+    }
+
+    /// Whether, along a path estimated from the lidar, its [`Entry::shapes`] are settled apart
+    /// (each from the first fit's size) rather than together.
+    fn shapes_settled_apart(&self) -> bool {
+        false
     }
 
     /// The parameter values at which the effect is absent (what the nominal model assumes),

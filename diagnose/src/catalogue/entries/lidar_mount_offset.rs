@@ -13,6 +13,15 @@ use super::super::sensor::Sensor;
 /// [`Entry::least_departures`]).
 pub(crate) const MOUNT_YAW_RESOLUTION_DEG: f64 = 0.15;
 
+/// The least span of headings a run must turn through for a mount to be fitted through the
+/// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
+/// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
+/// fit has only the sonar's ranges and a crab of the heading against the direction of travel
+/// (`cos ψ` of each step), which mimic a wheel's radius: on a straight run in front of a board a
+/// "mount" of degrees and decimetres fits. A quarter turn with a 1 cm offset is 16 mm of
+/// travel.
+const THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
 /// The lidar's real mount under a `lidar_mount_offset` of `params` (in the order of
 /// [`Entry::params`]) from the `declared` one: the simulator's own [`real_mount`].
 pub(crate) fn mounted(declared: &Mount, params: &[f64]) -> Mount {
@@ -37,6 +46,15 @@ impl Entry for LidarMountOffset {
     /// moves the beams' origin along each direction.
     fn variables(&self) -> &'static [Variable] {
         &[Variable::Bearing, Variable::Range]
+    }
+
+    /// Against a path estimated from the lidar a mount offset goes into the path: scan matching
+    /// places the lidar, and the robot is inferred from it through the declared mount, so the
+    /// lidar fits and the error shows in the sensors that look from the robot (the sonar's
+    /// origin and axis; the encoders, as the inferred robot point swings about the real one
+    /// while the robot turns): on a path that turns through [`THROUGH_PATH_MIN_TURN_RAD`].
+    fn seen_through_path(&self, heading_span_rad: f64) -> bool {
+        heading_span_rad >= THROUGH_PATH_MIN_TURN_RAD
     }
 
     /// The self-test draws a yaw of ±[1, 3]° and a position of ±[0.01, 0.03] m.

@@ -39,6 +39,10 @@ impl Entry for LidarRangeBias {
         &[Variable::Range]
     }
 
+    fn is_range_calibration(&self) -> bool {
+        true
+    }
+
     /// The self-test draws ±[10, 60] mm at 2 m and a scale error of ±[0.5, 3] % (its quadratic
     /// term not drawn).
     fn params(&self) -> &'static [ParamSpec] {

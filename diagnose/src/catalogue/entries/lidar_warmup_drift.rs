@@ -75,6 +75,18 @@ impl Entry for LidarWarmupDrift {
         &[1]
     }
 
+    /// Its two terms are settled apart: the path first takes up a constant term, the fit then
+    /// reads the near walls' shift as `k d²`, and rounds that follow both at once move the
+    /// drift between them instead of settling it.
+    fn shapes_settled_apart(&self) -> bool {
+        true
+    }
+
+    /// Where its time constant τ is at most `span_s`.
+    fn settles_within(&self, params: &[f64], span_s: f64) -> bool {
+        params.get(1).is_some_and(|tau_s| *tau_s <= span_s)
+    }
+
     /// Absent at k = 0 for any τ.
     fn absent(&self, _: f64) -> Vec<f64> {
         vec![0.0, 10.0, 0.0]

@@ -23,6 +23,11 @@ impl Entry for OdometerWheelSlip {
         &[Variable::WheelAcceleration]
     }
 
+    /// The mirror of a delay: encoders leading the path by `g v`, as ones stamped early would.
+    fn sized_as_a_delay(&self) -> bool {
+        true
+    }
+
     /// The self-test draws a gain of [0.03, 0.1] s (braking alike).
     fn params(&self) -> &'static [ParamSpec] {
         // Slip's gain is searched at g ≥ 0 only (the same 0.1 s grid as before on that side):

@@ -55,6 +55,19 @@ impl Entry for SensorLatency {
         }
     }
 
+    /// A delay of its stamps.
+    fn sized_as_a_delay(&self) -> bool {
+        true
+    }
+
+    /// The lidar's: the matching puts each pose at the scan's late stamp, so the lidar fits and
+    /// the sonar and the encoders, judged along a path that runs late, show the delay (the
+    /// encoders as a lead proportional to the wheel speed, a slip's signature; the sonar as a
+    /// range error proportional to the speed), on any path.
+    fn seen_through_path(&self, _: f64) -> bool {
+        self.0 == Sensor::Lidar
+    }
+
     /// The self-test draws a latency of [0.02, 0.08] s.
     fn params(&self) -> &'static [ParamSpec] {
         // A delay of up to 0.3 s (a driver buffering a whole revolution of a 5 Hz lidar is

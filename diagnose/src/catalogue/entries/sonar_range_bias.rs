@@ -23,6 +23,10 @@ impl Entry for SonarRangeBias {
         &[Variable::Range]
     }
 
+    fn is_range_calibration(&self) -> bool {
+        true
+    }
+
     /// The self-test draws a range offset of ±[10, 60] mm.
     fn params(&self) -> &'static [ParamSpec] {
         // The sonar's range offset alone, over ±0.2 m on a 5 cm grid: its scale is the speed

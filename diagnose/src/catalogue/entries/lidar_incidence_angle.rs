@@ -24,7 +24,8 @@ impl Entry for LidarIncidenceAngle {
         &[Variable::IncidenceAngle, Variable::Range]
     }
 
-    /// The self-test draws κ ±[0.01, 0.03] (its power of `tan θ` 1).
+    /// The self-test draws κ ±[0.01, 0.03] (its power of `tan θ` 1), on a fair coin moved whole
+    /// to its collimated term (the same scored error; `draw_values`).
     fn params(&self) -> &'static [ParamSpec] {
         // The collimated beam's term over ±0.2 m at 45° on a 2 cm grid: κ's window at 2 m, as
         // the self-test draws its size as κ's there (`draw_values` puts it all in one or the

@@ -24,7 +24,7 @@ impl Entry for LidarWarmupDrift {
     }
 
     /// The self-test draws k ±[0.004, 0.01] /m with τ in [5, 20] s (unscaled), on a fair coin
-    /// moved whole to its second term (the same scored error; `draw_values`).
+    /// moved whole to its constant term (the same scored error; `draw_values`).
     fn params(&self) -> &'static [ParamSpec] {
         // The warm-up's constant term over ±0.1 m on a 5 cm grid (a unit's drift is
         // centimetres at most), Nelder–Mead refining the three together. The self-test draws

@@ -574,10 +574,9 @@ fn rejudge_along(
 /// was not named: the log cannot tell it.
 fn lead_within_the_stamps(candidates: &[CandidateFit], options: &Options) -> Option<String> {
     let within = candidates.iter().find(|c| {
-        matches!(
-            c.effect,
-            Effect::SensorLatency(Sensor::Odometer) | Effect::OdometerWheelSlip
-        ) && c.heldout_gain > options.min_gain
+        c.effect.entry().sized_as_a_delay()
+            && c.effect.sensor() == Sensor::Odometer
+            && c.heldout_gain > options.min_gain
             && c.params.first().is_some_and(|lead| {
                 lead.abs() <= options.encoder_timing_s && lead.abs() > options.path_timing_s
             })
@@ -943,15 +942,6 @@ fn fixed_point_step(rounds: &[(f64, f64)]) -> Option<f64> {
     })
 }
 
-/// The least span of headings a run must turn through for a mount to be fitted through the
-/// sonar and the encoders. The encoders see the mount's position only as the robot turns (an
-/// offset `r` swings the inferred robot point through `r θ` in a turn of θ); without turns the
-/// fit has only the sonar's ranges and a crab of the heading against the direction of travel
-/// (`cos ψ` of each step), which mimic a wheel's radius: on a straight run in front of a board a
-/// "mount" of degrees and decimetres fits. A quarter turn with a 1 cm offset is 16 mm of
-/// travel.
-const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
-
 /// Against a path estimated from the lidar, a lidar mount offset goes into the path: scan
 /// matching places the lidar, and the robot is inferred from it through the declared mount, so
 /// the lidar fits and the error shows in the sensors that look from the robot (the sonar's
@@ -961,8 +951,8 @@ const MOUNT_THROUGH_PATH_MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// encoders' training log-likelihood along it is maximised. It is named when it gains on their
 /// held-out readings more than the effects named in them gain together (it explains what they
 /// were named for), it earns its place in the sensor it gains most in, and it moves the robot
-/// by at least [`Options::mount_min_m`]; a run that does not turn through
-/// [`MOUNT_THROUGH_PATH_MIN_TURN_RAD`] is not tried. Returns it (scored
+/// by at least [`Options::mount_min_m`]; a run that does not turn enough
+/// ([`crate::Entry::seen_through_path`]) is not tried. Returns it (scored
 /// there) with the path estimated again under it and the named lidar effects; the caller
 /// judges the sonar and the encoders again along that path.
 ///
@@ -984,13 +974,9 @@ fn through_path(
     let Some(declared) = ctx.physics.declared().lidar.map(|l| l.mount) else {
         return Ok(None);
     };
-    let seen_through_path = match effect {
-        Effect::LidarMountOffset => {
-            ctx.trajectory.heading_span_rad() >= MOUNT_THROUGH_PATH_MIN_TURN_RAD
-        }
-        Effect::SensorLatency(Sensor::Lidar) => true,
-        _ => false,
-    };
+    let seen_through_path = effect
+        .entry()
+        .seen_through_path(ctx.trajectory.heading_span_rad());
     let looking_from_robot = |s: Sensor| matches!(s, Sensor::Sonar | Sensor::Odometer);
     let others: Vec<&SensorData> = data
         .iter()
@@ -1263,10 +1249,9 @@ const RIVAL_SHARE: f64 = 0.1;
 const MAX_RIVALS: usize = 2;
 
 /// Each of `contenders` settled along its own path ([`settle`]), the one the lidar's held-out
-/// readings favour kept (the first on a tie). A warm-up's two terms are settled apart, each
-/// from the first fit's size: the path first takes up a constant term, the fit then reads the
-/// near walls' shift as `k d²`, and rounds that follow both at once move the drift between
-/// them instead of settling it.
+/// readings favour kept (the first on a tie). The shapes of an effect that settles them
+/// apart ([`crate::Entry::shapes_settled_apart`]: a warm-up's two terms) are settled each from
+/// the first fit's size.
 fn best_settled(
     ctx: &Context<'_>,
     aligned: &Aligned,
@@ -1277,7 +1262,7 @@ fn best_settled(
     let mut best: Option<Settled> = None;
     for &contender in contenders {
         let effect = contender.effect;
-        let apart: Vec<&[&[usize]]> = if effect == Effect::LidarWarmupDrift {
+        let apart: Vec<&[&[usize]]> = if effect.entry().shapes_settled_apart() {
             effect.shapes().iter().map(std::slice::from_ref).collect()
         } else {
             vec![effect.shapes()]

@@ -46,7 +46,9 @@ pub mod stats;
 mod trajectory;
 
 pub use align::Alignment;
-pub use catalogue::{DrawSource, Effect, ParamSpec, SearchLimits, SelfTestRange, Sensor};
+pub use catalogue::{
+    DrawSource, Effect, Entry, ParamSpec, SearchLimits, SelfTestRange, Sensor, Variable,
+};
 pub use diagnosis::{diagnose, diagnose_with_progress, Stage};
 pub use error::MismatchError;
 pub use explain::{CandidateFit, RmseOver};

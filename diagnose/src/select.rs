@@ -90,12 +90,11 @@ fn beyond_floor(c: &CandidateFit, options: &Options) -> bool {
 const WARMUP_SETTLED_SHARE: f64 = 1.0;
 
 /// Whether `c`, a lidar warm-up, is seen to settle within the readings it was scored on
-/// (anything else is).
+/// (anything else is; [`crate::Entry::settles_within`]).
 fn settles_within_run(c: &CandidateFit) -> bool {
-    c.effect != Effect::LidarWarmupDrift
-        || c.params
-            .get(1)
-            .is_some_and(|tau_s| *tau_s <= WARMUP_SETTLED_SHARE * c.seen_until_s)
+    c.effect
+        .entry()
+        .settles_within(&c.params, WARMUP_SETTLED_SHARE * c.seen_until_s)
 }
 
 /// Whether `c` is a lidar mount whose position offset is under [`Options::mount_min_m`].
@@ -114,18 +113,16 @@ pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
 /// Whether `c` is a delay no larger than the trajectory's own timing is known to
 /// ([`Options::path_timing_s`]): of a sensor judged along it (the sonar, the encoders), or of the
 /// lidar it was estimated from (told only through the other two); or a wheel slip's gain, the
-/// mirror of such a delay (encoders leading the path by `g v`, as ones stamped early would).
-/// The encoders' delay and slip are held against their own stamps' scatter too
-/// ([`Options::encoder_timing_s`]).
+/// mirror of such a delay (encoders leading the path by `g v`, as ones stamped early would;
+/// [`crate::Entry::sized_as_a_delay`]). The encoders' are held against their own stamps'
+/// scatter too ([`Options::encoder_timing_s`]).
 fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
-    let timing_s = match c.effect {
-        Effect::SensorLatency(Sensor::Odometer) | Effect::OdometerWheelSlip => {
-            options.path_timing_s.max(options.encoder_timing_s)
-        }
-        Effect::SensorLatency(_) => options.path_timing_s,
-        _ => return false,
+    let timing_s = if c.effect.sensor() == Sensor::Odometer {
+        options.path_timing_s.max(options.encoder_timing_s)
+    } else {
+        options.path_timing_s
     };
-    c.params.first().is_some_and(|d| d.abs() <= timing_s)
+    c.effect.entry().sized_as_a_delay() && c.params.first().is_some_and(|d| d.abs() <= timing_s)
 }
 
 /// Whether `c` is a range bias (the lidar's or the sonar's) whose sensor's error, under the
@@ -169,7 +166,7 @@ pub(crate) fn leaves_range_structure(
         .filter(|e| e.test == TestKind::SpreadAgainst && e.covariate != Some(Covariate::Range))
         .map(|e| e.score)
         .fold(0.0, f64::max);
-    matches!(c.effect, Effect::LidarRangeBias | Effect::SonarRangeBias)
+    c.effect.entry().is_range_calibration()
         && counted.iter().any(|e| {
             against_range(e, TestKind::BiasAgainst)
                 || (against_range(e, TestKind::SpreadAgainst)

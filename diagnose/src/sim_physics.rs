@@ -24,8 +24,9 @@ const CHUNK: usize = 2048;
 /// dozen readings, each several rays) is then shared by the threads too.
 const MIN_CHUNK: usize = 16;
 /// The widest beam the mixed-pixel fit tries (its catalogue range), radians.
-const MAX_HALF_WIDTH_RAD: f64 =
-    Effect::LidarMixedPixels.params()[0].hi * std::f64::consts::PI / 180.0;
+fn max_half_width_rad() -> f64 {
+    Effect::LidarMixedPixels.params()[0].hi * std::f64::consts::PI / 180.0
+}
 
 /// A lidar reading's place: the robot's pose (x, y, yaw) and the beam's angle, bit for bit.
 type BeamKey = [u64; 4];
@@ -163,7 +164,7 @@ impl SimPhysics {
         if let Some(c) = self.clear.read().ok().and_then(|m| m.get(&key).copied()) {
             return c;
         }
-        let c = geometry.clear_of_edges(&self.world, robot, angle, MAX_HALF_WIDTH_RAD);
+        let c = geometry.clear_of_edges(&self.world, robot, angle, max_half_width_rad());
         if let Ok(mut m) = self.clear.write() {
             if m.len() < CACHE_CAPACITY {
                 m.insert(key, c);

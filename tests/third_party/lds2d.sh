@@ -17,10 +17,13 @@ scenario=scenarios/room-tour.toml
 "$hilsim" record "$scenario" --out "$tmp/rec" --seed 5
 "$hilsim" serve "$scenario" --realtime --seed 5 > "$tmp/serve.out" &
 serve_pid=$!
-for _ in $(seq 100); do
+# Up to a minute: on a loaded machine the server builds its world slowly; stop early if it
+# has exited.
+for _ in $(seq 600); do
     grep -q '^serial: ' "$tmp/serve.out" 2>/dev/null && break
+    kill -0 "$serve_pid" 2>/dev/null || break
     sleep 0.1
 done
 port="$(sed -n 's/^serial: //p' "$tmp/serve.out")"
-[ -n "$port" ] || { echo "lds2d.sh: hilsim serve printed no port" >&2; exit 1; }
+[ -n "$port" ] || { echo "lds2d.sh: hilsim serve printed no port:" >&2; cat "$tmp/serve.out" >&2; exit 1; }
 timeout 60 "$venv/bin/python" tests/third_party/lds2d_client.py "$port" 20 "$tmp/rec/lidar.csv"

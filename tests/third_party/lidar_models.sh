@@ -24,12 +24,15 @@ while read -r model drivers; do
     for driver in $drivers; do
         "$hilsim" serve "$scenario" --realtime > "$tmp/serve.out" &
         serve_pid=$!
-        for _ in $(seq 100); do
+        # Up to a minute: on a loaded machine the server builds its world slowly; stop early if it
+        # has exited.
+        for _ in $(seq 600); do
             grep -q '^serial: ' "$tmp/serve.out" 2>/dev/null && break
+            kill -0 "$serve_pid" 2>/dev/null || break
             sleep 0.1
         done
         port="$(sed -n 's/^serial: //p' "$tmp/serve.out")"
-        [ -n "$port" ] || { echo "lidar_models.sh: hilsim serve printed no port" >&2; exit 1; }
+        [ -n "$port" ] || { echo "lidar_models.sh: hilsim serve printed no port:" >&2; cat "$tmp/serve.out" >&2; exit 1; }
         timeout 60 "$venv/bin/python" tests/third_party/lidar_models_client.py \
             "$driver" "$port" "$tmp/$model/lidar.csv" 5
         kill "$serve_pid" 2>/dev/null || true

@@ -136,7 +136,7 @@ impl LogSelfTest {
         if let Some(scatter_s) = self.encoder_scatter_s {
             writeln!(
                 out,
-                "the encoders' stamps scatter by ±{:.0} ms: a delay or slip of theirs within that is not identifiable",
+                "the encoders' stamps scatter by ±{:.0} ms (a delay or slip of theirs within that is not identifiable)",
                 scatter_s * 1000.0
             )?;
         }

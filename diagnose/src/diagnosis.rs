@@ -574,8 +574,7 @@ fn rejudge_along(
 /// was not named: the log cannot tell it.
 fn lead_within_the_stamps(candidates: &[CandidateFit], options: &Options) -> Option<String> {
     let within = candidates.iter().find(|c| {
-        c.effect.entry().sized_as_a_delay()
-            && c.effect.sensor() == Sensor::Odometer
+        stamps::is_encoder_lead(c.effect)
             && c.heldout_gain > options.min_gain
             && c.params.first().is_some_and(|lead| {
                 lead.abs() <= options.encoder_timing_s && lead.abs() > options.path_timing_s

@@ -117,7 +117,7 @@ pub(crate) fn mount_offset_m(params: &[f64]) -> f64 {
 /// [`crate::Entry::sized_as_a_delay`]). The encoders' are held against their own stamps'
 /// scatter too ([`Options::encoder_timing_s`]).
 fn within_path_timing(c: &CandidateFit, options: &Options) -> bool {
-    let timing_s = if c.effect.sensor() == Sensor::Odometer {
+    let timing_s = if crate::stamps::is_encoder_lead(c.effect) {
         options.path_timing_s.max(options.encoder_timing_s)
     } else {
         options.path_timing_s

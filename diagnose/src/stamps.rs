@@ -10,6 +10,14 @@ use hilsim_calibrator::stats::median;
 use hilsim_recording::OdometrySample;
 use nalgebra::{Matrix3, Vector3};
 
+use crate::catalogue::{Effect, Sensor};
+
+/// Whether `effect` is a lead of the encoders on their count (their delay, or a slip's gain, its
+/// mirror), which the scatter of their stamps bounds.
+pub(crate) fn is_encoder_lead(effect: Effect) -> bool {
+    effect.sensor() == Sensor::Odometer && effect.entry().sized_as_a_delay()
+}
+
 /// The readings either side of one that its stamp is judged against: a parabola through four
 /// neighbours follows the motion's speed and its change over a few tenths of a second at a
 /// logger's 5–10 Hz, with one reading to spare.

@@ -327,19 +327,19 @@ pub fn concealable(recording: &Recording, strength: f64) -> Vec<Effect> {
     }
     if has_encoders(recording) && has_truth(recording) {
         effects.extend(
-            ENCODER_LEADS
-                .into_iter()
-                .filter(|e| leads_beyond_stamps(recording, *e, strength).is_none()),
+            encoder_leads().filter(|e| leads_beyond_stamps(recording, *e, strength).is_none()),
         );
     }
     effects
 }
 
-/// The encoders' mechanisms told by a lead on their count over the wheels' changes of speed.
-const ENCODER_LEADS: [Effect; 2] = [
-    Effect::OdometerWheelSlip,
-    Effect::SensorLatency(Sensor::Odometer),
-];
+/// The encoders' mechanisms told by a lead on their count over the wheels' changes of speed, in
+/// the catalogue's order.
+fn encoder_leads() -> impl Iterator<Item = Effect> {
+    Effect::ALL
+        .into_iter()
+        .filter(|e| crate::stamps::is_encoder_lead(*e))
+}
 
 /// Why `effect`, a lead of the encoders, is not identifiable from `recording` at the draws'
 /// `strength`: its encoders' stamps scatter (`stamps.rs`) by at least the largest lead the
@@ -375,7 +375,7 @@ pub fn not_concealed(recording: &Recording, strength: f64) -> Vec<(String, Strin
     if has_encoders(recording) && !has_truth(recording) {
         out.extend(NOT_CONCEALED_WITHOUT_TRUTH.into_iter().map(owned));
     } else if has_encoders(recording) {
-        out.extend(ENCODER_LEADS.into_iter().filter_map(|e| {
+        out.extend(encoder_leads().filter_map(|e| {
             leads_beyond_stamps(recording, e, strength).map(|why| (e.label(), why))
         }));
     }

@@ -9,6 +9,7 @@
 mod declare;
 mod error;
 mod fit;
+mod local_map;
 mod path;
 mod raster;
 mod scans;

@@ -1,12 +1,13 @@
 //! The path a log's robot took: its truth when the recording has one; otherwise its wheels'
-//! dead reckoning corrected by matching each scan of its lidar to the last key scan
-//! (point-to-line ICP, `hilsim_calibrator::scan_match`).
+//! dead reckoning corrected by matching each scan of its lidar to the map the scans before it
+//! built (point-to-line ICP, `hilsim_calibrator::scan_match`, against [`LocalMap`]'s view).
 
-use hilsim_calibrator::scan_match::{match_scans, MatchOptions, Scan as Points};
+use hilsim_calibrator::scan_match::{match_scans, MatchOptions, Scan as Points, ScanMatch};
 use hilsim_recording::{Mount, Pose, RecordingDir};
 use hilsim_sim::recorded_path::RecordedPath;
 
 use crate::error::TwinError;
+use crate::local_map::LocalMap;
 use crate::scans::{for_each_scan, LogScan};
 
 /// Where the path comes from.
@@ -17,7 +18,8 @@ pub enum PoseSource {
     Auto,
     /// `truth.csv` (a corrected log's poses, a motion capture's).
     Truth,
-    /// The wheels' travel (`odometry.csv`) dead-reckoned, each scan matched to the last key scan.
+    /// The wheels' travel (`odometry.csv`) dead-reckoned, each scan matched to the map the
+    /// scans before it built.
     Odometry,
 }
 
@@ -28,7 +30,7 @@ pub struct FoundPath {
     pub path: RecordedPath,
     /// Which source gave it (never `Auto`).
     pub source: PoseSource,
-    /// Scans matched to their key scan, and scans whose match failed or strayed from the
+    /// Scans matched to the map, and scans whose match failed or strayed from the
     /// wheels' guess (then the wheels' guess was taken): for an odometry path.
     pub matched: usize,
     /// See `matched`.
@@ -37,16 +39,30 @@ pub struct FoundPath {
     pub skipped_rows: usize,
 }
 
-/// A key scan is replaced once the lidar has moved this far from it, metres: ICP's guess stays
-/// well inside its 0.3 m first gate, and the scans still overlap mostly.
+/// A scan is added to the map once the lidar has moved this far from where the last one added
+/// was taken, metres: the map then holds a scan every 0.3 m (enough to see every surface from
+/// two places), not the same view ten times a second.
 const KEY_SCAN_DISTANCE_M: f64 = 0.3;
 /// … or turned this far, degrees (a tenth of a SICK's 180° field of view).
 const KEY_SCAN_TURN_DEG: f64 = 15.0;
 /// A match further than this from the wheels' guess is a false one, metres: the wheels err by
-/// a few percent of the ≤ 0.3 m since the key scan.
+/// a few percent of the 0.1–0.3 m since the scan before.
 const MATCH_GATE_M: f64 = 0.15;
 /// See `MATCH_GATE_M`, degrees.
 const MATCH_GATE_DEG: f64 = 8.0;
+/// The wider gate of a match that lies on the map ([`taken`]), metres and degrees: a lidar
+/// stamped up to 0.3 s apart from the wheels (the diagnosis's latency range) on a robot
+/// turning at 1.5 rad/s and driving at 1 m/s.
+const WIDE_GATE_M: f64 = 0.4;
+/// See `WIDE_GATE_M`.
+const WIDE_GATE_DEG: f64 = 25.0;
+/// Share of a scan's points a match must pair with the map's surfaces to be taken in the wide
+/// gate: ICP keeps 90 % after its trim, so three quarters leaves room for what the map has not
+/// seen yet, while a match that slid along a false surface pairs far fewer.
+const ON_THE_MAP_SHARE: f64 = 0.75;
+/// … and the largest root mean square of those pairs' distances, metres: a few times a URG's or
+/// a SICK's range noise (1–3 cm).
+const ON_THE_MAP_RMS_M: f64 = 0.04;
 
 /// The path of the robot of the recording at `dir`.
 ///
@@ -128,8 +144,10 @@ fn odometry_path(dir: &RecordingDir, max_range_m: f64) -> Result<FoundPath, Twin
     let mount = dir.meta().lidar.unwrap_or_default();
     let options = MatchOptions::default();
     let mut points: Vec<(f64, Pose)> = Vec::new();
-    // The key scan: its points in its lidar's frame and that lidar's pose in the world.
-    let mut key: Option<(Points, Pose)> = None;
+    // What the scans matched so far have seen, and where the lidar was when the last of them
+    // was added.
+    let mut map = LocalMap::default();
+    let mut last_added: Option<Pose> = None;
     // The last scan's time and the robot's pose then, as found.
     let mut last: Option<(f64, Pose)> = None;
     let (mut matched, mut unmatched) = (0, 0);
@@ -147,37 +165,36 @@ fn odometry_path(dir: &RecordingDir, max_range_m: f64) -> Result<FoundPath, Twin
             None => wheels.pose_at(t),
         };
         let current = deskewed_points(&log, max_range_m, &wheels, &mount, t);
-        let found = match &key {
-            Some((reference, key_lidar)) => {
-                let guess_lidar = in_world(&mount, &guess).relative_to(key_lidar);
-                let guess_motion = [guess_lidar.x, guess_lidar.y, guess_lidar.yaw];
-                match match_scans(reference, &current, guess_motion, &options) {
-                    Ok(m) if near(&m.pose(), &guess_lidar) => {
-                        matched += 1;
-                        let p = m.pose();
-                        Some(robot_of(&mount, &key_lidar.compose(p.x, p.y, p.yaw)))
-                    }
-                    _ => {
-                        unmatched += 1;
-                        None
-                    }
+        let guess_lidar = in_world(&mount, &guess);
+        let view = map.view(&guess_lidar, max_range_m);
+        let new_ground = view.points.len() < options.min_points;
+        let found = if view.points.len() >= options.min_points {
+            match match_scans(&view, &current, [0.0; 3], &options) {
+                Ok(m) if taken(&m, current.points.len()) => {
+                    matched += 1;
+                    let p = m.pose();
+                    Some(robot_of(&mount, &guess_lidar.compose(p.x, p.y, p.yaw)))
+                }
+                _ => {
+                    unmatched += 1;
+                    None
                 }
             }
-            None => None,
+        } else {
+            None
         };
         let pose = found.unwrap_or(guess);
         let lidar = in_world(&mount, &pose);
-        let replace = match &key {
-            None => true,
-            Some((_, key_lidar)) => {
-                let d = lidar.relative_to(key_lidar);
-                found.is_none()
-                    || d.x.hypot(d.y) > KEY_SCAN_DISTANCE_M
-                    || d.yaw.abs().to_degrees() > KEY_SCAN_TURN_DEG
-            }
-        };
-        if replace && current.points.len() >= options.min_points {
-            key = Some((current, lidar));
+        // A scan is added once the lidar has moved on from the last added one, matched (or
+        // where the map has too little to match it to: the first scan, new ground).
+        let moved_on = last_added.is_none_or(|added| {
+            let d = lidar.relative_to(&added);
+            d.x.hypot(d.y) > KEY_SCAN_DISTANCE_M || d.yaw.abs().to_degrees() > KEY_SCAN_TURN_DEG
+        });
+        if (found.is_some() || new_ground) && moved_on && current.points.len() >= options.min_points
+        {
+            map.add(&current, &lidar);
+            last_added = Some(lidar);
         }
         last = Some((t, pose));
         points.push((t, pose));
@@ -245,12 +262,25 @@ fn deskewed_points(
     Points { points }
 }
 
-fn near(found: &Pose, guess: &Pose) -> bool {
-    (found.x - guess.x).hypot(found.y - guess.y) <= MATCH_GATE_M
+/// Whether a scan's match to the map is taken: near the wheels' guess, or farther (within a
+/// wider gate) when most of the scan lies on the map's surfaces. Wheels stamped apart from the
+/// scans put a turning robot where it was a little before or after: on the CoreSLAM rover's
+/// 75 s log, whose scans lag its encoders by about 0.15 s, turns of 1–2 rad/s move the guess
+/// 8–17° from matches that put 80–90 % of the scan on the map within 2–5 cm.
+fn taken(m: &ScanMatch, points: usize) -> bool {
+    let p = m.pose();
+    let on_the_map = m.correspondences as f64 >= ON_THE_MAP_SHARE * points as f64
+        && m.rms_residual_m <= ON_THE_MAP_RMS_M;
+    near(&p, &Pose::default(), MATCH_GATE_M, MATCH_GATE_DEG)
+        || (on_the_map && near(&p, &Pose::default(), WIDE_GATE_M, WIDE_GATE_DEG))
+}
+
+fn near(found: &Pose, guess: &Pose, gate_m: f64, gate_deg: f64) -> bool {
+    (found.x - guess.x).hypot(found.y - guess.y) <= gate_m
         && hilsim_recording::wrap_angle(found.yaw - guess.yaw)
             .abs()
             .to_degrees()
-            <= MATCH_GATE_DEG
+            <= gate_deg
 }
 
 /// The lidar's pose in the world for the robot at `robot`.

@@ -202,9 +202,9 @@ pub fn build_world(recording: &Path, options: &WorldOptions) -> Result<TwinWorld
     let path = find_path(&dir, options.poses, options.max_range_m)?;
     match path.source {
         PoseSource::Odometry => notes.push(format!(
-            "the path is the wheels' dead reckoning corrected by scan matching ({} of {} scans \
-             matched to their key scan; no loop closure: where the log returns to a place, its \
-             drift shows as a doubled wall)",
+            "the path is the wheels' dead reckoning corrected by matching each scan to the map \
+             the scans before it built ({} of {} scans matched; no loop closure beyond that: a \
+             place come back to after a long drift may show as a doubled wall)",
             path.matched,
             path.matched + path.unmatched
         )),

@@ -40,7 +40,11 @@ max_range_m = 6.0
 "#;
 
 fn record(dir: &Path) -> std::path::PathBuf {
-    let scenario = Scenario::from_toml(RUN, "run.toml".as_ref()).unwrap();
+    record_run(dir, RUN)
+}
+
+fn record_run(dir: &Path, run: &str) -> std::path::PathBuf {
+    let scenario = Scenario::from_toml(run, "run.toml".as_ref()).unwrap();
     let run = Emulation::new(&scenario, scenario.seed).unwrap().run();
     let rec = dir.join("rec");
     run.recording.write_dir(&rec).unwrap();
@@ -80,4 +84,39 @@ fn without_truth_the_path_is_the_wheels_corrected_by_the_scans() {
     }
     // The odometer here is exact, so this measures the matcher's drift over a 3-metre drive.
     assert!(worst < 0.05, "worst position error {worst} m");
+}
+
+#[test]
+fn encoders_stamped_apart_from_the_scans_do_not_lose_the_path() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Turns at 120°/s, as a rover's.
+    let run = RUN.replace(
+        "wheel_base_m = 0.23",
+        "wheel_base_m = 0.23\nturn_rate_deg_s = 120.0",
+    );
+    let rec = record_run(tmp.path(), &run);
+    // The encoders stamped 0.2 s early against the scans, as a log whose scans are stamped when
+    // they arrive: in the turns the wheels' guess is where the robot turned to 0.2 s later,
+    // 24° on.
+    let mut recording = hilsim_recording::Recording::read_dir(&rec).unwrap();
+    if let Some(odometry) = recording.odometry.as_mut() {
+        odometry.retain(|s| s.t_s >= 0.2);
+        for s in odometry.iter_mut() {
+            s.t_s -= 0.2;
+        }
+    }
+    recording.write_dir(&rec).unwrap();
+    let dir = hilsim_recording::RecordingDir::open(&rec).unwrap();
+    let found = find_path(&dir, PoseSource::Odometry, 8.0).unwrap();
+    let truth = find_path(&dir, PoseSource::Truth, 8.0).unwrap();
+    let mut worst: f64 = 0.0;
+    for (t, pose) in found.path.iter() {
+        let true_pose = truth.path.pose_at(t);
+        worst = worst.max((pose.x - true_pose.x).hypot(pose.y - true_pose.y));
+    }
+    // Matched to the map, each scan is placed where its own readings put it, whatever the
+    // wheels' stamps; the wheels still de-skew each scan (0.2 s of a 5 Hz unit's revolution)
+    // with the turn 0.2 s off. Measured: 52 mm; matched to each last key scan instead, the
+    // path strayed 95 mm.
+    assert!(worst < 0.07, "worst position error {worst} m, {found:?}");
 }

@@ -6,7 +6,7 @@
 //! stay single instead of doubled by the drift gathered in between (CoreSLAM matches to its
 //! whole map the same way: Steux and El Hamzaoui, ICARCV 2010).
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 use hilsim_calibrator::scan_match::Scan as Points;
 use hilsim_recording::Pose;
@@ -28,8 +28,10 @@ const WALL_DEPTH_M: f64 = 2.0 * CELL_M;
 /// Scans' points in the world, averaged by cell.
 #[derive(Debug, Clone, Default)]
 pub struct LocalMap {
-    /// Per cell: the sum of its points and their count.
-    cells: HashMap<(i64, i64), ([f64; 2], u32)>,
+    /// Per cell: the sum of its points and their count. Ordered, so that a view sums its cells
+    /// in the same order every run: the path, the world built along it and every diagnosis
+    /// of it are then the same for the same log.
+    cells: BTreeMap<(i64, i64), ([f64; 2], u32)>,
 }
 
 impl LocalMap {

@@ -1,6 +1,6 @@
 //! The map a log's scans have built so far, as the scan each new one is matched against: the
 //! centroids of the cells the scans' points fell in, seen from where the lidar is thought to be
-//! (the nearest cell along each bearing). Matching each scan to everything seen so far rather
+//! (the surface nearest along each bearing). Matching each scan to everything seen so far rather
 //! than to the last key scan alone keeps the path's drift from adding up scan by scan, and where
 //! the robot comes back to a place it is matched to what it saw there before: the map's walls
 //! stay single instead of doubled by the drift gathered in between (CoreSLAM matches to its
@@ -56,7 +56,15 @@ impl LocalMap {
         let bins = (360.0 / VIEW_STEP_DEG).round() as usize;
         let mut along: Vec<Vec<(f64, [f64; 2], u32)>> = vec![Vec::new(); bins];
         let (sin, cos) = lidar.yaw.sin_cos();
-        for (sum, n) in self.cells.values() {
+        // Only the cells within range across x: the map's ordered keys give that stripe
+        // without looking at the rest of a large map.
+        let stripe =
+            cell_of([lidar.x - max_range_m, 0.0]).0..=cell_of([lidar.x + max_range_m, 0.0]).0;
+        let cells = self
+            .cells
+            .range((*stripe.start(), i64::MIN)..=(*stripe.end(), i64::MAX))
+            .map(|(_, cell)| cell);
+        for (sum, n) in cells {
             let (wx, wy) = (sum[0] / f64::from(*n), sum[1] / f64::from(*n));
             let (dx, dy) = (wx - lidar.x, wy - lidar.y);
             let range = dx.hypot(dy);

@@ -42,9 +42,9 @@ pub struct FoundPath {
 /// A scan is added to the map once the lidar has moved this far from where the last one added
 /// was taken, metres: the map then holds a scan every 0.3 m (enough to see every surface from
 /// two places), not the same view ten times a second.
-const KEY_SCAN_DISTANCE_M: f64 = 0.3;
+const MAP_SCAN_DISTANCE_M: f64 = 0.3;
 /// … or turned this far, degrees (a tenth of a SICK's 180° field of view).
-const KEY_SCAN_TURN_DEG: f64 = 15.0;
+const MAP_SCAN_TURN_DEG: f64 = 15.0;
 /// A match further than this from the wheels' guess is a false one, metres: the wheels err by
 /// a few percent of the 0.1–0.3 m since the scan before.
 const MATCH_GATE_M: f64 = 0.15;
@@ -168,7 +168,9 @@ fn odometry_path(dir: &RecordingDir, max_range_m: f64) -> Result<FoundPath, Twin
         let guess_lidar = in_world(&mount, &guess);
         let view = map.view(&guess_lidar, max_range_m);
         let new_ground = view.points.len() < options.min_points;
-        let found = if view.points.len() >= options.min_points {
+        let found = if new_ground {
+            None
+        } else {
             match match_scans(&view, &current, [0.0; 3], &options) {
                 Ok(m) if taken(&m, current.points.len()) => {
                     matched += 1;
@@ -180,8 +182,6 @@ fn odometry_path(dir: &RecordingDir, max_range_m: f64) -> Result<FoundPath, Twin
                     None
                 }
             }
-        } else {
-            None
         };
         let pose = found.unwrap_or(guess);
         let lidar = in_world(&mount, &pose);
@@ -189,7 +189,7 @@ fn odometry_path(dir: &RecordingDir, max_range_m: f64) -> Result<FoundPath, Twin
         // where the map has too little to match it to: the first scan, new ground).
         let moved_on = last_added.is_none_or(|added| {
             let d = lidar.relative_to(&added);
-            d.x.hypot(d.y) > KEY_SCAN_DISTANCE_M || d.yaw.abs().to_degrees() > KEY_SCAN_TURN_DEG
+            d.x.hypot(d.y) > MAP_SCAN_DISTANCE_M || d.yaw.abs().to_degrees() > MAP_SCAN_TURN_DEG
         });
         if (found.is_some() || new_ground) && moved_on && current.points.len() >= options.min_points
         {
@@ -268,19 +268,15 @@ fn deskewed_points(
 /// 75 s log, whose scans lag its encoders by about 0.15 s, turns of 1–2 rad/s move the guess
 /// 8–17° from matches that put 80–90 % of the scan on the map within 2–5 cm.
 fn taken(m: &ScanMatch, points: usize) -> bool {
-    let p = m.pose();
     let on_the_map = m.correspondences as f64 >= ON_THE_MAP_SHARE * points as f64
         && m.rms_residual_m <= ON_THE_MAP_RMS_M;
-    near(&p, &Pose::default(), MATCH_GATE_M, MATCH_GATE_DEG)
-        || (on_the_map && near(&p, &Pose::default(), WIDE_GATE_M, WIDE_GATE_DEG))
+    moved_within(&m.pose(), MATCH_GATE_M, MATCH_GATE_DEG)
+        || (on_the_map && moved_within(&m.pose(), WIDE_GATE_M, WIDE_GATE_DEG))
 }
 
-fn near(found: &Pose, guess: &Pose, gate_m: f64, gate_deg: f64) -> bool {
-    (found.x - guess.x).hypot(found.y - guess.y) <= gate_m
-        && hilsim_recording::wrap_angle(found.yaw - guess.yaw)
-            .abs()
-            .to_degrees()
-            <= gate_deg
+/// Whether a match's correction `p` from the guess is within `gate_m` and `gate_deg`.
+fn moved_within(p: &Pose, gate_m: f64, gate_deg: f64) -> bool {
+    p.x.hypot(p.y) <= gate_m && hilsim_recording::wrap_angle(p.yaw).abs().to_degrees() <= gate_deg
 }
 
 /// The lidar's pose in the world for the robot at `robot`.

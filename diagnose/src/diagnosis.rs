@@ -10,7 +10,7 @@ use crate::crab;
 use crate::dropout;
 use crate::error::MismatchError;
 use crate::estimate::DeadReckoning;
-use crate::explain::{self, CandidateFit, RmseOver};
+use crate::explain::{self, CandidateFit, FitRows, RmseOver};
 use crate::health;
 use crate::locate::{self, Evidence, TestKind};
 use crate::outcome::{
@@ -997,7 +997,7 @@ fn through_path(
     // readings and its fit in the sensor it gains most in.
     let fitted_on = |base: &Hypothesis| -> Option<(f64, CandidateFit)> {
         let (params, param_sd) =
-            explain::fit_across(&through, &others, base, effect, options.max_fit_rows);
+            explain::fit_across(&through, &others, base, effect, FitRows::of(options));
         let fits: Vec<CandidateFit> = others
             .iter()
             .map(|d| {
@@ -1340,7 +1340,7 @@ fn settle(
         };
         lidar.clusters = Some(residuals::shared_error_clusters(ctx2.trajectory, &lidar.t));
         let refit =
-            explain::fit_candidate_in(&ctx2, &lidar, base, effect, shapes, options.max_fit_rows);
+            explain::fit_candidate_in(&ctx2, &lidar, base, effect, shapes, FitRows::of(options));
         // A refit short of its place ends the rounds unless it explains more than the last
         // (the path still settling under it: a warm-up's constant term grows round by round
         // from the part the first estimate left in the ranges); the rounds go on from it, and

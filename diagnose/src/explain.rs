@@ -5,9 +5,10 @@
 //! and the effects named in one sensor are refitted jointly.
 
 use crate::catalogue::{Effect, ParamSpec, Sensor};
-use crate::optimize::{maximize_shapes, refine, standard_errors};
+use crate::optimize::{maximize_shapes, refine, standard_errors, Objective};
 use crate::physics::Hypothesis;
 use crate::residuals::{fits, log_likelihood, rmse, Context, Fit, Predictive, SensorData};
+use crate::Options;
 
 /// One candidate effect, fitted and scored against a base model (the nominal one, or the
 /// effects already named in its sensor).
@@ -88,6 +89,31 @@ const SIZE_SHARE: f64 = 0.1;
 /// a post, a hundredth or two of a scan) is measured on that object.
 const FLOOR_MULTIPLE_SHARE: f64 = 0.01;
 const SIZE_MIN_READINGS: usize = 30;
+
+/// How many training readings a fit uses: at most `max` per sensor, the coarse grid of its
+/// search at most `grid` ([`Options::max_fit_rows`], [`Options::grid_fit_rows`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FitRows {
+    pub max: usize,
+    pub grid: usize,
+}
+
+impl FitRows {
+    pub(crate) fn of(options: &Options) -> Self {
+        Self {
+            max: options.max_fit_rows,
+            grid: options.grid_fit_rows,
+        }
+    }
+
+    /// `data`'s training rows the fit uses, and those its grid is searched on when fewer.
+    fn of_data(self, data: &SensorData) -> (Vec<usize>, Option<Vec<usize>>) {
+        let train = fit_rows(data, self.max);
+        let grid = fit_rows(data, self.grid);
+        let thinner = grid.len() < train.len();
+        (train, thinner.then_some(grid))
+    }
+}
 
 /// Training rows for fitting: every `stride`-th, at most `max_rows`. Data of two rows per
 /// reading (the encoders' two wheels) take an odd stride, so that both rows stay in.
@@ -293,9 +319,9 @@ pub(crate) fn fit_candidate(
     data: &SensorData,
     base: &Hypothesis,
     effect: Effect,
-    max_fit_rows: usize,
+    rows: FitRows,
 ) -> CandidateFit {
-    fit_candidate_in(ctx, data, base, effect, effect.shapes(), max_fit_rows)
+    fit_candidate_in(ctx, data, base, effect, effect.shapes(), rows)
 }
 
 /// As [`fit_candidate`], searching only `shapes` of the effect's (see [`Effect::shapes`]).
@@ -305,17 +331,19 @@ pub(crate) fn fit_candidate_in(
     base: &Hypothesis,
     effect: Effect,
     shapes: &[&[usize]],
-    max_fit_rows: usize,
+    rows: FitRows,
 ) -> CandidateFit {
     let specs = effect.params();
-    let train = fit_rows(data, max_fit_rows);
-    let mut objective = |x: &[f64]| fit_ll(ctx, data, &base.and(effect, x.to_vec()), &train);
+    let (train, grid) = rows.of_data(data);
+    let ll_on = |x: &[f64], rows: &[usize]| fit_ll(ctx, data, &base.and(effect, x.to_vec()), rows);
+    let mut coarse = grid.map(|grid| move |x: &[f64]| ll_on(x, &grid));
     let (params, _) = maximize_shapes(
         specs,
         shapes,
         effect.shapes_refined_together(),
         &effect.absent(0.0),
-        &mut objective,
+        &mut |x: &[f64]| ll_on(x, &train),
+        coarse.as_mut().map(|c| c as Objective<'_>),
     );
     let mut fit = score(ctx, data, base, effect, params, &train);
     // A parameter of none of the shapes searched (of fewer than the effect's) was held at its
@@ -338,24 +366,37 @@ pub(crate) fn fit_across(
     data: &[&SensorData],
     base: &Hypothesis,
     effect: Effect,
-    max_fit_rows: usize,
+    rows: FitRows,
 ) -> (Vec<f64>, Vec<f64>) {
-    let trains: Vec<Vec<usize>> = data.iter().map(|d| fit_rows(d, max_fit_rows)).collect();
-    let across = |x: &[f64], ll: fn(&Context<'_>, &SensorData, &Hypothesis, &[usize]) -> f64| {
+    let (trains, grids): (Vec<Vec<usize>>, Vec<Option<Vec<usize>>>) =
+        data.iter().map(|d| rows.of_data(d)).unzip();
+    let across = |x: &[f64],
+                  ll: fn(&Context<'_>, &SensorData, &Hypothesis, &[usize]) -> f64,
+                  coarse: bool| {
         let h = base.and(effect, x.to_vec());
         data.iter()
             .zip(&trains)
-            .map(|(d, rows)| ll(ctx, d, &h, rows))
+            .zip(&grids)
+            .map(|((d, train), grid)| {
+                let rows = match grid {
+                    Some(grid) if coarse => grid,
+                    _ => train,
+                };
+                ll(ctx, d, &h, rows)
+            })
             .sum::<f64>()
     };
+    let thinned = grids.iter().any(Option::is_some);
+    let mut coarse = thinned.then_some(|x: &[f64]| across(x, fit_ll, true));
     let (params, _) = maximize_shapes(
         effect.params(),
         effect.shapes(),
         effect.shapes_refined_together(),
         &effect.absent(0.0),
-        &mut |x: &[f64]| across(x, fit_ll),
+        &mut |x: &[f64]| across(x, fit_ll, false),
+        coarse.as_mut().map(|c| c as Objective<'_>),
     );
-    let mut scored = |x: &[f64]| across(x, total_ll);
+    let mut scored = |x: &[f64]| across(x, total_ll, false);
     let best = scored(&params);
     let param_sd = free_standard_errors(effect, &params, best, &mut scored);
     (params, param_sd)

@@ -25,34 +25,71 @@ fn simplex_evals(n: usize) -> usize {
 /// The maximum of `f` over the box of `specs`, with the value there, after at most about
 /// the grid's points (the product of each parameter's) and [`simplex_evals`] evaluations.
 pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) -> (Vec<f64>, f64) {
-    let mut eval = |u: &[f64]| -> f64 {
-        let x: Vec<f64> = specs.iter().zip(u).map(|(s, &u)| from_unit(s, u)).collect();
-        let v = f(&x);
-        if v.is_finite() {
-            v
-        } else {
-            f64::NEG_INFINITY
-        }
-    };
+    maximize_coarse_first(specs, f, None)
+}
+
+/// A function of the parameters to maximise.
+pub(crate) type Objective<'f> = &'f mut dyn FnMut(&[f64]) -> f64;
+
+/// Grid points whose coarse value is best, evaluated again in full: the start is the best of
+/// them. A thinned share of the readings ranks the grid's far-apart points as the whole does
+/// (their log-likelihoods differ by far more than the thinning's noise); the few best are
+/// checked in full so that two close basins are not told apart by the thinned share alone.
+const GRID_RECHECKED: usize = 3;
+
+/// As [`maximize`], the coarse grid searched on `coarse` when given: a cheaper estimate of
+/// `f` of the same shape (the log-likelihood of a thinned share of the same readings, whose
+/// scale may differ). The [`GRID_RECHECKED`] best grid points are evaluated with `f`, and the
+/// search goes on from the best of them with `f` alone.
+pub(crate) fn maximize_coarse_first(
+    specs: &[ParamSpec],
+    f: &mut dyn FnMut(&[f64]) -> f64,
+    mut coarse: Option<Objective<'_>>,
+) -> (Vec<f64>, f64) {
+    let in_box = |v: f64| if v.is_finite() { v } else { f64::NEG_INFINITY };
+    let x_of =
+        |u: &[f64]| -> Vec<f64> { specs.iter().zip(u).map(|(s, &u)| from_unit(s, u)).collect() };
+    let mut eval = |u: &[f64]| -> f64 { in_box(f(&x_of(u))) };
     // The coarse grid.
     let dims: Vec<usize> = specs.iter().map(|s| s.grid.max(2)).collect();
     let total: usize = dims.iter().product();
-    let mut best_u = vec![0.5; specs.len()];
-    let mut best_v = f64::NEG_INFINITY;
-    for index in 0..total {
+    let grid_point = |index: usize| -> Vec<f64> {
         let mut rest = index;
-        let u: Vec<f64> = dims
-            .iter()
+        dims.iter()
             .map(|&d| {
                 let i = rest % d;
                 rest /= d;
                 i as f64 / (d - 1) as f64
             })
-            .collect();
-        let v = eval(&u);
-        if v > best_v {
-            best_v = v;
-            best_u = u;
+            .collect()
+    };
+    let mut best_u = vec![0.5; specs.len()];
+    let mut best_v = f64::NEG_INFINITY;
+    match coarse.as_mut() {
+        Some(coarse) => {
+            let mut ranked: Vec<(f64, usize)> = (0..total)
+                .map(|index| (in_box(coarse(&x_of(&grid_point(index)))), index))
+                .collect();
+            // Best first; ties in grid order, so the result does not depend on the sort.
+            ranked.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            for &(_, index) in ranked.iter().take(GRID_RECHECKED) {
+                let u = grid_point(index);
+                let v = eval(&u);
+                if v > best_v {
+                    best_v = v;
+                    best_u = u;
+                }
+            }
+        }
+        None => {
+            for index in 0..total {
+                let u = grid_point(index);
+                let v = eval(&u);
+                if v > best_v {
+                    best_v = v;
+                    best_u = u;
+                }
+            }
         }
     }
     let cell: Vec<f64> = dims.iter().map(|&d| 1.0 / (d - 1) as f64).collect();
@@ -92,20 +129,7 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
             }
         }
     } else {
-        let (mut u, mut v, mut converged) =
-            nelder_mead(&mut eval, &best_u, &cell, simplex_evals(specs.len()));
-        // A likelihood far sharper than the grid (a wheel's radius to 1e-5 from a cell of
-        // 0.05) can use up the simplex's budget before it shrinks that far: restart from
-        // where it got with steps a tenth as large, at most three times. A converged search
-        // (every fit before the wheels' radius) is left as it was.
-        let mut step = cell.clone();
-        for _ in 0..3 {
-            if converged {
-                break;
-            }
-            step.iter_mut().for_each(|s| *s /= 10.0);
-            (u, v, converged) = nelder_mead(&mut eval, &u, &step, simplex_evals(specs.len()));
-        }
+        let (u, v) = simplex_search(&mut eval, &best_u, &cell);
         if v > best_v {
             best_v = v;
             best_u = u;
@@ -122,16 +146,18 @@ pub(crate) fn maximize(specs: &[ParamSpec], f: &mut dyn FnMut(&[f64]) -> f64) ->
 /// As [`maximize`], searching `shapes` one at a time first: each a set of the parameters left
 /// free (indices into `specs`), the others held at `held`; then, with several and `together`,
 /// refining all of them together from the best shape's maximum. No shape is [`maximize`] over
-/// all; one (or several not `together`) is the best shape's maximum with the rest held.
+/// all; one (or several not `together`) is the best shape's maximum with the rest held. Each
+/// shape's grid is searched on `coarse` when given ([`maximize_coarse_first`]).
 pub(crate) fn maximize_shapes(
     specs: &[ParamSpec],
     shapes: &[&[usize]],
     together: bool,
     held: &[f64],
     f: &mut dyn FnMut(&[f64]) -> f64,
+    mut coarse: Option<Objective<'_>>,
 ) -> (Vec<f64>, f64) {
     if shapes.is_empty() {
-        return maximize(specs, f);
+        return maximize_coarse_first(specs, f, coarse);
     }
     let mut best = (held.to_vec(), f64::NEG_INFINITY);
     for shape in shapes {
@@ -143,7 +169,12 @@ pub(crate) fn maximize_shapes(
             }
             x
         };
-        let (y, v) = maximize(&free, &mut |y: &[f64]| f(&full(y)));
+        let mut coarse_in_shape = coarse.as_mut().map(|c| move |y: &[f64]| c(&full(y)));
+        let (y, v) = maximize_coarse_first(
+            &free,
+            &mut |y: &[f64]| f(&full(y)),
+            coarse_in_shape.as_mut().map(|c| c as Objective<'_>),
+        );
         if v > best.1 {
             best = (full(&y), v);
         }
@@ -202,6 +233,28 @@ pub(crate) fn refine(
         .map(|(s, &u)| from_unit(s, u))
         .collect();
     (x, v)
+}
+
+/// Nelder–Mead from `start` with steps `step`, and again from where it got with steps a
+/// tenth as large while it has not converged, at most three times: a likelihood far sharper
+/// than the grid (a wheel's radius to 1e-5 from a cell of 0.05) can use up the simplex's
+/// budget before it shrinks that far. A converged search is left as it was.
+fn simplex_search(
+    f: &mut dyn FnMut(&[f64]) -> f64,
+    start: &[f64],
+    step: &[f64],
+) -> (Vec<f64>, f64) {
+    let budget = simplex_evals(start.len());
+    let (mut u, mut v, mut converged) = nelder_mead(f, start, step, budget);
+    let mut step = step.to_vec();
+    for _ in 0..3 {
+        if converged {
+            break;
+        }
+        step.iter_mut().for_each(|s| *s /= 10.0);
+        (u, v, converged) = nelder_mead(f, &u, &step, budget);
+    }
+    (u, v)
 }
 
 /// Nelder–Mead maximisation in the unit box from `start` with initial steps `step`: the best
@@ -425,11 +478,11 @@ mod tests {
                 - ((x[2] - m[2]) / 1e-3).powi(2)
         };
         let held = [0.0, 10.0, 0.0];
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], true, &held, &mut f);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], true, &held, &mut f, None);
         assert!((x[0] - m[0]).abs() < 2e-4, "{x:?}");
         assert!((x[1] / m[1] - 1.0).abs() < 0.02, "{x:?}");
         assert!((x[2] - m[2]).abs() < 2e-4, "{x:?}");
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], true, &held, &mut f);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], true, &held, &mut f, None);
         assert_eq!(x[2], 0.0, "{x:?}");
     }
 

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use crate::catalogue::{Effect, Sensor};
 use crate::conclude::{declared_cone, Left};
-use crate::explain::{self, CandidateFit};
+use crate::explain::{self, CandidateFit, FitRows};
 use crate::locate::{Evidence, Floors, TestKind};
 use crate::outcome::Options;
 use crate::physics::Hypothesis;
@@ -211,7 +211,7 @@ fn first_round(ctx: &Context<'_>, data: &[SensorData], options: &Options) -> Vec
     let nominal = Hypothesis::nominal();
     let mut candidates: Vec<CandidateFit> = tries
         .par_iter()
-        .map(|(e, d)| explain::fit_candidate(ctx, d, &nominal, *e, options.max_fit_rows))
+        .map(|(e, d)| explain::fit_candidate(ctx, d, &nominal, *e, FitRows::of(options)))
         .collect();
     candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
     candidates
@@ -313,7 +313,7 @@ fn select_in(
         if kept.len() == 1 {
             // Alone again: scored against the base, as in the first round.
             let alone =
-                explain::fit_candidate(ctx, data, base, kept[0].effect, options.max_fit_rows);
+                explain::fit_candidate(ctx, data, base, kept[0].effect, FitRows::of(options));
             return if earns_place(&alone, cone, options) {
                 vec![alone]
             } else {
@@ -336,7 +336,7 @@ fn on_top_of_chosen(
 ) -> Vec<CandidateFit> {
     let under = on_top_of(base, chosen);
     pool.par_iter()
-        .map(|c| explain::fit_candidate(ctx, data, &under, c.effect, options.max_fit_rows))
+        .map(|c| explain::fit_candidate(ctx, data, &under, c.effect, FitRows::of(options)))
         .collect()
 }
 
@@ -357,7 +357,7 @@ pub(crate) fn select(ctx: &Context<'_>, data: &[SensorData], options: &Options) 
         if !base.is_nominal() {
             pool = pool
                 .par_iter()
-                .map(|c| explain::fit_candidate(ctx, d, &base, c.effect, options.max_fit_rows))
+                .map(|c| explain::fit_candidate(ctx, d, &base, c.effect, FitRows::of(options)))
                 .collect();
         }
         named.extend(select_in(ctx, d, pool, &base, options));

@@ -16,7 +16,7 @@ use hilsim_sim::scenario::{self, Effects, LidarTiming};
 use hilsim_sim::{replay, Obstacle, Pose, Scenario, World};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 
 /// Readings predicted per parallel task at most …
 const CHUNK: usize = 2048;
@@ -28,8 +28,18 @@ fn max_half_width_rad() -> f64 {
     Effect::LidarMixedPixels.params()[0].hi * std::f64::consts::PI / 180.0
 }
 
-/// A lidar reading's place: the robot's pose (x, y, yaw) and the beam's angle, bit for bit.
-type BeamKey = [u64; 4];
+/// A lidar reading's place: the robot's pose (x, y, yaw), the beam's angle and the unit's
+/// mount on the robot (x, y, yaw), bit for bit.
+type BeamKey = [u64; 7];
+/// Where and when a hypothesis casts the beams: the unit's mount (x, y, yaw), the lidar's
+/// delay and the revolution's duration of a motion skew (NaN: none), bit for bit.
+type Geometry = [u64; 5];
+/// Geometries counted at most before the count starts again.
+const GEOMETRIES_COUNTED: usize = 4096;
+/// A cache by beam: a lookup per reading per evaluation is the fits' inner loop, so its keys
+/// are hashed by a fast hash (randomly seeded: a recording cannot be made to collide). Only
+/// looked up, never iterated: the seed changes no result.
+type BeamCache<V> = HashMap<BeamKey, V, foldhash::fast::RandomState>;
 /// Beams the caches hold at most (~1 KB each): a 60 s recording has 108,000 readings; beyond
 /// this (e.g. the many trial poses of a scan matcher) beams are cast again instead.
 const CACHE_CAPACITY: usize = 250_000;
@@ -41,11 +51,16 @@ pub struct SimPhysics {
     declared: Declared,
     names: Vec<String>,
     /// What each beam's quadrature directions see, without a footprint: the same under every
-    /// hypothesis but motion skew (another pose) and mixed pixels (another footprint), so the
-    /// fits of the other lidar effects cast no ray twice.
-    beams: RwLock<HashMap<BeamKey, Arc<BeamNodes>>>,
+    /// hypothesis of the same geometry (mount, delay, skew) but mixed pixels (another
+    /// footprint), so the fits of the lidar's range effects cast no ray twice.
+    beams: RwLock<BeamCache<Arc<BeamNodes>>>,
     /// Whether no other surface lies within the widest footprint of a beam.
-    clear: RwLock<HashMap<BeamKey, bool>>,
+    clear: RwLock<BeamCache<bool>>,
+    /// How often each geometry has been asked about: a geometry's beams are kept from its
+    /// second time on. A fit of the mount, the delay or the skew asks about a new geometry at
+    /// every evaluation, which would fill the caches with beams never asked about again; the
+    /// fits of the other effects on top of one found ask about it again and again.
+    geometries: Mutex<HashMap<Geometry, u32>>,
 }
 
 /// `p` with its heading wrapped as the simulator keeps every pose.
@@ -131,14 +146,34 @@ impl SimPhysics {
             names,
             beams: RwLock::default(),
             clear: RwLock::default(),
+            geometries: Mutex::default(),
         })
     }
 
-    /// The beam's quadrature directions from the cache, cast on a miss (without a footprint).
+    /// Whether the beams of `geometry` are worth keeping: the declared one always, another
+    /// from its second time on.
+    fn keeps(&self, geometry: Geometry, declared: bool) -> bool {
+        if declared {
+            return true;
+        }
+        let Ok(mut seen) = self.geometries.lock() else {
+            return false;
+        };
+        if seen.len() >= GEOMETRIES_COUNTED {
+            seen.clear();
+        }
+        let count = seen.entry(geometry).or_insert(0);
+        *count = count.saturating_add(1);
+        *count >= 2
+    }
+
+    /// The beam's quadrature directions from the cache, cast on a miss (without a footprint)
+    /// and kept when `keep`.
     fn cached_beam(
         &self,
         geometry: &LidarPredictor,
         key: BeamKey,
+        keep: bool,
         robot: &Pose,
         angle: f64,
     ) -> Arc<BeamNodes> {
@@ -146,6 +181,9 @@ impl SimPhysics {
             return b;
         }
         let b = Arc::new(geometry.beam_nodes(&self.world, robot, angle));
+        if !keep {
+            return b;
+        }
         if let Ok(mut m) = self.beams.write() {
             if m.len() < CACHE_CAPACITY {
                 m.insert(key, b.clone());
@@ -158,6 +196,7 @@ impl SimPhysics {
         &self,
         geometry: &LidarPredictor,
         key: BeamKey,
+        keep: bool,
         robot: &Pose,
         angle: f64,
     ) -> bool {
@@ -165,6 +204,9 @@ impl SimPhysics {
             return c;
         }
         let c = geometry.clear_of_edges(&self.world, robot, angle, max_half_width_rad());
+        if !keep {
+            return c;
+        }
         if let Ok(mut m) = self.clear.write() {
             if m.len() < CACHE_CAPACITY {
                 m.insert(key, c);
@@ -267,8 +309,18 @@ impl Physics for SimPhysics {
         let skew = hypothesis.param_of(Effect::LidarMotionSkew, 0);
         // `[effects.sensor_latency]`: each reading was taken this long before its stamp.
         let latency_s = all_effects.sensor_latency.map_or(0.0, |l| l.lidar_s);
-        // The beams' caches hold the declared mount's rays at the stamps' poses.
-        let moved = latency_s != 0.0 || all_effects.lidar_mount_offset.is_some();
+        let mount = [config.mount.x_m, config.mount.y_m, config.mount.yaw_deg];
+        let keep = self.keeps(
+            [
+                mount[0],
+                mount[1],
+                mount[2],
+                latency_s,
+                skew.unwrap_or(f64::NAN),
+            ]
+            .map(f64::to_bits),
+            all_effects.lidar_mount_offset.is_none() && latency_s == 0.0 && skew.is_none(),
+        );
         // When each reading's geometry is taken.
         let instant = |q: &LidarQuery| {
             let stamped = match (snapshot, skew) {
@@ -288,17 +340,17 @@ impl Physics for SimPhysics {
                 chunk.iter().map(|q| {
                     let p = trajectory.pose_at(instant(q));
                     let robot = pose(p);
-                    let e = if skew.is_some() || moved || !cacheable {
-                        // Another pose for every reading: nothing to reuse.
-                        predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
-                    } else {
-                        let key = [p.x, p.y, p.yaw, q.angle_deg].map(f64::to_bits);
-                        if mixed && !self.cached_clear(&geometry, key, &robot, q.angle_deg) {
+                    let e = if cacheable {
+                        let key = [p.x, p.y, p.yaw, q.angle_deg, mount[0], mount[1], mount[2]]
+                            .map(f64::to_bits);
+                        if mixed && !self.cached_clear(&geometry, key, keep, &robot, q.angle_deg) {
                             predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
                         } else {
-                            let beam = self.cached_beam(&geometry, key, &robot, q.angle_deg);
+                            let beam = self.cached_beam(&geometry, key, keep, &robot, q.angle_deg);
                             predictor.predict_nodes(&beam, q.t_s)
                         }
+                    } else {
+                        predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
                     };
                     LidarPrediction {
                         components: e.components,

@@ -40,11 +40,10 @@ pub struct MotorLag {
     speed: [f64; 2],
     /// Each wheel's acceleration (second order only), m/s².
     acceleration: [f64; 2],
+    /// The second-order response's step, and its transition and mean-speed row over it
+    /// ([`held_response`]), computed at the first step of that length.
+    discrete: Option<(f64, Matrix2, [f64; 2])>,
 }
-
-/// The longest integration step of a second-order response, in units of 1/ωₙ: semi-implicit
-/// Euler's phase error stays under a percent of a period.
-const SECOND_ORDER_STEP: f64 = 0.05;
 
 impl MotorLag {
     /// Wheels at rest, lagging with time constant `tau_s` (> 0).
@@ -55,6 +54,7 @@ impl MotorLag {
             second_order: None,
             speed: [0.0; 2],
             acceleration: [0.0; 2],
+            discrete: None,
         }
     }
 
@@ -116,8 +116,10 @@ impl MotorLag {
 }
 
 impl MotorLag {
-    /// [`MotorLag::step`] for a second-order response: semi-implicit Euler in sub-steps of at
-    /// most [`SECOND_ORDER_STEP`]`/ωₙ`, the mean speed the sub-steps' mean.
+    /// [`MotorLag::step`] for a second-order response, exact for a command held through the
+    /// step: the state `x = (v − u, v̇)` obeys `ẋ = A x`, `A = [[0, 1], [−ωₙ², −2ζωₙ]]`, so
+    /// `x(dt) = e^{A dt} x₀` and the mean speed is `u + [1 0] (∫₀^dt e^{A s} ds) x₀ / dt`. Both
+    /// matrices depend on the step alone, and are computed once for it.
     fn step_second_order(
         &mut self,
         target: WheelCommand,
@@ -125,25 +127,86 @@ impl MotorLag {
         damping: f64,
         natural: f64,
     ) -> WheelCommand {
-        let n = (dt_s * natural / SECOND_ORDER_STEP).ceil().max(1.0);
-        let h = dt_s / n;
+        let (transition, mean_row) = match self.discrete {
+            Some((dt, transition, mean_row)) if dt == dt_s => (transition, mean_row),
+            _ => {
+                let (transition, integral) = held_response(damping, natural, dt_s);
+                let mean_row = [integral[0][0] / dt_s, integral[0][1] / dt_s];
+                self.discrete = Some((dt_s, transition, mean_row));
+                (transition, mean_row)
+            }
+        };
         let mut mean = [0.0; 2];
         for (i, u) in [target.left_mps, target.right_mps].into_iter().enumerate() {
-            let (mut v, mut a) = (self.speed[i], self.acceleration[i]);
-            for _ in 0..n as usize {
-                let v0 = v;
-                a += (natural * natural * (u - v) - 2.0 * damping * natural * a) * h;
-                v += a * h;
-                mean[i] += (v0 + v) / 2.0 / n;
-            }
-            self.speed[i] = v;
-            self.acceleration[i] = a;
+            let (e, a) = (self.speed[i] - u, self.acceleration[i]);
+            mean[i] = u + mean_row[0] * e + mean_row[1] * a;
+            self.speed[i] = u + transition[0][0] * e + transition[0][1] * a;
+            self.acceleration[i] = transition[1][0] * e + transition[1][1] * a;
         }
         WheelCommand {
             left_mps: mean[0],
             right_mps: mean[1],
         }
     }
+}
+
+type Matrix2 = [[f64; 2]; 2];
+
+/// `(e^{A h}, ∫₀^h e^{A s} ds)` for the second-order response's `A` (damping ζ, natural
+/// frequency ωₙ): the blocks of the exponential of the augmented `[[A h, I h], [0, 0]]`
+/// (Van Loan 1978), by scaling and squaring a Taylor series. Valid for any damping: the
+/// under-, critically and over-damped closed forms need no cases here.
+fn held_response(damping: f64, natural: f64, h: f64) -> (Matrix2, Matrix2) {
+    let mut m = [[0.0; 4]; 4];
+    m[0][1] = h;
+    m[1][0] = -natural * natural * h;
+    m[1][1] = -2.0 * damping * natural * h;
+    m[0][2] = h;
+    m[1][3] = h;
+    // Scaled until its norm is under ½, where 16 terms reach double precision.
+    let norm = m
+        .iter()
+        .map(|row| row.iter().map(|v: &f64| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let squarings = if norm > 0.5 {
+        (norm / 0.5).log2().ceil() as i32
+    } else {
+        0
+    };
+    let scale = 0.5f64.powi(squarings);
+    m.iter_mut().flatten().for_each(|v| *v *= scale);
+    let mut sum = identity4();
+    let mut term = identity4();
+    for k in 1..=16 {
+        term = product4(&term, &m);
+        term.iter_mut().flatten().for_each(|v| *v /= f64::from(k));
+        for (s, t) in sum.iter_mut().flatten().zip(term.iter().flatten()) {
+            *s += t;
+        }
+    }
+    for _ in 0..squarings {
+        sum = product4(&sum, &sum);
+    }
+    (
+        [[sum[0][0], sum[0][1]], [sum[1][0], sum[1][1]]],
+        [[sum[0][2], sum[0][3]], [sum[1][2], sum[1][3]]],
+    )
+}
+
+fn identity4() -> [[f64; 4]; 4] {
+    let mut m = [[0.0; 4]; 4];
+    (0..4).for_each(|i| m[i][i] = 1.0);
+    m
+}
+
+fn product4(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    let mut c = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            c[i][j] = (0..4).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    c
 }
 
 /// `ωₙ t` at which the step response of damping ζ first reaches `1 − 1/e`: its closed form
@@ -179,4 +242,40 @@ fn response_time(damping: f64) -> f64 {
         }
     }
     (lo + hi) / 2.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The held step is exact: from rest, each step's speed is the closed-form step response
+    /// `1 − e^{−ζωₙt} (cos ω_d t + ζ/√(1−ζ²) sin ω_d t)` (ω_d = ωₙ√(1−ζ²)), and the travel the
+    /// means add up to is its integral, `t − 2ζ/ωₙ + e^{−ζωₙt} (2ζ/ωₙ cos ω_d t + (2ζ² − 1)/ω_d
+    /// sin ω_d t)`, whatever the step's length against the response.
+    #[test]
+    fn a_held_step_follows_the_closed_form() {
+        for (damping, tau, dt) in [(0.4, 0.3, 0.01), (0.7, 0.05, 0.02), (0.2, 0.02, 0.004)] {
+            let mut lag = MotorLag::second_order(tau, damping);
+            let natural = response_time(damping) / tau;
+            let wd = natural * (1.0 - damping * damping).sqrt();
+            let go = WheelCommand {
+                left_mps: 1.0,
+                right_mps: 1.0,
+            };
+            let mut travel = 0.0;
+            for k in 1..=300 {
+                travel += lag.step(go, dt).left_mps * dt;
+                let t = f64::from(k) * dt;
+                let decay = (-damping * natural * t).exp();
+                let (sin, cos) = (wd * t).sin_cos();
+                let speed = 1.0 - decay * (cos + damping * natural / wd * sin);
+                let integral = t - 2.0 * damping / natural
+                    + decay
+                        * (2.0 * damping / natural * cos
+                            + (2.0 * damping * damping - 1.0) / wd * sin);
+                assert!((lag.speeds().left_mps - speed).abs() < 1e-12, "{t}");
+                assert!((travel - integral).abs() < 1e-12, "{t}");
+            }
+        }
+    }
 }

@@ -63,33 +63,30 @@ pub(crate) fn maximize_coarse_first(
             })
             .collect()
     };
-    let mut best_u = vec![0.5; specs.len()];
-    let mut best_v = f64::NEG_INFINITY;
-    match coarse.as_mut() {
+    // The grid points evaluated in full: every one, or the coarse estimate's best.
+    let starts: Vec<usize> = match coarse.as_mut() {
         Some(coarse) => {
             let mut ranked: Vec<(f64, usize)> = (0..total)
                 .map(|index| (in_box(coarse(&x_of(&grid_point(index)))), index))
                 .collect();
             // Best first; ties in grid order, so the result does not depend on the sort.
             ranked.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-            for &(_, index) in ranked.iter().take(GRID_RECHECKED) {
-                let u = grid_point(index);
-                let v = eval(&u);
-                if v > best_v {
-                    best_v = v;
-                    best_u = u;
-                }
-            }
+            ranked
+                .iter()
+                .take(GRID_RECHECKED)
+                .map(|&(_, index)| index)
+                .collect()
         }
-        None => {
-            for index in 0..total {
-                let u = grid_point(index);
-                let v = eval(&u);
-                if v > best_v {
-                    best_v = v;
-                    best_u = u;
-                }
-            }
+        None => (0..total).collect(),
+    };
+    let mut best_u = vec![0.5; specs.len()];
+    let mut best_v = f64::NEG_INFINITY;
+    for index in starts {
+        let u = grid_point(index);
+        let v = eval(&u);
+        if v > best_v {
+            best_v = v;
+            best_u = u;
         }
     }
     let cell: Vec<f64> = dims.iter().map(|&d| 1.0 / (d - 1) as f64).collect();
@@ -523,6 +520,37 @@ mod tests {
             assert!((s / w - 1.0).abs() < 1e-4, "{se:?}");
         }
         let _ = v;
+    }
+
+    /// A coarse estimate of another scale, whose grid ranking puts a false peak first, still
+    /// leads to the true maximum: the best grid points are checked in full. The likelihood is
+    /// flat far from its peak, so a search started at the false peak would stay there.
+    #[test]
+    fn a_coarse_grid_starts_the_search_from_the_full_likelihood() {
+        let specs = [spec(-1.0, 1.0, false), spec(-1.0, 1.0, false)];
+        let bump = |x: &[f64]| {
+            let r2 = (x[0] - 0.31).powi(2) + (x[1] + 0.42).powi(2);
+            100.0 * (-r2 / (2.0 * 0.1f64.powi(2))).exp()
+        };
+        // A quarter of the readings: a quarter of the log-likelihood, and a spurious peak at
+        // the grid point (0.8, 0.8) that the whole does not have.
+        let mut coarse = |x: &[f64]| {
+            let at = (x[0] - 0.8).abs() < 1e-9 && (x[1] - 0.8).abs() < 1e-9;
+            0.25 * bump(x) + if at { 1e6 } else { 0.0 }
+        };
+        let mut calls = 0;
+        let mut full = |x: &[f64]| {
+            calls += 1;
+            bump(x)
+        };
+        let (x, _) = maximize_coarse_first(&specs, &mut full, Some(&mut coarse));
+        // The simplex stops within 0.01 nats of the peak's 100: 0.1 · √(2 · 0.01/100) = 0.0014.
+        assert!(
+            (x[0] - 0.31).abs() < 0.002 && (x[1] + 0.42).abs() < 0.002,
+            "{x:?}"
+        );
+        // The full likelihood saw only the rechecked points and the simplex, not the grid's 121.
+        assert!(calls < 121, "{calls}");
     }
 
     #[test]

@@ -310,17 +310,18 @@ impl Physics for SimPhysics {
         // `[effects.sensor_latency]`: each reading was taken this long before its stamp.
         let latency_s = all_effects.sensor_latency.map_or(0.0, |l| l.lidar_s);
         let mount = [config.mount.x_m, config.mount.y_m, config.mount.yaw_deg];
-        let keep = self.keeps(
-            [
-                mount[0],
-                mount[1],
-                mount[2],
-                latency_s,
-                skew.unwrap_or(f64::NAN),
-            ]
-            .map(f64::to_bits),
-            all_effects.lidar_mount_offset.is_none() && latency_s == 0.0 && skew.is_none(),
-        );
+        let keep = cacheable
+            && self.keeps(
+                [
+                    mount[0],
+                    mount[1],
+                    mount[2],
+                    latency_s,
+                    skew.unwrap_or(f64::NAN),
+                ]
+                .map(f64::to_bits),
+                all_effects.lidar_mount_offset.is_none() && latency_s == 0.0 && skew.is_none(),
+            );
         // When each reading's geometry is taken.
         let instant = |q: &LidarQuery| {
             let stamped = match (snapshot, skew) {

@@ -441,7 +441,8 @@ impl LidarPredictor {
 pub struct ExpectedSonar {
     /// The expected reading and its spread.
     pub reading: Gaussian,
-    /// The nearest echo's true range, metres.
+    /// The echo's true range (the nearest echo's, or its blend with the lobe's centroid),
+    /// metres.
     pub true_range_m: f64,
 }
 
@@ -465,7 +466,7 @@ impl SonarPredictor {
     /// The ping when the robot is at `robot`; `None`: no echo within range (no sample).
     #[must_use]
     pub fn predict(&self, world: &World, robot: &Pose) -> Option<ExpectedSonar> {
-        let d = self.sonar.nearest_echo(world, robot)?;
+        let d = self.sonar.echo_m(world, robot)?;
         let mean = self.sonar.mean_reading_m(d);
         let sd = self.sonar.reading_sd_m(d);
         Some(ExpectedSonar {

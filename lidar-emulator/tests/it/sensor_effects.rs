@@ -278,6 +278,7 @@ fn a_wider_sonar_cone_sees_the_nearer_object_off_axis() {
     let mut wide = axis_only.clone();
     wide.effects.sonar_beam_width = Some(hilsim_sim::scenario::SonarBeamWidth {
         half_angle_deg: 20.0,
+        centroid_share: 0.0,
     });
     let a = record(&axis_only).sonar.unwrap();
     let b = record(&wide).sonar.unwrap();
@@ -288,6 +289,33 @@ fn a_wider_sonar_cone_sees_the_nearer_object_off_axis() {
     // The recording's metadata keeps the declared (axis-only) cone: the effect is what the
     // model left out, not what the robot's builder wrote down.
     assert_eq!(record(&wide).meta.sonar.unwrap().half_angle_deg, 0.0);
+}
+
+#[test]
+fn a_sonar_timing_its_echoes_centre_reads_between_the_near_object_and_the_wall() {
+    // The cylinder of the test above, 18.4° off the axis inside a 20° cone, and the wall 3 m
+    // ahead: the nearest echo is the cylinder's; the lobe's centroid is pulled towards the wall,
+    // whose echoes fill the lobe's centre, and the cylinder's 1/d² spreading pulls it back.
+    let world = "cylinders = [{ center = [1.5, 0.5], radius = 0.1 }]";
+    let sonar = "[sensors.sonar]\nbias = [0.0, 1.0]\nnoise = [0.0]\n";
+    let with_share = |share: f64| {
+        let mut s = scenario(world, sonar);
+        s.effects.sonar_beam_width = Some(hilsim_sim::scenario::SonarBeamWidth {
+            half_angle_deg: 20.0,
+            centroid_share: share,
+        });
+        record(&s).sonar.unwrap()[0].range_m
+    };
+    let nearest = 1.5f64.hypot(0.5) - 0.1;
+    let (onset, half, centre) = (with_share(0.0), with_share(0.5), with_share(1.0));
+    assert!((onset - nearest).abs() < MM_TOL, "{onset}");
+    assert!(centre > nearest + 0.5 && centre < 3.1, "{centre}");
+    // The share blends the two linearly.
+    // Each reading is rounded to the millimetre.
+    assert!(
+        (half - (onset + centre) / 2.0).abs() < 1.5e-3,
+        "{half} {onset} {centre}"
+    );
 }
 
 #[test]

@@ -180,12 +180,18 @@ pub struct LidarWarmupDrift {
     pub stretch: f64,
 }
 
-/// `[effects.sonar_beam_width]`: the sonar's real cone.
+/// `[effects.sonar_beam_width]`: the sonar's real cone, and how it times an echo spread
+/// across it.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SonarBeamWidth {
     /// Half of the real beam cone, degrees; replaces `[sensors.sonar] half_angle_deg`.
     pub half_angle_deg: f64,
+    /// The share of the reading that is the echoes' centroid across the beam's main lobe
+    /// rather than the nearest echo in the cone: 0 (default) times the echo's onset, 1 its
+    /// centre (an envelope detector's peak).
+    #[serde(default)]
+    pub centroid_share: f64,
 }
 
 /// `[effects.sonar_speed_of_sound]`: every range scaled by `c(calibrated_at_c) / c(air)`.

@@ -99,6 +99,7 @@ pub(super) fn validate(s: &Scenario) -> Check {
                 ),
             );
         }
+        within(p("centroid_share"), x.centroid_share, 0.0, 1.0, "a share")?;
     }
     if let Some(x) = e.sonar_speed_of_sound {
         let p = |k: &'static str| key_path!["effects", "sonar_speed_of_sound", k];

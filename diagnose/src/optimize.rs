@@ -142,13 +142,15 @@ pub(crate) fn maximize_coarse_first(
 
 /// As [`maximize`], searching `shapes` one at a time first: each a set of the parameters left
 /// free (indices into `specs`), the others held at `held`; then, with several and `together`,
-/// refining all of them together from the best shape's maximum. No shape is [`maximize`] over
-/// all; one (or several not `together`) is the best shape's maximum with the rest held. Each
-/// shape's grid is searched on `coarse` when given ([`maximize_coarse_first`]).
+/// refining the shapes' parameters and `also_refined` together from the best shape's maximum.
+/// No shape is [`maximize`] over all; one (or several not `together`) is the best shape's
+/// maximum with the rest held. Each shape's grid is searched on `coarse` when given
+/// ([`maximize_coarse_first`]).
 pub(crate) fn maximize_shapes(
     specs: &[ParamSpec],
     shapes: &[&[usize]],
     together: bool,
+    also_refined: &[usize],
     held: &[f64],
     f: &mut dyn FnMut(&[f64]) -> f64,
     mut coarse: Option<Objective<'_>>,
@@ -179,9 +181,33 @@ pub(crate) fn maximize_shapes(
     if shapes.len() == 1 || !together {
         return best;
     }
-    let (x, v) = refine(specs, &best.0, simplex_evals(specs.len()), f);
+    let mut refined: Vec<usize> = shapes
+        .iter()
+        .flat_map(|shape| shape.iter())
+        .chain(also_refined)
+        .copied()
+        .filter(|&i| i < specs.len())
+        .collect();
+    refined.sort_unstable();
+    refined.dedup();
+    let refined_specs: Vec<ParamSpec> = refined.iter().map(|&i| specs[i]).collect();
+    let start: Vec<f64> = refined.iter().map(|&i| best.0[i]).collect();
+    let from = best.0.clone();
+    let full = |y: &[f64]| {
+        let mut x = from.clone();
+        for (&i, &v) in refined.iter().zip(y) {
+            x[i] = v;
+        }
+        x
+    };
+    let (y, v) = refine(
+        &refined_specs,
+        &start,
+        simplex_evals(refined.len()),
+        &mut |y: &[f64]| f(&full(y)),
+    );
     if v > best.1 {
-        (x, v)
+        (full(&y), v)
     } else {
         best
     }
@@ -475,12 +501,38 @@ mod tests {
                 - ((x[2] - m[2]) / 1e-3).powi(2)
         };
         let held = [0.0, 10.0, 0.0];
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], true, &held, &mut f, None);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1], &[2, 1]], true, &[], &held, &mut f, None);
         assert!((x[0] - m[0]).abs() < 2e-4, "{x:?}");
         assert!((x[1] / m[1] - 1.0).abs() < 0.02, "{x:?}");
         assert!((x[2] - m[2]).abs() < 2e-4, "{x:?}");
-        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], true, &held, &mut f, None);
+        let (x, _) = maximize_shapes(&specs, &[&[0, 1]], true, &[], &held, &mut f, None);
         assert_eq!(x[2], 0.0, "{x:?}");
+    }
+
+    /// A parameter of no shape (a warm-up's stretch) stays held at its value unless the joint
+    /// refinement is told to free it too; freed, it is found from there.
+    #[test]
+    fn a_parameter_of_no_shape_is_freed_only_in_the_refinement_it_is_given_to() {
+        let specs = [
+            spec(-0.05, 0.05, false),
+            spec(1.0, 1000.0, true),
+            spec(-0.1, 0.1, false),
+            spec(0.35, 2.83, true),
+        ];
+        let m = [0.0, 12.8, 0.031, 1.6];
+        let mut f = |x: &[f64]| {
+            -((x[0] - m[0]) / 1e-3).powi(2)
+                - ((x[1].ln() - m[1].ln()) / 0.05).powi(2)
+                - ((x[2] - m[2]) / 1e-3).powi(2)
+                - ((x[3].ln() - m[3].ln()) / 0.05).powi(2)
+        };
+        let held = [0.0, 10.0, 0.0, 1.0];
+        let shapes: &[&[usize]] = &[&[0, 1], &[2, 1]];
+        let (x, _) = maximize_shapes(&specs, shapes, true, &[], &held, &mut f, None);
+        assert_eq!(x[3], 1.0, "{x:?}");
+        let (x, _) = maximize_shapes(&specs, shapes, true, &[3], &held, &mut f, None);
+        assert!((x[3] / m[3] - 1.0).abs() < 0.02, "{x:?}");
+        assert!((x[2] - m[2]).abs() < 2e-4, "{x:?}");
     }
 
     #[test]

@@ -206,6 +206,18 @@ impl Effect {
         self.entry().shapes()
     }
 
+    /// The parameters its shapes' joint refinement frees besides theirs: against a recorded
+    /// path those of [`Entry::refined_against_recorded_path`], along an estimated one
+    /// (`estimated`) none.
+    #[must_use]
+    pub fn refined_besides_shapes(self, estimated: bool) -> &'static [usize] {
+        if estimated {
+            &[]
+        } else {
+            self.entry().refined_against_recorded_path()
+        }
+    }
+
     /// The parameters that set its form, not its size ([`Entry::form_params`]).
     #[must_use]
     pub fn form_params(self) -> &'static [usize] {
@@ -321,5 +333,26 @@ mod tests {
         }
         assert!(Effect::DriveWheelBase.shows_in(Sensor::Drive));
         assert!(!Effect::OdometerWheelSlip.shows_in(Sensor::Drive));
+    }
+
+    /// A warm-up's stretch is refined against a recorded path only, is a free parameter (with
+    /// a standard error) where the refinement moved it off one mass, and its sentence says the
+    /// shape departs from the catalogue's; a sonar timed at the centroid says so too.
+    #[test]
+    fn a_form_refined_off_the_catalogues_is_free_and_said() {
+        let warmup = Effect::LidarWarmupDrift;
+        assert_eq!(warmup.refined_besides_shapes(false), &[3]);
+        assert!(warmup.refined_besides_shapes(true).is_empty());
+        let one_mass = [0.005, 10.0, 0.0, 1.0];
+        let stretched = [0.005, 10.0, 0.0, 1.6];
+        assert_eq!(warmup.free(&one_mass), vec![0, 1, 2]);
+        assert_eq!(warmup.free(&stretched), vec![0, 1, 2, 3]);
+        assert!(!warmup.explanation(&one_mass, 0.0).contains("differs"));
+        let said = warmup.explanation(&stretched, 0.0);
+        assert!(said.contains("^1.60") && said.contains("differs"), "{said}");
+        let sonar = Effect::SonarBeamWidth;
+        assert!(!sonar.explanation(&[12.0, 0.0], 0.0).contains("centroid"));
+        let said = sonar.explanation(&[12.0, 1.0], 0.0);
+        assert!(said.contains("100 % at their centroid"), "{said}");
     }
 }

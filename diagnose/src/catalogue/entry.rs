@@ -159,6 +159,13 @@ pub trait Entry: Sync {
         &[]
     }
 
+    /// Parameters of no shape that the joint refinement of the best of [`Entry::shapes`]
+    /// frees as well, against a recorded path (`truth.csv`) only: a form that path shows and
+    /// an estimated one takes up. Elsewhere they are held at their [`Entry::absent`] values.
+    fn refined_against_recorded_path(&self) -> &'static [usize] {
+        &[]
+    }
+
     /// The parameters that set its form, not its size (indices into [`Entry::params`]). A
     /// path estimated from the lidar takes up part of an effect's size, not of its form, so
     /// the realignment follows the size alone to its fixed point.
@@ -196,6 +203,12 @@ pub trait Entry: Sync {
                 if !free.contains(&i) {
                     free.push(i);
                 }
+            }
+        }
+        // A parameter refined on its own against a recorded path, where the refinement moved it.
+        for &i in self.refined_against_recorded_path() {
+            if params.get(i) != absent.get(i) && !free.contains(&i) {
+                free.push(i);
             }
         }
         free.sort_unstable();

@@ -353,6 +353,11 @@ mod tests {
         let sonar = Effect::SonarBeamWidth;
         assert!(!sonar.explanation(&[12.0, 0.0], 0.0).contains("centroid"));
         let said = sonar.explanation(&[12.0, 1.0], 0.0);
-        assert!(said.contains("100 % at their centroid"), "{said}");
+        assert!(
+            said.contains("echoes at their centroid") && said.contains("differs"),
+            "{said}"
+        );
+        let said = sonar.explanation(&[12.0, 0.5], 0.0);
+        assert!(said.contains("50 % at their centroid"), "{said}");
     }
 }

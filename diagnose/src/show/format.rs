@@ -62,3 +62,58 @@ pub(super) fn heldout_unit(f: &crate::explain::CandidateFit) -> &'static str {
         RmseOver::Readings | RmseOver::ReadingsGivenPast => "readings",
     }
 }
+
+/// Why a fitted parameter `i` of `f` has a standard error of exactly 0: held at its absence
+/// by the fit, or a form the fit moved off its absence where the likelihood's curvature gives
+/// no error (a form at its range's end, a centroid share of 1), whose error is then given for
+/// the size alone.
+pub(super) fn without_error(f: &crate::explain::CandidateFit, i: usize) -> &'static str {
+    let absent = f.effect.absent(0.0);
+    let moved = f.params.get(i) != absent.get(i);
+    if moved && f.effect.form_params().contains(&i) {
+        "its form, no s.e."
+    } else {
+        "held"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::without_error;
+    use crate::catalogue::{Effect, Sensor};
+    use crate::explain::CandidateFit;
+
+    fn sonar_cone(params: Vec<f64>) -> CandidateFit {
+        CandidateFit {
+            effect: Effect::SonarBeamWidth,
+            sensor: Sensor::Sonar,
+            param_sd: vec![0.01, 0.0],
+            params,
+            train_gain: 150.0,
+            heldout_gain: 130.0,
+            bic_gain: 120.0,
+            rmse_before: 0.5,
+            rmse_after: 0.01,
+            noise_floor: 0.008,
+            heldout_n: 200,
+            rmse_over: crate::RmseOver::ReadingsGivenPast,
+            heldout_ll_per_reading: 4.0,
+            size_m: 1.0,
+            size_noise_m: 0.002,
+            floor_multiple: 4.0,
+            scaled_rmse: (1.2, 1.0),
+            seen_until_s: 60.0,
+        }
+    }
+
+    /// A centroid share fitted at 1 (no curvature past its range's end) is a form found, not a
+    /// parameter held; one left at the nearest echo is held.
+    #[test]
+    fn a_form_moved_off_its_absence_is_not_called_held() {
+        assert_eq!(
+            without_error(&sonar_cone(vec![17.3, 1.0]), 1),
+            "its form, no s.e."
+        );
+        assert_eq!(without_error(&sonar_cone(vec![17.3, 0.0]), 1), "held");
+    }
+}

@@ -2,7 +2,9 @@
 
 use std::fmt::Write as _;
 
-use super::format::{escape, fit_metric, fit_value, fmt_sig, heldout_unit, mm, rmse_of};
+use super::format::{
+    escape, fit_metric, fit_value, fmt_sig, heldout_unit, mm, rmse_of, without_error,
+};
 use crate::locate::Evidence;
 use crate::outcome::{Diagnosis, Verdict};
 
@@ -136,7 +138,7 @@ fn fix(s: &mut String, d: &Diagnosis) {
                 spec.name,
                 fmt_sig(f.params[i]),
                 if f.param_sd[i] == 0.0 {
-                    "held".to_string()
+                    without_error(f, i).to_string()
                 } else {
                     fmt_sig(f.param_sd[i])
                 },

@@ -2,7 +2,9 @@
 
 use std::fmt::Write as _;
 
-use super::format::{fit_metric, fit_size, fit_value, fmt_sig, heldout_unit, mm, rmse_of};
+use super::format::{
+    fit_metric, fit_size, fit_value, fmt_sig, heldout_unit, mm, rmse_of, without_error,
+};
 use crate::outcome::Diagnosis;
 
 /// The diagnosis for people: a few lines.
@@ -20,12 +22,12 @@ pub fn summary(d: &Diagnosis) -> String {
             .enumerate()
             .map(|(i, spec)| {
                 let sd = f.param_sd[i];
-                // A standard error of exactly 0: a parameter the fit held at its absence.
+                // A standard error of exactly 0: held, or a form without one.
                 if sd == 0.0 {
                     return format!("{} = {} {}", spec.name, fmt_sig(f.params[i]), spec.unit)
                         .trim_end()
                         .to_string()
-                        + " (held)";
+                        + &format!(" ({})", without_error(f, i));
                 }
                 let sd = if sd.is_finite() {
                     format!(" ± {}", fmt_sig(sd))

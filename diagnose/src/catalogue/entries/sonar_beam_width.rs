@@ -71,7 +71,13 @@ impl Entry for SonarBeamWidth {
         let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
         let share = params.get(1).copied().unwrap_or(0.0);
         // A tenth of the grid's ½ step from the onset: the catalogue's nearest echo.
-        let echo = if share.is_finite() && share >= 0.05 {
+        let echo = if share.is_finite() && share >= 0.995 {
+            format!(
+                "times its echoes at their centroid across the beam's main lobe, in a cone of \
+                 ±{:.1}°: the shape differs from the catalogue's nearest echo",
+                p(0)
+            )
+        } else if share.is_finite() && share >= 0.05 {
             format!(
                 "times its echoes {:.0} % at their centroid across the beam's main lobe and the \
                  rest at the nearest, in a cone of ±{:.1}°: the shape differs from the \

@@ -9,7 +9,7 @@ use crate::{
 };
 use hilsim_lidar_emulator::effects::{real_mount, LidarEffects};
 use hilsim_lidar_emulator::prediction::{
-    BeamNodes, LidarPredictor, OdometerPredictor, SonarPredictor,
+    BeamNodes, ExpectedLidar, LidarPredictor, OdometerPredictor, SonarPredictor,
 };
 use hilsim_recording::{CommandSample, TruthSample};
 use hilsim_sim::scenario::{self, Effects, LidarTiming};
@@ -31,6 +31,13 @@ fn max_half_width_rad() -> f64 {
 /// A lidar reading's place: the robot's pose (x, y, yaw), the beam's angle and the unit's
 /// mount on the robot (x, y, yaw), bit for bit.
 type BeamKey = [u64; 7];
+
+/// The fingerprint of a call's readings' keys ([`CallBeams`]): a fixed hash, as the
+/// fingerprint only narrows the search and the keys themselves are compared.
+fn fingerprint(keys: &[BeamKey]) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::fast::FixedState::with_seed(0).hash_one(keys)
+}
 /// Where and when a hypothesis casts the beams: the unit's mount (x, y, yaw), the lidar's
 /// delay and the revolution's duration of a motion skew (NaN: none), bit for bit.
 type Geometry = [u64; 5];
@@ -61,6 +68,48 @@ pub struct SimPhysics {
     /// every evaluation, which would fill the caches with beams never asked about again; the
     /// fits of the other effects on top of one found ask about it again and again.
     geometries: Mutex<HashMap<Geometry, u32>>,
+    /// The beams of whole calls, in their readings' order: a fit evaluates the same readings
+    /// along the same path at every step, and looking each beam up in [`SimPhysics::beams`]
+    /// (a cache miss for its bucket and its key) was a sixth of a diagnosis with truth.
+    calls: Mutex<Vec<Arc<CallBeams>>>,
+}
+
+/// The beams of one call's readings, in order, with the readings' keys they were found for.
+struct CallBeams {
+    /// A hash of `keys`, to pass over the calls of other readings at a glance.
+    fingerprint: u64,
+    keys: Vec<BeamKey>,
+    beams: Vec<Arc<BeamNodes>>,
+}
+
+/// Readings the calls kept hold at most together (~70 bytes each): the training and grid
+/// readings of the fits in flight, a few times over.
+const CALLS_CAPACITY: usize = 200_000;
+
+impl SimPhysics {
+    /// The beams kept for a call whose readings have `keys`.
+    fn call_beams(&self, fingerprint: u64, keys: &[BeamKey]) -> Option<Arc<CallBeams>> {
+        let calls = self.calls.lock().ok()?;
+        calls
+            .iter()
+            .find(|c| c.fingerprint == fingerprint && c.keys == keys)
+            .cloned()
+    }
+
+    /// Keeps a call's beams, the oldest calls making room.
+    fn keep_call(&self, call: CallBeams) {
+        if call.keys.len() > CALLS_CAPACITY {
+            return;
+        }
+        let Ok(mut calls) = self.calls.lock() else {
+            return;
+        };
+        let mut held: usize = calls.iter().map(|c| c.keys.len()).sum();
+        while held + call.keys.len() > CALLS_CAPACITY && !calls.is_empty() {
+            held -= calls.remove(0).keys.len();
+        }
+        calls.push(Arc::new(call));
+    }
 }
 
 /// `p` with its heading wrapped as the simulator keeps every pose.
@@ -147,6 +196,7 @@ impl SimPhysics {
             beams: RwLock::default(),
             clear: RwLock::default(),
             geometries: Mutex::default(),
+            calls: Mutex::default(),
         })
     }
 
@@ -335,15 +385,69 @@ impl Physics for SimPhysics {
             .len()
             .div_ceil(rayon::current_num_threads())
             .clamp(MIN_CHUNK, CHUNK);
+        let prediction = |e: ExpectedLidar| LidarPrediction {
+            components: e.components,
+            true_range_m: e.true_range_m,
+            incidence_deg: e.cos_incidence.clamp(0.0, 1.0).acos().to_degrees(),
+            object: e.obstacle.map(|o| self.object_id(o)),
+            reflectivity: e.reflectivity,
+            near_edge: e.near_edge,
+            world_reach_m: e.world_reach_m,
+        };
+        let place = |q: &LidarQuery| {
+            let p = trajectory.pose_at(instant(q));
+            let key =
+                [p.x, p.y, p.yaw, q.angle_deg, mount[0], mount[1], mount[2]].map(f64::to_bits);
+            (pose(p), key)
+        };
+        // Without a footprint of its own, a kept call's beams are read in order.
+        if cacheable && keep && !mixed {
+            let places: Vec<(Pose, BeamKey)> = queries
+                .par_chunks(chunk)
+                .flat_map_iter(|chunk| chunk.iter().map(place))
+                .collect();
+            let keys: Vec<BeamKey> = places.iter().map(|&(_, key)| key).collect();
+            let print = fingerprint(&keys);
+            let call = match self.call_beams(print, &keys) {
+                Some(call) => call,
+                None => {
+                    let beams: Vec<Arc<BeamNodes>> = queries
+                        .par_chunks(chunk)
+                        .zip(places.par_chunks(chunk))
+                        .flat_map_iter(|(chunk, places)| {
+                            chunk.iter().zip(places).map(|(q, (robot, key))| {
+                                self.cached_beam(&geometry, *key, true, robot, q.angle_deg)
+                            })
+                        })
+                        .collect();
+                    let call = CallBeams {
+                        fingerprint: print,
+                        keys,
+                        beams,
+                    };
+                    let beams = call.beams.clone();
+                    self.keep_call(call);
+                    return queries
+                        .par_iter()
+                        .zip(beams.par_iter())
+                        .with_min_len(MIN_CHUNK)
+                        .map(|(q, beam)| prediction(predictor.predict_nodes(beam, q.t_s)))
+                        .collect();
+                }
+            };
+            return queries
+                .par_iter()
+                .zip(call.beams.par_iter())
+                .with_min_len(MIN_CHUNK)
+                .map(|(q, beam)| prediction(predictor.predict_nodes(beam, q.t_s)))
+                .collect();
+        }
         queries
             .par_chunks(chunk)
             .flat_map_iter(|chunk| {
                 chunk.iter().map(|q| {
-                    let p = trajectory.pose_at(instant(q));
-                    let robot = pose(p);
+                    let (robot, key) = place(q);
                     let e = if cacheable {
-                        let key = [p.x, p.y, p.yaw, q.angle_deg, mount[0], mount[1], mount[2]]
-                            .map(f64::to_bits);
                         if mixed && !self.cached_clear(&geometry, key, keep, &robot, q.angle_deg) {
                             predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
                         } else {
@@ -353,15 +457,7 @@ impl Physics for SimPhysics {
                     } else {
                         predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
                     };
-                    LidarPrediction {
-                        components: e.components,
-                        true_range_m: e.true_range_m,
-                        incidence_deg: e.cos_incidence.clamp(0.0, 1.0).acos().to_degrees(),
-                        object: e.obstacle.map(|o| self.object_id(o)),
-                        reflectivity: e.reflectivity,
-                        near_edge: e.near_edge,
-                        world_reach_m: e.world_reach_m,
-                    }
+                    prediction(e)
                 })
             })
             .collect()

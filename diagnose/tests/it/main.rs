@@ -7,3 +7,4 @@ mod estimated_path;
 mod mismatch;
 mod on_log;
 mod range_shape;
+mod sim_physics;

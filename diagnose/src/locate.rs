@@ -238,6 +238,11 @@ fn place(c: Covariate, lim: (f64, f64), names: &dyn Fn(u32) -> String) -> String
                 "beams away from edges".to_string()
             }
         }
+        // Echoes no nearer off the axis than on it, to the report's centimetre: "nearer by
+        // 0 m" would read as a measurement.
+        Covariate::OffAxisNearer if lim.1 < 0.005 => {
+            "no echo nearer off the axis than on it".to_string()
+        }
         _ if fmt_value(lim.0) == fmt_value(lim.1) => {
             format!("{} {} {}", c.name(), fmt_value(lim.0), c.unit())
                 .trim_end()
@@ -673,6 +678,22 @@ pub fn threshold(alpha: f64, tests: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::residuals::Queries;
+
+    /// A bin of echoes no nearer off the sonar's axis than on it says so; one of echoes
+    /// nearer gives how much.
+    #[test]
+    fn a_bin_of_no_nearer_echo_is_not_said_to_be_nearer_by_nothing() {
+        let names = |_: u32| String::new();
+        assert_eq!(
+            place(Covariate::OffAxisNearer, (0.0, 0.0), &names),
+            "no echo nearer off the axis than on it"
+        );
+        assert_eq!(
+            place(Covariate::OffAxisNearer, (0.0, 0.35), &names),
+            "off-axis echo nearer by 0–0.35 m"
+        );
+        assert_eq!(place(Covariate::Range, (0.0, 0.0), &names), "range 0 m");
+    }
 
     /// Lidar readings from 0.5 to 5 m whose residuals are the declared noise's, but for one in
     /// eight beyond 4.4 m read 2 m short of the prediction (a ray a built map let through a

@@ -134,9 +134,8 @@ impl Sonar {
     /// echo's spreading `1/d²`. `None`: no echo within range.
     #[must_use]
     pub fn echo_m(&self, world: &World, robot: &hilsim_sim::Pose) -> Option<f64> {
-        let nearest = self.nearest_echo(world, robot);
         let Some(lobe) = &self.lobe else {
-            return nearest;
+            return self.nearest_echo(world, robot);
         };
         let sensor = self.mount.in_world(robot);
         let (mut sum, mut weight) = (0.0, 0.0);
@@ -151,10 +150,15 @@ impl Sonar {
             }
         }
         if weight <= 0.0 {
-            return nearest;
+            return self.nearest_echo(world, robot);
         }
         let centroid = sum / weight;
+        // Timed wholly at the centroid, the nearest echo is not cast.
+        if lobe.share >= 1.0 {
+            return Some(centroid);
+        }
         // An echo off the cone but in the lobe still times a reading, as its centre does.
+        let nearest = self.nearest_echo(world, robot);
         Some(nearest.map_or(centroid, |n| (1.0 - lobe.share) * n + lobe.share * centroid))
     }
 

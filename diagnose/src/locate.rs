@@ -243,6 +243,15 @@ fn place(c: Covariate, lim: (f64, f64), names: &dyn Fn(u32) -> String) -> String
         Covariate::OffAxisNearer if lim.1 < 0.005 => {
             "no echo nearer off the axis than on it".to_string()
         }
+        // Its name is a noun for the bins and plots; a bin reads as a phrase.
+        Covariate::OffAxisNearer if fmt_value(lim.0) == fmt_value(lim.1) => {
+            format!("off-axis echo nearer by {} m", fmt_value(lim.1))
+        }
+        Covariate::OffAxisNearer => format!(
+            "off-axis echo nearer by {}–{} m",
+            fmt_value(lim.0),
+            fmt_value(lim.1)
+        ),
         _ if fmt_value(lim.0) == fmt_value(lim.1) => {
             format!("{} {} {}", c.name(), fmt_value(lim.0), c.unit())
                 .trim_end()
@@ -680,7 +689,8 @@ mod tests {
     use crate::residuals::Queries;
 
     /// A bin of echoes no nearer off the sonar's axis than on it says so; one of echoes
-    /// nearer gives how much.
+    /// nearer gives how much, as a phrase (the covariate's name is a noun, for the χ²'s bins
+    /// and the plots).
     #[test]
     fn a_bin_of_no_nearer_echo_is_not_said_to_be_nearer_by_nothing() {
         let names = |_: u32| String::new();
@@ -691,6 +701,10 @@ mod tests {
         assert_eq!(
             place(Covariate::OffAxisNearer, (0.0, 0.35), &names),
             "off-axis echo nearer by 0–0.35 m"
+        );
+        assert_eq!(
+            place(Covariate::OffAxisNearer, (0.35, 0.35), &names),
+            "off-axis echo nearer by 0.35 m"
         );
         assert_eq!(place(Covariate::Range, (0.0, 0.0), &names), "range 0 m");
     }

@@ -32,12 +32,6 @@ fn max_half_width_rad() -> f64 {
 /// mount on the robot (x, y, yaw), bit for bit.
 type BeamKey = [u64; 7];
 
-/// The fingerprint of a call's readings' keys ([`CallBeams`]): a fixed hash, as the
-/// fingerprint only narrows the search and the keys themselves are compared.
-fn fingerprint(keys: &[BeamKey]) -> u64 {
-    use std::hash::BuildHasher;
-    foldhash::fast::FixedState::with_seed(0).hash_one(keys)
-}
 /// Where and when a hypothesis casts the beams: the unit's mount (x, y, yaw), the lidar's
 /// delay and the revolution's duration of a motion skew (NaN: none), bit for bit.
 type Geometry = [u64; 5];
@@ -82,6 +76,13 @@ struct CallBeams {
     beams: Vec<Arc<BeamNodes>>,
 }
 
+/// The fingerprint of a call's readings' keys ([`CallBeams`]): a fixed hash, as the
+/// fingerprint only narrows the search and the keys themselves are compared.
+fn fingerprint(keys: &[BeamKey]) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::fast::FixedState::with_seed(0).hash_one(keys)
+}
+
 /// Readings the calls kept hold at most together (~70 bytes each): the training and grid
 /// readings of the fits in flight, a few times over.
 const CALLS_CAPACITY: usize = 200_000;
@@ -96,19 +97,21 @@ impl SimPhysics {
             .cloned()
     }
 
-    /// Keeps a call's beams, the oldest calls making room.
-    fn keep_call(&self, call: CallBeams) {
+    /// Keeps a call's beams (unless they alone exceed [`CALLS_CAPACITY`]), the oldest calls
+    /// making room; returns them.
+    fn keep_call(&self, call: CallBeams) -> Arc<CallBeams> {
+        let call = Arc::new(call);
         if call.keys.len() > CALLS_CAPACITY {
-            return;
+            return call;
         }
-        let Ok(mut calls) = self.calls.lock() else {
-            return;
-        };
-        let mut held: usize = calls.iter().map(|c| c.keys.len()).sum();
-        while held + call.keys.len() > CALLS_CAPACITY && !calls.is_empty() {
-            held -= calls.remove(0).keys.len();
+        if let Ok(mut calls) = self.calls.lock() {
+            let mut held: usize = calls.iter().map(|c| c.keys.len()).sum();
+            while held + call.keys.len() > CALLS_CAPACITY && !calls.is_empty() {
+                held -= calls.remove(0).keys.len();
+            }
+            calls.push(call.clone());
         }
-        calls.push(Arc::new(call));
+        call
     }
 }
 
@@ -420,19 +423,11 @@ impl Physics for SimPhysics {
                             })
                         })
                         .collect();
-                    let call = CallBeams {
+                    self.keep_call(CallBeams {
                         fingerprint: print,
                         keys,
                         beams,
-                    };
-                    let beams = call.beams.clone();
-                    self.keep_call(call);
-                    return queries
-                        .par_iter()
-                        .zip(beams.par_iter())
-                        .with_min_len(MIN_CHUNK)
-                        .map(|(q, beam)| prediction(predictor.predict_nodes(beam, q.t_s)))
-                        .collect();
+                    })
                 }
             };
             return queries

@@ -61,7 +61,7 @@ impl Covariate {
             Covariate::Accel => "acceleration",
             Covariate::TurnRate => "turn rate",
             Covariate::WheelSpeed => "wheel speed",
-            Covariate::OffAxisNearer => "off-axis echo nearer by",
+            Covariate::OffAxisNearer => "nearness of an off-axis echo",
             Covariate::SinceCommand => "time since a command change",
         }
     }

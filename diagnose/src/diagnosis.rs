@@ -21,6 +21,7 @@ use crate::plot;
 use crate::residuals::{self, Context, Covariate, SensorData};
 use crate::select::{self, hypothesis_of, Selection};
 use crate::stamps;
+use crate::wheels_against_scans;
 use hilsim_report::svg::fmt_sig;
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
@@ -180,6 +181,52 @@ pub fn diagnose_with_progress(
         .map(|(_, a)| a)
         .or(realigned.as_ref())
         .unwrap_or(&aligned);
+    // Against the scans' own path, the encoders are judged span by span
+    // (`wheels_against_scans.rs`): a lidar stamped late against them turns late, wheels
+    // farther apart than declared count more travel apart for a turn, and wheels of another
+    // size another travel.
+    let FromSpans {
+        delay: lagged,
+        wheels,
+    } = from_spans(final_ctx, path_so_far, &mut candidates, options);
+    let lag_ctx = lagged.as_ref().map(|(_, a)| along(&ctx, a));
+    let final_ctx = lag_ctx.as_ref().unwrap_or(final_ctx);
+    let mut named = match &lag_ctx {
+        Some(along) => {
+            let (named, again) =
+                rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
+            nominal = again;
+            named
+        }
+        None => named,
+    };
+    // Along the scans' own path the encoders' effects are their spans': judged reading by
+    // reading along a path that skids in its turns, the encoders do not tell their base or
+    // size (each reading's skid is taken for a shared error of the path), and a lead of theirs
+    // on the speed's changes (a delay, a slip) is the lidar's delay seen from their side.
+    if !wheels.is_empty() {
+        // The encoders' effects fitted to their readings (not a mount read from the path).
+        let from_readings = |c: &CandidateFit| {
+            c.sensor == Sensor::Odometer
+                && matches!(
+                    c.rmse_over,
+                    RmseOver::Readings | RmseOver::ReadingsGivenPast
+                )
+        };
+        named.retain(|c| !from_readings(c));
+        candidates.retain(|c| !from_readings(c));
+        for (fit, earns) in wheels {
+            candidates.retain(|c| c.effect != fit.effect);
+            if earns {
+                named.push(fit.clone());
+            }
+            candidates.push(fit);
+        }
+        candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    }
+    named.extend(lagged.as_ref().map(|(fit, _)| fit.clone()));
+    named.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    let path_so_far = lagged.as_ref().map_or(path_so_far, |(_, a)| a);
     // A lidar mount offset or delay the estimated path took up, seen by the sonar and the
     // encoders: whichever gains more where both are found (a mount of a decimetre and degrees
     // mimics a delay of a fifth of a second on a drive that turns as it speeds up).
@@ -468,9 +515,17 @@ fn explaining_their_sensor(
                     && after.size_m > select::MAX_MAIN_SIZE_LEFT * main.size_m
             })
     };
+    // An effect read from the path's own motion (a mount's crab, the encoders' spans) explains
+    // that motion, not its sensor's readings: its held-out gain there is its evidence.
+    let read_from_path =
+        |c: &CandidateFit| matches!(c.rmse_over, RmseOver::PathSteps | RmseOver::PathSpans);
     named
         .into_iter()
-        .filter(|c| !c.effect.moves_readings() || !unexplained_sensor(c.effect.sensor()))
+        .filter(|c| {
+            !c.effect.moves_readings()
+                || read_from_path(c)
+                || !unexplained_sensor(c.effect.sensor())
+        })
         .filter(|c| {
             !select::leaves_range_structure(c, &nominal.evidence, left, threshold, &options.floors)
         })
@@ -981,7 +1036,11 @@ fn through_path(
         .iter()
         .filter(|d| looking_from_robot(d.sensor))
         .collect();
+    // Against the scans' own path the lidar's delay is read from its turns (`from_turns`) and
+    // its mount's yaw from the path's sideways motion (`crab_mount`); the encoders' travel
+    // along a path that skids in its turns does not tell a mount's position.
     if !ctx.estimated
+        || aligned.reckoned == Some(DeadReckoning::Scans)
         || !seen_through_path
         || !options.effects.contains(&effect)
         || others.is_empty()
@@ -1068,6 +1127,115 @@ const CRAB_SIZE_RANGE_M: f64 = 2.0;
 /// How many standard errors from the declared mount a yaw read from the path's sideways motion
 /// must lie: 3, as the halves of a log are compared.
 const CRAB_MIN_SD: f64 = 3.0;
+
+/// What the spans of the scans' own path name: the lidar's delay against the encoders, with
+/// the path put back by it, and the wheels' base and sizes (each fit, and whether it is named).
+struct FromSpans {
+    delay: Option<(CandidateFit, Aligned)>,
+    wheels: Vec<(CandidateFit, bool)>,
+}
+
+/// The lidar's delay against the encoders, the wheels' effective base and their sizes, against
+/// a path that is the lidar's own matches ([`DeadReckoning::Scans`]: a log with encoders and no
+/// commands), read from its spans ([`wheels_against_scans`]). Each is a candidate, and named
+/// when it gains on the held-out spans by [`Options::min_gain`], lies three standard errors
+/// from its absence (`Reading::departs`) and beyond its entry's least departure, and stops
+/// inside its search. The delay comes with the path put back by it (the matched pose at stamp t is the
+/// robot's at t − delay).
+fn from_spans(
+    ctx: &Context<'_>,
+    aligned: &Aligned,
+    candidates: &mut Vec<CandidateFit>,
+    options: &Options,
+) -> FromSpans {
+    let none = FromSpans {
+        delay: None,
+        wheels: Vec::new(),
+    };
+    let delay = Effect::SensorLatency(Sensor::Lidar);
+    let (Some(odometry), Some(&delays)) =
+        (ctx.recording.odometry.as_deref(), delay.params().first())
+    else {
+        return none;
+    };
+    if aligned.reckoned != Some(DeadReckoning::Scans) {
+        return none;
+    }
+    let Some(spans) = wheels_against_scans::fit(
+        &aligned.trajectory,
+        ctx.physics.declared().wheel_base_m,
+        odometry,
+        (delays.lo, delays.hi),
+    ) else {
+        return none;
+    };
+    let mut judged = |effect: Effect, reading: &wheels_against_scans::Reading| {
+        // Sized as what it puts right on the held-out spans.
+        let size_m = (reading.rmse_before_m - reading.rmse_after_m).max(0.0);
+        let floor_m = options.floors.odometer_m;
+        let fit = CandidateFit {
+            effect,
+            sensor: Sensor::Odometer,
+            params: reading.value.clone(),
+            param_sd: reading.sd.clone(),
+            train_gain: reading.train_gain,
+            heldout_gain: reading.heldout_gain,
+            bic_gain: 2.0 * reading.train_gain
+                - reading.value.len() as f64 * (spans.train_n as f64).ln(),
+            rmse_before: reading.rmse_before_m,
+            rmse_after: reading.rmse_after_m,
+            noise_floor: reading.noise_m,
+            heldout_n: spans.heldout_n,
+            rmse_over: RmseOver::PathSpans,
+            heldout_ll_per_reading: reading.heldout_gain / spans.heldout_n.max(1) as f64,
+            size_m,
+            size_noise_m: floor_m,
+            floor_multiple: size_m / floor_m.max(f64::MIN_POSITIVE),
+            scaled_rmse: (
+                reading.rmse_before_m / reading.noise_m.max(f64::MIN_POSITIVE),
+                reading.rmse_after_m / reading.noise_m.max(f64::MIN_POSITIVE),
+            ),
+            seen_until_s: aligned.end_s,
+        };
+        match candidates.iter_mut().find(|x| x.effect == effect) {
+            Some(x) => *x = fit.clone(),
+            None => candidates.push(fit.clone()),
+        }
+        let absent = effect.absent(0.0);
+        // Every parameter within its search, one beyond its least departure, and the reading
+        // beyond its errors.
+        let inside = effect
+            .params()
+            .iter()
+            .zip(&reading.value)
+            .all(|(spec, &v)| !SearchLimits::at_limit(spec, v));
+        let beyond_least = effect
+            .entry()
+            .least_departures()
+            .iter()
+            .any(|&(i, least)| (reading.value[i] - absent[i]).abs() > least);
+        let earns = reading.heldout_gain > options.min_gain
+            && fit.bic_gain > 0.0
+            && inside
+            && beyond_least
+            && reading.departs;
+        (fit, earns)
+    };
+    let (delay_fit, late) = judged(delay, &spans.delay_s);
+    let delay = late.then(|| {
+        let again = Aligned {
+            trajectory: aligned.trajectory.delayed(delay_fit.params[0]),
+            ..aligned.clone()
+        };
+        (delay_fit, again)
+    });
+    let wheels = vec![
+        judged(Effect::DriveWheelBase, &spans.base_scale),
+        judged(Effect::OdometerWheelRadius, &spans.radius_scales),
+    ];
+    candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
+    FromSpans { delay, wheels }
+}
 
 /// The yaw of a lidar turned on its mount, against a path that is the lidar's own matches
 /// ([`DeadReckoning::Scans`]: a log with encoders and no commands), read from the path moving

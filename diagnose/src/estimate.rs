@@ -318,15 +318,22 @@ fn matched(
     let mut variances = Vec::new();
     let mut correction = [0.0; 3];
     let (mut near, mut used) = (0_usize, 0_usize);
+    // The stamps each knot's readings span: its geometry is theirs throughout (a lidar that
+    // takes it at one instant, that instant).
+    let mut extents = Vec::with_capacity(revs.len());
     for rows in &revs {
         if let Some((knot, variance, fit)) = matcher.revolution(rows, &mut correction) {
+            extents.push(match (matcher.snapshot, rows.first(), rows.last()) {
+                (false, Some(a), Some(b)) => (a.t_s, b.t_s),
+                _ => (knot.0, knot.0),
+            });
             knots.push(knot);
             variances.push(variance);
             near += fit.near;
             used += fit.used;
         }
     }
-    let scans = scans_only(base, &knots, &variances);
+    let scans = scans_only(base, &knots, &extents, &variances);
     let (knots, variances) = smooth_corrections(base, &knots, &variances);
     if knots.is_empty() {
         return Err(MismatchError::Refused(
@@ -344,22 +351,52 @@ fn matched(
     })
 }
 
-/// The path of the revolutions' own matches: `base` at each knot with the knot's correction,
-/// straight between knots, and its uncertainty from the matches' own variances.
+/// Poses of `base` averaged over a revolution's readings: this many, evenly through its stamps.
+const REVOLUTION_SAMPLES: usize = 9;
+
+/// The path of the revolutions' own matches: at each knot, `base` averaged over the stamps its
+/// readings span (`extents`) with the knot's correction, straight between knots, and its
+/// uncertainty from the matches' own variances. The correction is the one that fits the whole
+/// revolution, so it is added to the revolution's mean pose of `base`, not to `base` at its
+/// middle: where `base` (the encoders) changes its turn within a revolution, its pose at the
+/// middle departs from that mean at the encoders' own time, which a lidar stamped later than
+/// the encoders would not share.
 fn scans_only(
     base: &Trajectory,
     knots: &[Knot],
+    extents: &[(f64, f64)],
     variances: &[[f64; 3]],
 ) -> Option<(Trajectory, Uncertainty)> {
+    let mean_pose = |(from, to): (f64, f64), t: f64| {
+        let middle = base.pose_at(t);
+        let n = REVOLUTION_SAMPLES as f64;
+        let (mut x, mut y, mut turn) = (0.0, 0.0, 0.0);
+        for i in 0..REVOLUTION_SAMPLES {
+            let p = base.pose_at(from + (to - from) * i as f64 / (n - 1.0));
+            x += p.x / n;
+            y += p.y / n;
+            turn += wrap(p.yaw - middle.yaw) / n;
+        }
+        (x, y, middle.yaw + turn)
+    };
+    // A knot no later than the one before (a revolution's readings stamped out of order) is
+    // left out rather than the whole path.
+    let mut last = f64::NEG_INFINITY;
     let samples: Vec<TruthSample> = knots
         .iter()
-        .map(|&(t, c)| {
-            let p = base.pose_at(t);
+        .zip(extents)
+        .filter(|(&(t, _), _)| {
+            let later = t > last;
+            last = last.max(t);
+            later
+        })
+        .map(|(&(t, c), &extent)| {
+            let (x, y, yaw) = mean_pose(extent, t);
             TruthSample {
                 t_s: t,
-                x_m: p.x + c[0],
-                y_m: p.y + c[1],
-                yaw_rad: wrap(p.yaw + c[2]),
+                x_m: x + c[0],
+                y_m: y + c[1],
+                yaw_rad: wrap(yaw + c[2]),
             }
         })
         .collect();
@@ -390,6 +427,10 @@ fn revolutions(lidar: &[LidarSample]) -> Vec<Vec<&LidarSample>> {
     }
     revs.into_iter().map(|(_, rows)| rows).collect()
 }
+
+/// A revolution whose readings sweep this far, degrees, is a full circle (the last reading of
+/// a 360-reading revolution is 359° after its first).
+const FULL_CIRCLE_DEG: f64 = 358.0;
 
 /// Matches revolutions' readings to the world along the dead reckoning.
 struct Matcher<'a> {
@@ -485,11 +526,17 @@ impl Matcher<'_> {
             }
         }
         // The correction holds where the readings' geometry was taken: at the revolution's
-        // start for a lidar that takes it at one instant, else around its middle.
+        // start for a lidar that takes it at one instant, else halfway through it: half a turn
+        // after the start of a full circle, and halfway through the readings of a sweep that
+        // covers less (a 240° sweep, which starts two-thirds of a turn after the angle it
+        // counts from; the part of a revolution a log starts or ends in).
+        let (first_s, last_s) = (rows[0].t_s, rows[rows.len() - 1].t_s);
         let knot = if self.snapshot {
             start
-        } else {
+        } else if last_s - first_s >= FULL_CIRCLE_DEG * self.period {
             start + 0.5 * 360.0 * self.period
+        } else {
+            0.5 * (first_s + last_s)
         };
         let inv = invert3(info)?;
         let last = known.unwrap_or_else(|| self.scan_residuals(&scan, *correction));

@@ -79,6 +79,9 @@ pub enum RmseOver {
     /// The sideways motion of the lidar-matched path's steps, which wheels cannot make (a
     /// lidar's mount yaw read from it: `crab.rs`).
     PathSteps,
+    /// The lidar-matched path's spans against the encoders': their turns as the wheels' travel
+    /// apart, or their travel (`wheels_against_scans.rs`).
+    PathSpans,
 }
 
 /// Readings the size of an effect is measured over: this share of the held-out ones, at

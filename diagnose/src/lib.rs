@@ -44,6 +44,7 @@ mod sparse_truth;
 mod stamps;
 pub mod stats;
 mod trajectory;
+mod wheels_against_scans;
 
 pub use align::Alignment;
 pub use catalogue::{

@@ -30,6 +30,12 @@ pub trait LogWorld: Sync {
     fn takes_parts(&self) -> bool {
         true
     }
+    /// Whether the world is built from each recording's own scans. Without truth the path is
+    /// then matched from those scans too, and a lidar turned on its mount turns the world and
+    /// the path with it: nothing in the log shows the turn.
+    fn built_from_scans(&self) -> bool {
+        false
+    }
     /// `scenario` with its map built again from `recording`'s scans turned by the mount yaw
     /// they agree on best, when that departs from the declared one, and that yaw (degrees
     /// from the declared mount); `None` when the world does not move with the lidar's mount.
@@ -104,6 +110,9 @@ impl LogWorld for BuiltWorld {
     }
     fn describe(&self) -> String {
         "the world built from each recording's own scans".to_string()
+    }
+    fn built_from_scans(&self) -> bool {
+        true
     }
     /// A map built from scans placed at a truth's poses through a turned lidar is smeared
     /// (each scan turned about the place it was seen from), and judged against it the turn is

@@ -305,13 +305,26 @@ fn has_encoders(recording: &Recording) -> bool {
     recording.odometry.as_ref().is_some_and(|o| !o.is_empty())
 }
 
+/// Why a lidar turned on its mount is not concealed in a log without truth whose world is built
+/// from its own scans.
+const MOUNT_TURNS_THE_WORLD: &str = "not identifiable from this log: without truth the path is \
+     matched from the scans and the world built from them, and a turned lidar turns both with \
+     it (give a map or a truth to diagnose the mount)";
+
+/// Whether a lidar turned on its mount turns everything `recording` is judged against: no
+/// truth, and a world built from its own scans (`world_from_scans`).
+fn mount_turns_the_world(recording: &Recording, world_from_scans: bool) -> bool {
+    world_from_scans && !has_truth(recording)
+}
+
 /// The mechanisms that can be concealed in `recording` at the draws' `strength`: the lidar's
-/// with a lidar; the wheels' radii and base with encoders judged against a truth or the lidar (a
-/// log without truth is diagnosed along the scans' own matches); their slip and delay only
-/// against a truth, and only when the encoders' stamps scatter by less than the largest lead
-/// drawn ([`not_concealed`]).
+/// with a lidar (its mount's turn not without truth in a world built from its own scans,
+/// `world_from_scans`); the wheels' radii and base with encoders judged against a truth or the
+/// lidar (a log without truth is diagnosed along the scans' own matches); their slip and delay
+/// only against a truth, and only when the encoders' stamps scatter by less than the largest
+/// lead drawn ([`not_concealed`]).
 #[must_use]
-pub fn concealable(recording: &Recording, strength: f64) -> Vec<Effect> {
+pub fn concealable(recording: &Recording, strength: f64, world_from_scans: bool) -> Vec<Effect> {
     let mut effects = Vec::new();
     let has_lidar = recording.lidar.as_ref().is_some_and(|l| !l.is_empty());
     if has_lidar {
@@ -321,6 +334,9 @@ pub fn concealable(recording: &Recording, strength: f64) -> Vec<Effect> {
             Effect::SensorLatency(Sensor::Lidar),
             Effect::LidarDropout,
         ]);
+        if mount_turns_the_world(recording, world_from_scans) {
+            effects.retain(|e| *e != Effect::LidarMountOffset);
+        }
     }
     if has_encoders(recording) && (has_truth(recording) || has_lidar) {
         effects.extend([Effect::OdometerWheelRadius, Effect::DriveWheelBase]);
@@ -366,12 +382,23 @@ fn leads_beyond_stamps(recording: &Recording, effect: Effect, strength: f64) -> 
 }
 
 /// The catalogue's mechanisms not concealed in `recording` at the draws' `strength`, and why:
-/// [`NOT_CONCEALED`], a log's wheels' slip and delay without truth, and those its encoders'
-/// stamps scatter too much to show.
+/// [`NOT_CONCEALED`], a log's wheels' slip and delay without truth, those its encoders' stamps
+/// scatter too much to show, and the mount's turn without truth in a world built from its own
+/// scans (`world_from_scans`).
 #[must_use]
-pub fn not_concealed(recording: &Recording, strength: f64) -> Vec<(String, String)> {
+pub fn not_concealed(
+    recording: &Recording,
+    strength: f64,
+    world_from_scans: bool,
+) -> Vec<(String, String)> {
     let owned = |(e, why): (&str, &str)| (e.to_string(), why.to_string());
     let mut out: Vec<(String, String)> = NOT_CONCEALED.into_iter().map(owned).collect();
+    if mount_turns_the_world(recording, world_from_scans) {
+        out.push(owned((
+            Effect::LidarMountOffset.name(),
+            MOUNT_TURNS_THE_WORLD,
+        )));
+    }
     if has_encoders(recording) && !has_truth(recording) {
         out.extend(NOT_CONCEALED_WITHOUT_TRUTH.into_iter().map(owned));
     } else if has_encoders(recording) {

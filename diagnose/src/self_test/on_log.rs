@@ -214,7 +214,8 @@ pub struct LogSelfTest {
     pub outcomes: Vec<LogOutcome>,
 }
 
-/// The recording's samples stamped within `[from_s, to_s)`.
+/// The recording's samples stamped within `[from_s, to_s)`, its encoders counting from its
+/// first reading there, as a log started there would.
 fn window(recording: &Recording, from_s: f64, to_s: f64) -> Recording {
     let inside = |t: f64| t >= from_s && t < to_s;
     let mut r = recording.clone();
@@ -224,6 +225,12 @@ fn window(recording: &Recording, from_s: f64, to_s: f64) -> Recording {
     }
     for o in r.odometry.iter_mut() {
         o.retain(|s| inside(s.t_s));
+        if let Some(first) = o.first().copied() {
+            for s in o.iter_mut() {
+                s.left_m -= first.left_m;
+                s.right_m -= first.right_m;
+            }
+        }
     }
     for s in r.sonar.iter_mut() {
         s.retain(|s| inside(s.t_s));
@@ -289,9 +296,14 @@ pub fn baseline(
 
 /// Trial `index`'s concealments in `recording`, from (seed, index) alone.
 #[must_use]
-pub fn concealments(recording: &Recording, plan: &LogPlan, index: u64) -> Vec<Concealment> {
+pub fn concealments(
+    recording: &Recording,
+    world: &dyn LogWorld,
+    plan: &LogPlan,
+    index: u64,
+) -> Vec<Concealment> {
     let mut d = Draws::new(plan.seed, index);
-    let mut pool = concealable(recording, plan.strength);
+    let mut pool = concealable(recording, plan.strength, world.built_from_scans());
     if pool.is_empty() {
         return Vec::new();
     }
@@ -322,7 +334,7 @@ pub fn trial_run(
     plan: &LogPlan,
     index: u64,
 ) -> Result<LogTrialRun, String> {
-    let concealed = concealments(recording, plan, index);
+    let concealed = concealments(recording, world, plan, index);
     let label = format!("trial {index}");
     conceal_and_diagnose(recording, world, &concealed, &plan.options, &label)
 }
@@ -376,7 +388,7 @@ fn trial(
     let result = trial_run(recording, world, plan, index);
     let concealed = match &result {
         Ok(run) => run.concealed.clone(),
-        Err(_) => concealments(recording, plan, index),
+        Err(_) => concealments(recording, world, plan, index),
     };
     let answer = Answer::of(&result.map(|run| run.diagnosis));
     let param_errors = concealed
@@ -414,7 +426,7 @@ pub fn run_on_log(
             plan.trials
         )));
     }
-    let pool = concealable(recording, plan.strength);
+    let pool = concealable(recording, plan.strength, world.built_from_scans());
     if pool.is_empty() {
         return Err(MismatchError::Input(
             "nothing to conceal: the recording has no lidar, and no encoders with a truth".into(),
@@ -433,7 +445,7 @@ pub fn run_on_log(
         plan: plan.clone(),
         world: world.describe(),
         concealable: pool,
-        not_concealed: not_concealed(recording, plan.strength),
+        not_concealed: not_concealed(recording, plan.strength, world.built_from_scans()),
         encoder_scatter_s: recording
             .odometry
             .as_deref()

@@ -52,6 +52,7 @@ pub(super) fn rmse_of(f: &crate::explain::CandidateFit) -> &'static str {
         RmseOver::PathSteps => {
             " (the lidar-matched path's sideways motion, which wheels cannot make)"
         }
+        RmseOver::PathSpans => " (the lidar-matched path's spans against the encoders')",
     }
 }
 
@@ -59,6 +60,7 @@ pub(super) fn rmse_of(f: &crate::explain::CandidateFit) -> &'static str {
 pub(super) fn heldout_unit(f: &crate::explain::CandidateFit) -> &'static str {
     match f.rmse_over {
         RmseOver::PathSteps => "steps",
+        RmseOver::PathSpans => "spans",
         RmseOver::Readings | RmseOver::ReadingsGivenPast => "readings",
     }
 }

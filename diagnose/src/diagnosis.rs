@@ -145,15 +145,15 @@ pub fn diagnose_with_progress(
         realign_lidar(&ctx, &aligned, named, &mut candidates, &mut data, options)?;
     let realigned_ctx = realigned.as_ref().map(|a| along(&ctx, a));
     let final_ctx = realigned_ctx.as_ref().unwrap_or(&ctx);
-    let named = match &realigned_ctx {
-        Some(along) => {
-            let (named, again) =
-                rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
-            nominal = again;
-            named
-        }
-        None => named,
-    };
+    let named = rejudged_along(
+        realigned_ctx.as_ref(),
+        &aligned,
+        named,
+        &mut candidates,
+        &mut data,
+        &mut nominal,
+        options,
+    )?;
     // Against the scans' own path, a lidar turned on its mount moves the path sideways, which
     // the wheels cannot (`crab.rs`).
     let crabbed = crab_mount(
@@ -191,15 +191,15 @@ pub fn diagnose_with_progress(
     } = from_spans(final_ctx, path_so_far, &mut candidates, options);
     let lag_ctx = lagged.as_ref().map(|(_, a)| along(&ctx, a));
     let final_ctx = lag_ctx.as_ref().unwrap_or(final_ctx);
-    let mut named = match &lag_ctx {
-        Some(along) => {
-            let (named, again) =
-                rejudge_along(along, &aligned, named, &mut candidates, &mut data, options)?;
-            nominal = again;
-            named
-        }
-        None => named,
-    };
+    let mut named = rejudged_along(
+        lag_ctx.as_ref(),
+        &aligned,
+        named,
+        &mut candidates,
+        &mut data,
+        &mut nominal,
+        options,
+    )?;
     // Along the scans' own path the encoders' effects are their spans': judged reading by
     // reading along a path that skids in its turns, the encoders do not tell their base or
     // size (each reading's skid is taken for a shared error of the path), and a lead of theirs
@@ -622,6 +622,25 @@ fn rejudge_along(
         replace_effects(named, candidates, again, |s| s != Sensor::Lidar)
     };
     Ok((named, nominal_evidence(along, aligned, data, options)))
+}
+
+/// [`rejudge_along`] `along` a new path when there is one (`nominal` then follows it), the
+/// named effects as they are otherwise.
+fn rejudged_along(
+    along: Option<&Context<'_>>,
+    aligned: &Aligned,
+    named: Vec<CandidateFit>,
+    candidates: &mut Vec<CandidateFit>,
+    data: &mut [SensorData],
+    nominal: &mut Nominal,
+    options: &Options,
+) -> Result<Vec<CandidateFit>, MismatchError> {
+    let Some(along) = along else {
+        return Ok(named);
+    };
+    let (named, again) = rejudge_along(along, aligned, named, candidates, data, options)?;
+    *nominal = again;
+    Ok(named)
 }
 
 /// A note for an encoder delay or wheel slip that gained its place on held-out data but whose
@@ -1128,6 +1147,60 @@ const CRAB_SIZE_RANGE_M: f64 = 2.0;
 /// must lie: 3, as the halves of a log are compared.
 const CRAB_MIN_SD: f64 = 3.0;
 
+/// An effect read from the path's own motion (its steps or its spans against the encoders),
+/// not from a sensor's readings, and what it explains there.
+struct PathRead {
+    effect: Effect,
+    params: Vec<f64>,
+    param_sd: Vec<f64>,
+    train_gain: f64,
+    heldout_gain: f64,
+    /// Its free parameters, for the BIC.
+    free: usize,
+    train_n: usize,
+    heldout_n: usize,
+    rmse_before_m: f64,
+    rmse_after_m: f64,
+    noise_m: f64,
+    rmse_over: RmseOver,
+    size_m: f64,
+    /// The floor its size is measured against, metres.
+    floor_m: f64,
+}
+
+impl PathRead {
+    /// Its fit, scored in the encoders (the path they are judged against is what it was read
+    /// from), put in `candidates` in place of any other fit of its effect.
+    fn candidate(self, seen_until_s: f64, candidates: &mut Vec<CandidateFit>) -> CandidateFit {
+        let per_noise = |v: f64| v / self.noise_m.max(f64::MIN_POSITIVE);
+        let fit = CandidateFit {
+            effect: self.effect,
+            sensor: Sensor::Odometer,
+            train_gain: self.train_gain,
+            heldout_gain: self.heldout_gain,
+            bic_gain: 2.0 * self.train_gain - self.free as f64 * (self.train_n as f64).ln(),
+            rmse_before: self.rmse_before_m,
+            rmse_after: self.rmse_after_m,
+            noise_floor: self.noise_m,
+            heldout_n: self.heldout_n,
+            rmse_over: self.rmse_over,
+            heldout_ll_per_reading: self.heldout_gain / self.heldout_n.max(1) as f64,
+            size_m: self.size_m,
+            size_noise_m: self.floor_m,
+            floor_multiple: self.size_m / self.floor_m.max(f64::MIN_POSITIVE),
+            scaled_rmse: (per_noise(self.rmse_before_m), per_noise(self.rmse_after_m)),
+            seen_until_s,
+            params: self.params,
+            param_sd: self.param_sd,
+        };
+        match candidates.iter_mut().find(|x| x.effect == fit.effect) {
+            Some(x) => *x = fit.clone(),
+            None => candidates.push(fit.clone()),
+        }
+        fit
+    }
+}
+
 /// What the spans of the scans' own path name: the lidar's delay against the encoders, with
 /// the path put back by it, and the wheels' base and sizes (each fit, and whether it is named).
 struct FromSpans {
@@ -1172,35 +1245,23 @@ fn from_spans(
     let mut judged = |effect: Effect, reading: &wheels_against_scans::Reading| {
         // Sized as what it puts right on the held-out spans.
         let size_m = (reading.rmse_before_m - reading.rmse_after_m).max(0.0);
-        let floor_m = options.floors.odometer_m;
-        let fit = CandidateFit {
+        let fit = PathRead {
             effect,
-            sensor: Sensor::Odometer,
             params: reading.value.clone(),
             param_sd: reading.sd.clone(),
             train_gain: reading.train_gain,
             heldout_gain: reading.heldout_gain,
-            bic_gain: 2.0 * reading.train_gain
-                - reading.value.len() as f64 * (spans.train_n as f64).ln(),
-            rmse_before: reading.rmse_before_m,
-            rmse_after: reading.rmse_after_m,
-            noise_floor: reading.noise_m,
+            free: reading.value.len(),
+            train_n: spans.train_n,
             heldout_n: spans.heldout_n,
+            rmse_before_m: reading.rmse_before_m,
+            rmse_after_m: reading.rmse_after_m,
+            noise_m: reading.noise_m,
             rmse_over: RmseOver::PathSpans,
-            heldout_ll_per_reading: reading.heldout_gain / spans.heldout_n.max(1) as f64,
             size_m,
-            size_noise_m: floor_m,
-            floor_multiple: size_m / floor_m.max(f64::MIN_POSITIVE),
-            scaled_rmse: (
-                reading.rmse_before_m / reading.noise_m.max(f64::MIN_POSITIVE),
-                reading.rmse_after_m / reading.noise_m.max(f64::MIN_POSITIVE),
-            ),
-            seen_until_s: aligned.end_s,
-        };
-        match candidates.iter_mut().find(|x| x.effect == effect) {
-            Some(x) => *x = fit.clone(),
-            None => candidates.push(fit.clone()),
+            floor_m: options.floors.odometer_m,
         }
+        .candidate(aligned.end_s, candidates);
         let absent = effect.absent(0.0);
         // Every parameter within its search, one beyond its least departure, and the reading
         // beyond its errors.
@@ -1262,33 +1323,23 @@ fn crab_mount(
     };
     let size_m = CRAB_SIZE_RANGE_M * c.yaw_rad.tan().abs();
     let floor_m = options.floors.lidar_m;
-    let fit = CandidateFit {
+    let fit = PathRead {
         effect,
-        sensor: Sensor::Odometer,
         params: vec![c.yaw_rad.to_degrees(), 0.0, 0.0],
         param_sd: vec![c.yaw_sd_rad.to_degrees(), f64::NAN, f64::NAN],
         train_gain: c.train_gain,
         heldout_gain: c.heldout_gain,
-        bic_gain: 2.0 * c.train_gain - (c.train_n as f64).ln(),
-        rmse_before: c.rmse_before_m,
-        rmse_after: c.rmse_after_m,
-        noise_floor: c.noise_m,
+        free: 1,
+        train_n: c.train_n,
         heldout_n: c.heldout_n,
+        rmse_before_m: c.rmse_before_m,
+        rmse_after_m: c.rmse_after_m,
+        noise_m: c.noise_m,
         rmse_over: RmseOver::PathSteps,
-        heldout_ll_per_reading: c.heldout_gain / c.heldout_n.max(1) as f64,
         size_m,
-        size_noise_m: floor_m,
-        floor_multiple: size_m / floor_m.max(f64::MIN_POSITIVE),
-        scaled_rmse: (
-            c.rmse_before_m / c.noise_m.max(f64::MIN_POSITIVE),
-            c.rmse_after_m / c.noise_m.max(f64::MIN_POSITIVE),
-        ),
-        seen_until_s: aligned.end_s,
-    };
-    match candidates.iter_mut().find(|x| x.effect == effect) {
-        Some(x) => *x = fit.clone(),
-        None => candidates.push(fit.clone()),
+        floor_m,
     }
+    .candidate(aligned.end_s, candidates);
     candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
     let earns = fit.heldout_gain > options.min_gain
         && fit.bic_gain > 0.0

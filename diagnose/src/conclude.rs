@@ -3,7 +3,7 @@
 //! explain it, and what no named effect explains.
 
 use crate::catalogue::Sensor;
-use crate::explain::CandidateFit;
+use crate::explain::{CandidateFit, RmseOver};
 use crate::locate::{Evidence, Floors, TestKind};
 use crate::outcome::{NamedEffect, Options, SensorSummary, Verdict};
 use crate::residuals::Context;
@@ -125,7 +125,13 @@ pub(crate) fn conclude(
         .iter()
         .filter(|l| dead.iter().all(|d| d.sensor != l.sensor))
     {
-        let explained = effects.iter().any(|e| e.fit.effect.shows_in(l.sensor));
+        // An effect read from the path's own motion against this sensor (the encoders' spans,
+        // the crab) judged the sensor by that motion, not reading by reading.
+        let explained = effects.iter().any(|e| {
+            e.fit.effect.shows_in(l.sensor)
+                || (e.fit.sensor == l.sensor
+                    && matches!(e.fit.rmse_over, RmseOver::PathSteps | RmseOver::PathSpans))
+        });
         // Most readings far from every prediction and no effect of the sensor named: the
         // recording is not a run of this scenario (or its trajectory is wrong).
         if let Some(m) = nominal

@@ -3,7 +3,7 @@
 //! explain it, and what no named effect explains.
 
 use crate::catalogue::Sensor;
-use crate::explain::{CandidateFit, RmseOver};
+use crate::explain::CandidateFit;
 use crate::locate::{Evidence, Floors, TestKind};
 use crate::outcome::{NamedEffect, Options, SensorSummary, Verdict};
 use crate::residuals::Context;
@@ -129,8 +129,7 @@ pub(crate) fn conclude(
         // the crab) judged the sensor by that motion, not reading by reading.
         let explained = effects.iter().any(|e| {
             e.fit.effect.shows_in(l.sensor)
-                || (e.fit.sensor == l.sensor
-                    && matches!(e.fit.rmse_over, RmseOver::PathSteps | RmseOver::PathSpans))
+                || (e.fit.sensor == l.sensor && e.fit.rmse_over.of_path_motion())
         });
         // Most readings far from every prediction and no effect of the sensor named: the
         // recording is not a run of this scenario (or its trajectory is wrong).

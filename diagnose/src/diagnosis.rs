@@ -206,13 +206,8 @@ pub fn diagnose_with_progress(
     // on the speed's changes (a delay, a slip) is the lidar's delay seen from their side.
     if !wheels.is_empty() {
         // The encoders' effects fitted to their readings (not a mount read from the path).
-        let from_readings = |c: &CandidateFit| {
-            c.sensor == Sensor::Odometer
-                && matches!(
-                    c.rmse_over,
-                    RmseOver::Readings | RmseOver::ReadingsGivenPast
-                )
-        };
+        let from_readings =
+            |c: &CandidateFit| c.sensor == Sensor::Odometer && !c.rmse_over.of_path_motion();
         named.retain(|c| !from_readings(c));
         candidates.retain(|c| !from_readings(c));
         for (fit, earns) in wheels {
@@ -517,13 +512,11 @@ fn explaining_their_sensor(
     };
     // An effect read from the path's own motion (a mount's crab, the encoders' spans) explains
     // that motion, not its sensor's readings: its held-out gain there is its evidence.
-    let read_from_path =
-        |c: &CandidateFit| matches!(c.rmse_over, RmseOver::PathSteps | RmseOver::PathSpans);
     named
         .into_iter()
         .filter(|c| {
             !c.effect.moves_readings()
-                || read_from_path(c)
+                || c.rmse_over.of_path_motion()
                 || !unexplained_sensor(c.effect.sensor())
         })
         .filter(|c| {

@@ -84,6 +84,15 @@ pub enum RmseOver {
     PathSpans,
 }
 
+impl RmseOver {
+    /// Whether the fit was read from the path's own motion (its steps or spans) rather than
+    /// from its sensor's readings: that motion is its evidence.
+    #[must_use]
+    pub fn of_path_motion(self) -> bool {
+        matches!(self, Self::PathSteps | Self::PathSpans)
+    }
+}
+
 /// Readings the size of an effect is measured over: this share of the held-out ones, at
 /// least [`SIZE_MIN_READINGS`].
 const SIZE_SHARE: f64 = 0.1;

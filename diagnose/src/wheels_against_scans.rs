@@ -261,11 +261,6 @@ fn loss(residuals: &[f64], noise: f64) -> f64 {
         .sum()
 }
 
-/// The spans' travel less `k` times the encoders' mean travel.
-fn travel_residuals((y, x): &(Vec<f64>, Vec<[f64; 2]>), k: f64) -> Vec<f64> {
-    y.iter().zip(x).map(|(y, x)| y - k * x[0]).collect()
-}
-
 fn rms(residuals: &[f64]) -> f64 {
     (residuals.iter().map(|v| v * v).sum::<f64>() / residuals.len().max(1) as f64).sqrt()
 }
@@ -276,21 +271,35 @@ struct Equation {
     held: (Vec<f64>, Vec<[f64; 2]>),
 }
 
-impl Equation {
-    /// What a model adds over another (both trained on the training spans): its gains on
-    /// either half, and the held-out RMS without and with it.
-    fn compare(&self, without: &Linear, with: &Linear, noise: f64) -> (f64, f64, f64, f64) {
-        let r = |fit: &Linear, (y, x): &(Vec<f64>, Vec<[f64; 2]>)| fit.residuals(y, x);
-        let (train_0, train_1) = (r(without, &self.train), r(with, &self.train));
-        let (held_0, held_1) = (r(without, &self.held), r(with, &self.held));
-        (
-            loss(&train_0, noise) - loss(&train_1, noise),
-            loss(&held_0, noise) - loss(&held_1, noise),
-            rms(&held_0),
-            rms(&held_1),
-        )
-    }
+/// What a model adds over another, each trained on the training spans of its equation (the
+/// same spans, at its own delay): its gains on either half in `noise`, and the held-out RMS
+/// without and with it.
+struct Gain {
+    train: f64,
+    held: f64,
+    rmse_before_m: f64,
+    rmse_after_m: f64,
+}
 
+impl Gain {
+    fn of(without: (&Equation, &Linear), with: (&Equation, &Linear), noise: f64) -> Self {
+        let r = |(e, fit): (&Equation, &Linear)| {
+            (
+                fit.residuals(&e.train.0, &e.train.1),
+                fit.residuals(&e.held.0, &e.held.1),
+            )
+        };
+        let ((train_0, held_0), (train_1, held_1)) = (r(without), r(with));
+        Gain {
+            train: loss(&train_0, noise) - loss(&train_1, noise),
+            held: loss(&held_0, noise) - loss(&held_1, noise),
+            rmse_before_m: rms(&held_0),
+            rmse_after_m: rms(&held_1),
+        }
+    }
+}
+
+impl Equation {
     fn fit(&self, noise: f64, held: [Option<f64>; 2]) -> Linear {
         robust_fit(&self.train.0, &self.train.1, noise, held)
     }
@@ -430,60 +439,64 @@ pub(crate) fn fit(
         train: travel_of(&train),
         held: travel_of(&held),
     };
-    let travel_noise = robust_noise(&travel_residuals(&travel.train, m_train));
+    let travel_noise = robust_noise(
+        &Linear {
+            coef: [m_train, 0.0],
+        }
+        .residuals(&travel.train.0, &travel.train.1),
+    );
     let m_sd = travel_noise * (all.len() as f64).sqrt() / encoders_m.abs();
     // The delay: its gain over no delay, the wheels' coefficients refitted at either.
     let delay = {
-        let at_zero = on_time.fit(turn_noise, free);
-        let r = |fit: &Linear, e: &Equation| {
-            (
-                fit.residuals(&e.train.0, &e.train.1),
-                fit.residuals(&e.held.0, &e.held.1),
-            )
-        };
-        let ((train_0, held_0), (train_1, held_1)) = (r(&at_zero, &on_time), r(&full_turn, &turn));
+        let gain = Gain::of(
+            (&on_time, &on_time.fit(turn_noise, free)),
+            (&turn, &full_turn),
+            turn_noise,
+        );
         Reading {
             value: vec![delay_s],
             sd: vec![delay_sd_s],
-            train_gain: loss(&train_0, turn_noise) - loss(&train_1, turn_noise),
-            heldout_gain: loss(&held_0, turn_noise) - loss(&held_1, turn_noise),
-            rmse_before_m: rms(&held_0),
-            rmse_after_m: rms(&held_1),
+            train_gain: gain.train,
+            heldout_gain: gain.held,
+            rmse_before_m: gain.rmse_before_m,
+            rmse_after_m: gain.rmse_after_m,
             noise_m: turn_noise,
             departs: delay_s > MIN_SD * delay_sd_s,
         }
     };
     // The base: B / b = m / s, against the turn with s held at m.
     let base = {
-        let (train_gain, heldout_gain, before, after) = turn.compare(
-            &turn.fit(turn_noise, [Some(m), None]),
-            &full_turn,
-            turn_noise,
-        );
+        let declared = turn.fit(turn_noise, [Some(m), None]);
+        let gain = Gain::of((&turn, &declared), (&turn, &full_turn), turn_noise);
         let scale = m / s;
         let sd = scale * ((s_sd / s).powi(2) + (m_sd / m).powi(2)).sqrt();
         Reading {
             value: vec![scale],
             sd: vec![sd],
-            departs: (scale - 1.0).abs() > MIN_SD * sd,
-            train_gain,
-            heldout_gain,
-            rmse_before_m: before,
-            rmse_after_m: after,
+            train_gain: gain.train,
+            heldout_gain: gain.held,
+            rmse_before_m: gain.rmse_before_m,
+            rmse_after_m: gain.rmse_after_m,
             noise_m: turn_noise,
+            departs: (scale - 1.0).abs() > MIN_SD * sd,
         }
     };
     // The radii: their mean m against the travel at 1, and their difference d = c m / (2 s)
     // against the turn with c held at 0.
     let radii = {
-        let loss_at = |rows: &(Vec<f64>, Vec<[f64; 2]>), k: f64| {
-            loss(&travel_residuals(rows, k), travel_noise)
-        };
-        let held_before = travel_residuals(&travel.held, 1.0);
-        let held_after = travel_residuals(&travel.held, m_train);
-        let (turn_train, turn_held, _, _) = turn.compare(
-            &turn.fit(turn_noise, [None, Some(0.0)]),
-            &full_turn,
+        let mean = Gain::of(
+            (&travel, &Linear { coef: [1.0, 0.0] }),
+            (
+                &travel,
+                &Linear {
+                    coef: [m_train, 0.0],
+                },
+            ),
+            travel_noise,
+        );
+        let apart = Gain::of(
+            (&turn, &turn.fit(turn_noise, [None, Some(0.0)])),
+            (&turn, &full_turn),
             turn_noise,
         );
         let d = c * m / (2.0 * s);
@@ -492,11 +505,10 @@ pub(crate) fn fit(
         Reading {
             value: vec![m - d, m + d],
             sd: vec![sd, sd],
-            train_gain: loss_at(&travel.train, 1.0) - loss_at(&travel.train, m_train) + turn_train,
-            heldout_gain: loss(&held_before, travel_noise) - loss(&held_after, travel_noise)
-                + turn_held,
-            rmse_before_m: rms(&held_before),
-            rmse_after_m: rms(&held_after),
+            train_gain: mean.train + apart.train,
+            heldout_gain: mean.held + apart.held,
+            rmse_before_m: mean.rmse_before_m,
+            rmse_after_m: mean.rmse_after_m,
             noise_m: travel_noise,
             departs: (m - 1.0).abs() > MIN_SD * m_sd || d.abs() > MIN_SD * d_sd,
         }

@@ -73,6 +73,23 @@ pub(crate) struct Reading {
     pub departs: bool,
 }
 
+impl Reading {
+    /// `value` (its errors `sd`), scored by what it adds over its absence (`gain`) in an
+    /// equation of noise `noise_m`.
+    fn new(value: Vec<f64>, sd: Vec<f64>, gain: &Gain, noise_m: f64, departs: bool) -> Self {
+        Reading {
+            value,
+            sd,
+            train_gain: gain.train,
+            heldout_gain: gain.held,
+            rmse_before_m: gain.rmse_before_m,
+            rmse_after_m: gain.rmse_after_m,
+            noise_m,
+            departs,
+        }
+    }
+}
+
 /// What the spans show of the encoders against the lidar's path.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Spans {
@@ -453,16 +470,8 @@ pub(crate) fn fit(
             (&turn, &full_turn),
             turn_noise,
         );
-        Reading {
-            value: vec![delay_s],
-            sd: vec![delay_sd_s],
-            train_gain: gain.train,
-            heldout_gain: gain.held,
-            rmse_before_m: gain.rmse_before_m,
-            rmse_after_m: gain.rmse_after_m,
-            noise_m: turn_noise,
-            departs: delay_s > MIN_SD * delay_sd_s,
-        }
+        let departs = delay_s > MIN_SD * delay_sd_s;
+        Reading::new(vec![delay_s], vec![delay_sd_s], &gain, turn_noise, departs)
     };
     // The base: B / b = m / s, against the turn with s held at m.
     let base = {
@@ -470,16 +479,8 @@ pub(crate) fn fit(
         let gain = Gain::of((&turn, &declared), (&turn, &full_turn), turn_noise);
         let scale = m / s;
         let sd = scale * ((s_sd / s).powi(2) + (m_sd / m).powi(2)).sqrt();
-        Reading {
-            value: vec![scale],
-            sd: vec![sd],
-            train_gain: gain.train,
-            heldout_gain: gain.held,
-            rmse_before_m: gain.rmse_before_m,
-            rmse_after_m: gain.rmse_after_m,
-            noise_m: turn_noise,
-            departs: (scale - 1.0).abs() > MIN_SD * sd,
-        }
+        let departs = (scale - 1.0).abs() > MIN_SD * sd;
+        Reading::new(vec![scale], vec![sd], &gain, turn_noise, departs)
     };
     // The radii: their mean m against the travel at 1, and their difference d = c m / (2 s)
     // against the turn with c held at 0.
@@ -502,16 +503,20 @@ pub(crate) fn fit(
         let d = c * m / (2.0 * s);
         let d_sd = c_sd * m / (2.0 * s).abs();
         let sd = m_sd.hypot(d_sd);
-        Reading {
-            value: vec![m - d, m + d],
-            sd: vec![sd, sd],
-            train_gain: mean.train + apart.train,
-            heldout_gain: mean.held + apart.held,
-            rmse_before_m: mean.rmse_before_m,
-            rmse_after_m: mean.rmse_after_m,
-            noise_m: travel_noise,
-            departs: (m - 1.0).abs() > MIN_SD * m_sd || d.abs() > MIN_SD * d_sd,
-        }
+        // Scored on both equations, sized on the travel's.
+        let gain = Gain {
+            train: mean.train + apart.train,
+            held: mean.held + apart.held,
+            ..mean
+        };
+        let departs = (m - 1.0).abs() > MIN_SD * m_sd || d.abs() > MIN_SD * d_sd;
+        Reading::new(
+            vec![m - d, m + d],
+            vec![sd, sd],
+            &gain,
+            travel_noise,
+            departs,
+        )
     };
     Some(Spans {
         delay_s: delay,

@@ -20,8 +20,10 @@ use crate::physics::{Hypothesis, Physics};
 use crate::plot;
 use crate::residuals::{self, Context, Covariate, SensorData};
 use crate::select::{self, hypothesis_of, Selection};
+use crate::sparse_truth;
 use crate::stamps;
-use crate::wheels_against_scans;
+use crate::trajectory::Trajectory;
+use crate::wheel_spans::{self, SpanLimits};
 use hilsim_report::svg::fmt_sig;
 
 /// Rounds (at most) of estimating the trajectory again under a lidar effect's fit and refitting
@@ -182,7 +184,7 @@ pub fn diagnose_with_progress(
         .or(realigned.as_ref())
         .unwrap_or(&aligned);
     // Against the scans' own path, the encoders are judged span by span
-    // (`wheels_against_scans.rs`): a lidar stamped late against them turns late, wheels
+    // (`wheel_spans.rs`): a lidar stamped late against them turns late, wheels
     // farther apart than declared count more travel apart for a turn, and wheels of another
     // size another travel.
     let FromSpans {
@@ -200,10 +202,19 @@ pub fn diagnose_with_progress(
         &mut nominal,
         options,
     )?;
-    // Along the scans' own path the encoders' effects are their spans': judged reading by
-    // reading along a path that skids in its turns, the encoders do not tell their base or
-    // size (each reading's skid is taken for a shared error of the path), and a lead of theirs
-    // on the speed's changes (a delay, a slip) is the lidar's delay seen from their side.
+    // Against a truth sparser than the encoders, their timing, base and sizes are read span by
+    // span between its poses, as against the scans' own path.
+    let wheels = if wheels.is_empty() {
+        encoders_over_truth(final_ctx, &mut candidates, options)
+    } else {
+        wheels
+    };
+    // Along the scans' own path, or a sparse truth, the encoders' effects are their spans'.
+    // Judged reading by reading along a path that skids in its turns, the encoders do not tell
+    // their base or size (each reading's skid is taken for a shared error of the path), and a
+    // lead of theirs on the speed's changes (a delay, a slip) is the lidar's delay seen from
+    // their side; against a truth of a pose every few seconds, a lead is told by the speed at
+    // each reading, which a scatter of their stamps blurs.
     if !wheels.is_empty() {
         // The encoders' effects fitted to their readings (not a mount read from the path).
         let from_readings =
@@ -642,6 +653,7 @@ fn rejudged_along(
 fn lead_within_the_stamps(candidates: &[CandidateFit], options: &Options) -> Option<String> {
     let within = candidates.iter().find(|c| {
         stamps::is_encoder_lead(c.effect)
+            && !c.rmse_over.of_path_motion()
             && c.heldout_gain > options.min_gain
             && c.params.first().is_some_and(|lead| {
                 lead.abs() <= options.encoder_timing_s && lead.abs() > options.path_timing_s
@@ -1203,7 +1215,7 @@ struct FromSpans {
 
 /// The lidar's delay against the encoders, the wheels' effective base and their sizes, against
 /// a path that is the lidar's own matches ([`DeadReckoning::Scans`]: a log with encoders and no
-/// commands), read from its spans ([`wheels_against_scans`]). Each is a candidate, and named
+/// commands), read from its spans ([`wheel_spans`]). Each is a candidate, and named
 /// when it gains on the held-out spans by [`Options::min_gain`], lies three standard errors
 /// from its absence (`Reading::departs`) and beyond its entry's least departure, and stops
 /// inside its search. The delay comes with the path put back by it (the matched pose at stamp t is the
@@ -1227,53 +1239,25 @@ fn from_spans(
     if aligned.reckoned != Some(DeadReckoning::Scans) {
         return none;
     }
-    let Some(spans) = wheels_against_scans::fit(
+    let Some(spans) = wheel_spans::fit(
         &aligned.trajectory,
         ctx.physics.declared().wheel_base_m,
         odometry,
         (delays.lo, delays.hi),
+        SpanLimits::SCANS,
     ) else {
         return none;
     };
-    let mut judged = |effect: Effect, reading: &wheels_against_scans::Reading| {
-        // Sized as what it puts right on the held-out spans.
-        let size_m = (reading.rmse_before_m - reading.rmse_after_m).max(0.0);
-        let fit = PathRead {
+    let mut judged = |effect: Effect, reading: &wheel_spans::Reading| {
+        judged_on_spans(
             effect,
-            params: reading.value.clone(),
-            param_sd: reading.sd.clone(),
-            train_gain: reading.train_gain,
-            heldout_gain: reading.heldout_gain,
-            free: reading.value.len(),
-            train_n: spans.train_n,
-            heldout_n: spans.heldout_n,
-            rmse_before_m: reading.rmse_before_m,
-            rmse_after_m: reading.rmse_after_m,
-            noise_m: reading.noise_m,
-            rmse_over: RmseOver::PathSpans,
-            size_m,
-            floor_m: options.floors.odometer_m,
-        }
-        .candidate(aligned.end_s, candidates);
-        let absent = effect.absent(0.0);
-        // Every parameter within its search, one beyond its least departure, and the reading
-        // beyond its errors.
-        let inside = effect
-            .params()
-            .iter()
-            .zip(&reading.value)
-            .all(|(spec, &v)| !SearchLimits::at_limit(spec, v));
-        let beyond_least = effect
-            .entry()
-            .least_departures()
-            .iter()
-            .any(|&(i, least)| (reading.value[i] - absent[i]).abs() > least);
-        let earns = reading.heldout_gain > options.min_gain
-            && fit.bic_gain > 0.0
-            && inside
-            && beyond_least
-            && reading.departs;
-        (fit, earns)
+            reading,
+            &spans,
+            RmseOver::PathSpans,
+            aligned.end_s,
+            candidates,
+            options,
+        )
     };
     let (delay_fit, late) = judged(delay, &spans.delay_s);
     let delay = late.then(|| {
@@ -1289,6 +1273,136 @@ fn from_spans(
     ];
     candidates.sort_by(|a, b| b.heldout_gain.total_cmp(&a.heldout_gain));
     FromSpans { delay, wheels }
+}
+
+/// `reading` of `spans` as `effect`'s candidate (put in `candidates`), and whether it is named:
+/// it gains on the held-out spans by [`Options::min_gain`] and by the BIC, lies three standard
+/// errors from its absence (`Reading::departs`) and beyond its entry's least departure, and
+/// stops inside its search.
+fn judged_on_spans(
+    effect: Effect,
+    reading: &wheel_spans::Reading,
+    spans: &wheel_spans::Spans,
+    rmse_over: RmseOver,
+    seen_until_s: f64,
+    candidates: &mut Vec<CandidateFit>,
+    options: &Options,
+) -> (CandidateFit, bool) {
+    // Sized as how much it changes the held-out spans' residual (their turn as travel apart,
+    // or their travel).
+    let size_m = reading.change_m;
+    let fit = PathRead {
+        effect,
+        params: reading.value.clone(),
+        param_sd: reading.sd.clone(),
+        train_gain: reading.train_gain,
+        heldout_gain: reading.heldout_gain,
+        free: reading.value.len(),
+        train_n: spans.train_n,
+        heldout_n: spans.heldout_n,
+        rmse_before_m: reading.rmse_before_m,
+        rmse_after_m: reading.rmse_after_m,
+        noise_m: reading.noise_m,
+        rmse_over,
+        size_m,
+        floor_m: options.floors.odometer_m,
+    }
+    .candidate(seen_until_s, candidates);
+    let absent = effect.absent(0.0);
+    let inside = effect
+        .params()
+        .iter()
+        .zip(&reading.value)
+        .all(|(spec, &v)| !SearchLimits::at_limit(spec, v));
+    let beyond_least = effect
+        .entry()
+        .least_departures()
+        .iter()
+        .any(|&(i, least)| (reading.value[i] - absent[i]).abs() > least);
+    let earns = reading.heldout_gain > options.min_gain
+        && fit.bic_gain > 0.0
+        && inside
+        && beyond_least
+        && reading.departs;
+    (fit, earns)
+}
+
+/// The encoders against a truth sparser than they are (a logger's scan-matched pose every few
+/// seconds), read span by span between its poses ([`wheel_spans`]): their timing, the wheels'
+/// effective base and their sizes, each a candidate and whether it is named
+/// ([`judged_on_spans`]). Encoders stamped late against the truth are the odometer's
+/// `sensor_latency`, encoders that lead it on the speed's changes a wheel slip (its mirror,
+/// [`crate::Entry::sized_as_a_delay`], read as an even slip: the spans tell a lead, not when
+/// it was gained). Judged reading by reading, a lead is told by the speed at each reading,
+/// measured through the same stamps, so a logger's scatter of its stamps hides it
+/// (`stamps.rs`); over the spans only the travel at the truth's stamps counts, and the scatter
+/// averages out. The turn that follows the travel is the wheels' sizes apart, not their base
+/// (a robot that drives its loops one way turns with the distance driven). Empty when the
+/// truth is not sparse, or the spans are too few.
+fn encoders_over_truth(
+    ctx: &Context<'_>,
+    candidates: &mut Vec<CandidateFit>,
+    options: &Options,
+) -> Vec<(CandidateFit, bool)> {
+    let (Some(truth), Some(odometry)) = (
+        ctx.recording.truth.as_deref(),
+        ctx.recording.odometry.as_deref(),
+    ) else {
+        return Vec::new();
+    };
+    let latency = Effect::SensorLatency(Sensor::Odometer);
+    let (Some(hi), Ok(path)) = (
+        latency.params().first().map(|p| p.hi),
+        Trajectory::new(truth),
+    ) else {
+        return Vec::new();
+    };
+    if ctx.estimated || !sparse_truth::is_sparse(truth, odometry) {
+        return Vec::new();
+    }
+    let Some(spans) = wheel_spans::fit(
+        &path,
+        ctx.physics.declared().wheel_base_m,
+        odometry,
+        (-hi, hi),
+        SpanLimits::SPARSE_TRUTH,
+    ) else {
+        return Vec::new();
+    };
+    let lead_s = spans.delay_s.value[0];
+    let (effect, value) = if lead_s < 0.0 {
+        (latency, vec![-lead_s])
+    } else {
+        let slip = Effect::OdometerWheelSlip;
+        let mut value = slip.absent(0.0);
+        value[0] = lead_s;
+        (slip, value)
+    };
+    // The form (a slip's braking share) held at its absence.
+    let sd = (0..value.len())
+        .map(|i| if i == 0 { spans.delay_s.sd[0] } else { 0.0 })
+        .collect();
+    let timing = wheel_spans::Reading {
+        value,
+        sd,
+        ..spans.delay_s.clone()
+    };
+    let mut judged = |effect: Effect, reading: &wheel_spans::Reading| {
+        judged_on_spans(
+            effect,
+            reading,
+            &spans,
+            RmseOver::TruthSpans,
+            ctx.end_s,
+            candidates,
+            options,
+        )
+    };
+    vec![
+        judged(effect, &timing),
+        judged(Effect::DriveWheelBase, &spans.base_scale),
+        judged(Effect::OdometerWheelRadius, &spans.radius_scales),
+    ]
 }
 
 /// The yaw of a lidar turned on its mount, against a path that is the lidar's own matches

@@ -80,8 +80,10 @@ pub enum RmseOver {
     /// lidar's mount yaw read from it: `crab.rs`).
     PathSteps,
     /// The lidar-matched path's spans against the encoders': their turns as the wheels' travel
-    /// apart, or their travel (`wheels_against_scans.rs`).
+    /// apart, or their travel (`wheel_spans.rs`).
     PathSpans,
+    /// A sparse truth's spans between its poses against the encoders', the same way.
+    TruthSpans,
 }
 
 impl RmseOver {
@@ -89,7 +91,7 @@ impl RmseOver {
     /// from its sensor's readings: that motion is its evidence.
     #[must_use]
     pub fn of_path_motion(self) -> bool {
-        matches!(self, Self::PathSteps | Self::PathSpans)
+        matches!(self, Self::PathSteps | Self::PathSpans | Self::TruthSpans)
     }
 }
 

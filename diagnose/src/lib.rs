@@ -44,7 +44,7 @@ mod sparse_truth;
 mod stamps;
 pub mod stats;
 mod trajectory;
-mod wheels_against_scans;
+mod wheel_spans;
 
 pub use align::Alignment;
 pub use catalogue::{

@@ -52,6 +52,16 @@ pub(crate) fn is_sparse(truth: &[TruthSample], odometry: &[OdometrySample]) -> b
     }
 }
 
+/// Whether `recording`'s encoders are judged against a sparse truth, whose spans between poses
+/// read their delay or slip whatever the scatter of their stamps (`wheel_spans.rs`).
+#[must_use]
+pub(crate) fn reads_encoder_leads(recording: &hilsim_recording::Recording) -> bool {
+    match (recording.truth.as_deref(), recording.odometry.as_deref()) {
+        (Some(truth), Some(odometry)) => !truth.is_empty() && is_sparse(truth, odometry),
+        _ => false,
+    }
+}
+
 /// The median of the positive steps between consecutive `times`.
 fn median_step(times: impl Iterator<Item = f64>) -> Option<f64> {
     let times: Vec<f64> = times.collect();

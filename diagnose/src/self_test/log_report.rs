@@ -91,6 +91,7 @@ impl LogSelfTest {
             "concealable": self.concealable.iter().map(|e| e.label()).collect::<Vec<_>>(),
             "not_concealed": self.not_concealed.iter().map(|(e, why)| json!({"effect": e, "why": why})).collect::<Vec<_>>(),
             "encoder_stamp_scatter_s": self.encoder_scatter_s,
+            "encoder_leads_over_truth_spans": self.leads_over_truth_spans,
             "untouched": answer_json(&b.whole),
             "halves": b.halves.as_ref().map(|h| h.iter().map(answer_json).collect::<Vec<_>>()),
             "halves_stable": b.stable(),
@@ -134,11 +135,18 @@ impl LogSelfTest {
             s.trials, self.plan.seed, self.plan.strength, self.world
         )?;
         if let Some(scatter_s) = self.encoder_scatter_s {
-            writeln!(
-                out,
-                "the encoders' stamps scatter by ±{:.0} ms (a delay or slip of theirs within that is not identifiable)",
-                scatter_s * 1000.0
-            )?;
+            let ms = scatter_s * 1000.0;
+            if self.leads_over_truth_spans {
+                writeln!(
+                    out,
+                    "the encoders' stamps scatter by ±{ms:.0} ms; their delay and slip are read over the truth's spans between its poses, where that averages out"
+                )?;
+            } else {
+                writeln!(
+                    out,
+                    "the encoders' stamps scatter by ±{ms:.0} ms (a delay or slip of theirs within that is not identifiable)"
+                )?;
+            }
         }
         writeln!(out, "untouched: {}", answer_text(&b.whole))?;
         match &b.halves {
@@ -147,7 +155,7 @@ impl LogSelfTest {
                 writeln!(out, "  second half: {}", answer_text(second))?;
                 writeln!(
                     out,
-                    "  the halves {} (the same effects, sizes within {HALVES_WITHIN_SD} combined standard errors)",
+                    "  the halves {} (each effect named in either half sized alike in the other, named or not: within {HALVES_WITHIN_SD} combined standard errors)",
                     if b.stable() { "agree" } else { "DISAGREE" }
                 )?;
             }

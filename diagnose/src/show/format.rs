@@ -53,6 +53,7 @@ pub(super) fn rmse_of(f: &crate::explain::CandidateFit) -> &'static str {
             " (the lidar-matched path's sideways motion, which wheels cannot make)"
         }
         RmseOver::PathSpans => " (the lidar-matched path's spans against the encoders')",
+        RmseOver::TruthSpans => " (the truth's spans between its poses against the encoders')",
     }
 }
 
@@ -60,7 +61,7 @@ pub(super) fn rmse_of(f: &crate::explain::CandidateFit) -> &'static str {
 pub(super) fn heldout_unit(f: &crate::explain::CandidateFit) -> &'static str {
     match f.rmse_over {
         RmseOver::PathSteps => "steps",
-        RmseOver::PathSpans => "spans",
+        RmseOver::PathSpans | RmseOver::TruthSpans => "spans",
         RmseOver::Readings | RmseOver::ReadingsGivenPast => "readings",
     }
 }

@@ -205,10 +205,7 @@ fn spans(
             continue;
         }
         let (from_s, to_s) = (times[start], times[k]);
-        if duration <= limits.most_s
-            && from_s - delays.1 >= first
-            && to_s - delays.0 <= last
-        {
+        if duration <= limits.most_s && from_s - delays.1 >= first && to_s - delays.0 <= last {
             out.push(Span {
                 from_s,
                 to_s,
@@ -736,13 +733,27 @@ mod tests {
     #[test]
     fn a_late_lidar_and_the_wheels_are_read_from_the_paths_spans() {
         let (path, odometry) = weaving(0.12);
-        let late = fit(&path, WHEEL_BASE_M, &odometry, (0.0, 0.3), SpanLimits::SCANS).unwrap();
+        let late = fit(
+            &path,
+            WHEEL_BASE_M,
+            &odometry,
+            (0.0, 0.3),
+            SpanLimits::SCANS,
+        )
+        .unwrap();
         let delay = &late.delay_s;
         assert!((delay.value[0] - 0.12).abs() < 0.01, "{late:?}");
         assert!(delay.sd[0] < 0.005, "{late:?}");
         assert!(delay.heldout_gain > 50.0, "{late:?}");
         let (path, odometry) = weaving(0.0);
-        let on_time = fit(&path, WHEEL_BASE_M, &odometry, (0.0, 0.3), SpanLimits::SCANS).unwrap();
+        let on_time = fit(
+            &path,
+            WHEEL_BASE_M,
+            &odometry,
+            (0.0, 0.3),
+            SpanLimits::SCANS,
+        )
+        .unwrap();
         assert!(on_time.delay_s.value[0] < 0.01, "{on_time:?}");
         assert!(on_time.delay_s.heldout_gain < 10.0, "{on_time:?}");
         for spans in [&late, &on_time] {
@@ -762,7 +773,14 @@ mod tests {
         let (path, odometry) = weaving(0.1);
         let short: Vec<TruthSample> = path.samples().into_iter().take(100).collect();
         let short = Trajectory::new(&short).unwrap();
-        assert!(fit(&short, WHEEL_BASE_M, &odometry, (0.0, 0.3), SpanLimits::SCANS).is_none());
+        assert!(fit(
+            &short,
+            WHEEL_BASE_M,
+            &odometry,
+            (0.0, 0.3),
+            SpanLimits::SCANS
+        )
+        .is_none());
     }
 
     /// Against a truth of a pose every 2 s (a CARMEN logger's), encoders read at 10 Hz whose

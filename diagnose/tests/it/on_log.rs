@@ -368,6 +368,13 @@ fn encoder_leads_within_their_stamps_scatter_are_not_concealed() {
 /// commands left out of the recording: a robot's own log, diagnosed along its scans' own
 /// matches against the scenario's world.
 fn loops() -> (Scenario, Recording) {
+    let (loops, mut recording) = loops_with_truth();
+    recording.truth = None;
+    (loops, recording)
+}
+
+/// The loops' run with its truth, its commands left out.
+fn loops_with_truth() -> (Scenario, Recording) {
     let side = |m: f64| {
         format!("[[drive]]\nspeed_mps = 0.3\ndistance_m = {m}\n[[drive]]\nturn_deg = 90.0\n")
     };
@@ -382,9 +389,81 @@ fn loops() -> (Scenario, Recording) {
         .expect("the emulation")
         .run()
         .recording;
-    recording.truth = None;
     recording.commands.clear();
     (loops, recording)
+}
+
+/// Against a truth of a pose every half second (a logger's, stored with its scans), encoders read at
+/// 10 Hz whose stamps scatter by up to ±0.1 s about when they counted (a fixed pattern, kept in
+/// their stamps' order, as a CARMEN log's are) are judged span by span between the truth's
+/// poses: stamped 60 ms late, their delay is named within the self-test's 20 % of what the log
+/// without it reads. Judged reading by reading, within that scatter it is not named.
+#[test]
+fn against_a_sparse_truth_a_late_encoder_is_read_through_its_stamps_scatter() {
+    let (loops, mut recording) = loops_with_truth();
+    let truth = recording.truth.as_mut().expect("the run's truth");
+    let mut next_s = 0.0;
+    truth.retain(|s| {
+        let keep = s.t_s >= next_s;
+        if keep {
+            next_s = s.t_s + 0.5;
+        }
+        keep
+    });
+    let odometry = recording.odometry.as_mut().expect("encoders");
+    let step = (0.1 / (odometry[1].t_s - odometry[0].t_s)).round().max(1.0) as usize;
+    let mut logged: Vec<_> = odometry
+        .iter()
+        .step_by(step)
+        .enumerate()
+        .map(|(k, s)| OdometrySample {
+            t_s: s.t_s + [0.0, 0.1, -0.06, 0.04, -0.1, 0.08, -0.02][k % 7],
+            ..*s
+        })
+        .collect();
+    logged.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+    *odometry = logged;
+    let world = GivenWorld(loops);
+    let late = Concealment::Restamp {
+        sensor: Sensor::Odometer,
+        delay_s: 0.06,
+    };
+    let options = Options {
+        effects: vec![
+            late.effect(),
+            Effect::OdometerWheelSlip,
+            Effect::OdometerWheelRadius,
+            Effect::DriveWheelBase,
+        ],
+        ..Options::default()
+    };
+    // The encoders' lead on the truth: a slip's gain less their delay.
+    let lead = |d: &Diagnosis| -> f64 {
+        let read = |effect: Effect| {
+            d.candidates
+                .iter()
+                .find(|c| c.effect == effect)
+                .map_or(0.0, |c| c.params[0])
+        };
+        read(Effect::OdometerWheelSlip) - read(late.effect())
+    };
+    let untouched = conceal_and_diagnose(&recording, &world, &[], &options, "untouched")
+        .expect("a diagnosis")
+        .diagnosis;
+    let d = conceal_and_diagnose(&recording, &world, &[late], &options, "t")
+        .expect("a diagnosis")
+        .diagnosis;
+    assert!(
+        d.effects.iter().any(|e| e.fit.effect == late.effect()),
+        "not named: {}",
+        d.explanation
+    );
+    let delay = lead(&untouched) - lead(&d);
+    assert!(
+        (delay - 0.06).abs() < 0.2 * 0.06,
+        "{delay} s: {}",
+        d.explanation
+    );
 }
 
 /// A run without truth and without commands is diagnosed along its scans' own matches: a

@@ -732,28 +732,23 @@ mod tests {
     /// wheel's size are read within a fifth of their 8 % and 1 %.
     #[test]
     fn a_late_lidar_and_the_wheels_are_read_from_the_paths_spans() {
-        let (path, odometry) = weaving(0.12);
-        let late = fit(
-            &path,
-            WHEEL_BASE_M,
-            &odometry,
-            (0.0, 0.3),
-            SpanLimits::SCANS,
-        )
-        .unwrap();
+        let read = |delay_s: f64| {
+            let (path, odometry) = weaving(delay_s);
+            fit(
+                &path,
+                WHEEL_BASE_M,
+                &odometry,
+                (0.0, 0.3),
+                SpanLimits::SCANS,
+            )
+            .unwrap()
+        };
+        let late = read(0.12);
         let delay = &late.delay_s;
         assert!((delay.value[0] - 0.12).abs() < 0.01, "{late:?}");
         assert!(delay.sd[0] < 0.005, "{late:?}");
         assert!(delay.heldout_gain > 50.0, "{late:?}");
-        let (path, odometry) = weaving(0.0);
-        let on_time = fit(
-            &path,
-            WHEEL_BASE_M,
-            &odometry,
-            (0.0, 0.3),
-            SpanLimits::SCANS,
-        )
-        .unwrap();
+        let on_time = read(0.0);
         assert!(on_time.delay_s.value[0] < 0.01, "{on_time:?}");
         assert!(on_time.delay_s.heldout_gain < 10.0, "{on_time:?}");
         for spans in [&late, &on_time] {

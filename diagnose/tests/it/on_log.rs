@@ -198,6 +198,20 @@ fn a_turned_lidar_is_named_against_the_crispest_map_of_its_own_scans() {
     assert!((yaw_deg - 2.0).abs() < 0.7, "named {yaw_deg}° for 2°");
 }
 
+/// `recording`'s truth thinned to a pose every `step_s` seconds, as a logger stores one with
+/// each scan.
+fn keep_a_pose_every(recording: &mut Recording, step_s: f64) {
+    let truth = recording.truth.as_mut().expect("the run's truth");
+    let mut next_s = 0.0;
+    truth.retain(|s| {
+        let keep = s.t_s >= next_s;
+        if keep {
+            next_s = s.t_s + step_s;
+        }
+        keep
+    });
+}
+
 /// `d` names `concealed`'s entry with its size within the self-test's 20 %.
 fn assert_named_within_a_fifth(d: &Diagnosis, concealed: Concealment) {
     let effect = concealed.effect();
@@ -223,15 +237,7 @@ fn assert_named_within_a_fifth(d: &Diagnosis, concealed: Concealment) {
 #[test]
 fn against_a_sparse_truth_the_encoders_are_judged_over_its_spans() {
     let (room, mut recording) = log();
-    let truth = recording.truth.as_mut().expect("the run's truth");
-    let mut next_s = 0.0;
-    truth.retain(|s| {
-        let keep = s.t_s >= next_s;
-        if keep {
-            next_s = s.t_s + 0.5;
-        }
-        keep
-    });
+    keep_a_pose_every(&mut recording, 0.5);
     let world = GivenWorld(room);
     let concealed = Concealment::WheelRadius {
         left_scale: 1.05,
@@ -401,15 +407,7 @@ fn loops_with_truth() -> (Scenario, Recording) {
 #[test]
 fn against_a_sparse_truth_a_late_encoder_is_read_through_its_stamps_scatter() {
     let (loops, mut recording) = loops_with_truth();
-    let truth = recording.truth.as_mut().expect("the run's truth");
-    let mut next_s = 0.0;
-    truth.retain(|s| {
-        let keep = s.t_s >= next_s;
-        if keep {
-            next_s = s.t_s + 0.5;
-        }
-        keep
-    });
+    keep_a_pose_every(&mut recording, 0.5);
     let odometry = recording.odometry.as_mut().expect("encoders");
     let step = (0.1 / (odometry[1].t_s - odometry[0].t_s)).round().max(1.0) as usize;
     let mut logged: Vec<_> = odometry

@@ -1350,6 +1350,9 @@ fn encoders_over_truth(
     ) else {
         return Vec::new();
     };
+    if ctx.estimated || !sparse_truth::reads_encoder_leads(ctx.recording) {
+        return Vec::new();
+    }
     let latency = Effect::SensorLatency(Sensor::Odometer);
     let (Some(hi), Ok(path)) = (
         latency.params().first().map(|p| p.hi),
@@ -1357,9 +1360,6 @@ fn encoders_over_truth(
     ) else {
         return Vec::new();
     };
-    if ctx.estimated || !sparse_truth::is_sparse(truth, odometry) {
-        return Vec::new();
-    }
     let Some(spans) = wheel_spans::fit(
         &path,
         ctx.physics.declared().wheel_base_m,

@@ -300,12 +300,13 @@ pub fn diagnose_with_progress(
     }
     let mut left = structure_left(final_ctx, &data, &nominal, &named);
     let mut before = named.len();
-    let mut named = explaining_their_sensor(&nominal, &left, named, options);
+    let path_recorded = !final_ctx.estimated;
+    let mut named = explaining_their_sensor(&nominal, &left, named, path_recorded, options);
     // An effect refused changes what its sensor's others leave: they are judged again without it.
     while named.len() < before {
         left = structure_left(final_ctx, &data, &nominal, &named);
         before = named.len();
-        named = explaining_their_sensor(&nominal, &left, named, options);
+        named = explaining_their_sensor(&nominal, &left, named, path_recorded, options);
     }
     let before = named.len();
     named = within_the_search(named, &mut notes);
@@ -500,6 +501,7 @@ fn explaining_their_sensor(
     nominal: &Nominal,
     left: &[Left],
     named: Vec<CandidateFit>,
+    path_recorded: bool,
     options: &Options,
 ) -> Vec<CandidateFit> {
     let threshold = nominal.threshold;
@@ -529,11 +531,58 @@ fn explaining_their_sensor(
             !c.effect.moves_readings()
                 || c.rmse_over.of_path_motion()
                 || !unexplained_sensor(c.effect.sensor())
+                || (path_recorded && explains_its_own_variable(c, nominal, left, options))
         })
         .filter(|c| {
             !select::leaves_range_structure(c, &nominal.evidence, left, threshold, &options.floors)
         })
         .collect()
+}
+
+/// Share of the normal score of a structure against one of an effect's own variables at or
+/// below which the sensor's named effects are taken to explain it: half the score is an eighth
+/// of the χ² statistic (the score grows as its cube root).
+const MAX_OWN_LEFT: f64 = 0.5;
+
+/// Whether `c` explains a structure of its sensor against one of its own variables other than
+/// the sensor's main one: the residuals' mean departs against it under the nominal model by a
+/// test that counts, and under the named effects keeps at most [`MAX_OWN_LEFT`] of its score.
+/// A structure that is only the main one's shadow through a path that ties two variables
+/// together (the range and the time, as a room is crossed) cannot be explained while the main
+/// one stands; one that is explained so is a mechanism of its own beside it (a warm-up in time
+/// beside a map's error at far range on a real log, which it leaves standing whole).
+fn explains_its_own_variable(
+    c: &CandidateFit,
+    nominal: &Nominal,
+    left: &[Left],
+    options: &Options,
+) -> bool {
+    let threshold = nominal.threshold;
+    let main = nominal
+        .evidence
+        .iter()
+        .find(|e| e.sensor == c.sensor && e.counts(threshold, &options.floors));
+    let own: Vec<Covariate> = c
+        .effect
+        .entry()
+        .variables()
+        .iter()
+        .filter_map(|v| v.covariate())
+        .filter(|&v| main.is_none_or(|m| m.covariate != Some(v)))
+        .collect();
+    nominal
+        .evidence
+        .iter()
+        .filter(|e| e.sensor == c.sensor && e.test == TestKind::BiasAgainst)
+        .filter(|e| e.covariate.is_some_and(|v| own.contains(&v)))
+        .filter(|e| e.counts(threshold, &options.floors))
+        .any(|before| {
+            left.iter()
+                .filter(|l| l.sensor == c.sensor)
+                .flat_map(|l| l.evidence.iter())
+                .find(|e| e.test == before.test && e.covariate == before.covariate)
+                .is_some_and(|after| after.score <= MAX_OWN_LEFT * before.score)
+        })
 }
 
 /// Each sensor's tests under its named effects (the nominal evidence where none is named).
@@ -1724,11 +1773,11 @@ fn settle(
 #[cfg(test)]
 mod tests {
     use super::{
-        fixed_point_step, within_the_paths_scale, within_the_search, REALIGN_ROUNDS,
-        REALIGN_SETTLED,
+        explaining_their_sensor, fixed_point_step, within_the_paths_scale, within_the_search,
+        REALIGN_ROUNDS, REALIGN_SETTLED,
     };
     use crate::catalogue::{Effect, Sensor};
-    use crate::conclude::Left;
+    use crate::conclude::{Left, Nominal};
     use crate::explain::CandidateFit;
     use crate::locate::{Evidence, TestKind};
     use crate::outcome::Options;
@@ -1817,6 +1866,71 @@ mod tests {
         );
         assert_eq!(kept.len(), 1);
         assert!(notes.is_empty(), "{notes:?}");
+    }
+
+    /// The lidar's mean departing against `covariate` by `size_m` with `score`.
+    fn lidar_bias_against(covariate: Covariate, score: f64, size_m: f64) -> Evidence {
+        Evidence {
+            covariate: Some(covariate),
+            score,
+            ..lidar_left_by_range(size_m).evidence.remove(0)
+        }
+    }
+
+    #[test]
+    fn a_warmup_is_named_beside_a_far_error_it_leaves_when_it_explains_the_lidar_in_time() {
+        let options = Options::default();
+        // A built map's error at far range (the main structure, left whole) and a warm-up's
+        // 24 mm in time; the warm-up's fit takes the time structure's score from 31 to `left`.
+        let nominal = Nominal {
+            sensors: Vec::new(),
+            evidence: vec![
+                lidar_bias_against(Covariate::Range, 41.0, 0.4),
+                lidar_bias_against(Covariate::Time, 31.0, 0.024),
+            ],
+            misaligned: None,
+            threshold: 3.0,
+        };
+        let left = |time_score: f64| {
+            [Left {
+                sensor: Sensor::Lidar,
+                evidence: vec![
+                    lidar_bias_against(Covariate::Range, 41.5, 0.4),
+                    lidar_bias_against(Covariate::Time, time_score, 0.012),
+                ],
+            }]
+        };
+        let warmup = CandidateFit {
+            effect: Effect::LidarWarmupDrift,
+            sensor: Sensor::Lidar,
+            params: vec![0.0, 400.0, -0.02, 1.0],
+            ..wheels(1.0, 1.0)
+        };
+        let kept = |time_score: f64, path_recorded: bool| {
+            explaining_their_sensor(
+                &nominal,
+                &left(time_score),
+                vec![warmup.clone()],
+                path_recorded,
+                &options,
+            )
+            .len()
+        };
+        assert_eq!(kept(12.0, true), 1);
+        // Half its time structure standing: it explains neither.
+        assert_eq!(kept(20.0, true), 0);
+        // Along a path matched from the scans, whose own error changes in time.
+        assert_eq!(kept(12.0, false), 0);
+        // A mount offset acts through no variable tested in time: it explains the far error
+        // or nothing.
+        let mount = CandidateFit {
+            effect: Effect::LidarMountOffset,
+            params: vec![1.0, 0.0, 0.0],
+            ..warmup.clone()
+        };
+        assert!(
+            explaining_their_sensor(&nominal, &left(12.0), vec![mount], true, &options).is_empty()
+        );
     }
 
     #[test]

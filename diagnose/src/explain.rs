@@ -287,7 +287,14 @@ pub(crate) fn score(
     let (rmse_after, noise_floor, heldout_n) = rmse(&after, both);
     let scaled_rmse = (scaled_rms(&before, both), scaled_rms(&after, both));
     let ranges = matches!(data.sensor, Sensor::Lidar | Sensor::Sonar);
-    let reach: Vec<f64> = heldout.iter().map(|&i| data.world_reach(i)).collect();
+    // Along a path matched from the scans the path's own error changes in time as well (it
+    // is matched from the first scans alone at the start), so there the world's reach counts
+    // against every effect.
+    let reach: Vec<f64> = if ctx.estimated || effect.entry().mimicked_by_the_world() {
+        heldout.iter().map(|&i| data.world_reach(i)).collect()
+    } else {
+        Vec::new()
+    };
     let floor = |noise_m: f64| ctx.floors.floor_m(data.sensor, noise_m);
     let ((size_m, size_noise_m), floor_multiple) = if ctx.conditions(data) {
         effect_size(

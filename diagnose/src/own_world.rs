@@ -1,9 +1,9 @@
 //! A log's world: the user's scenario, or the world built from the log's own scans as
 //! `hilsim world` builds it, and a log diagnosed in it ([`diagnosed_in`]). A map built from
-//! the scans at a truth's poses is built again under the lidar's named delay and mount.
+//! the scans at a truth's poses is built again under the lidar's named delay, mount and warm-up.
 //! `hilsim diagnose --real` without `--sim` and the self-test on a log both judge a log here.
 
-use hilsim_lidar_emulator::effects::real_mount;
+use hilsim_lidar_emulator::effects::{real_mount, warmup_error_m};
 use hilsim_recording::Recording;
 use hilsim_sim::scenario::Effects;
 use hilsim_sim::Scenario;
@@ -149,8 +149,10 @@ impl LogWorld for BuiltWorld {
     /// A map built from scans placed at a truth's poses takes in the lidar's delay and mount:
     /// each scan lands where the robot was at its stamp, seen through the declared mount, so a
     /// late or turned lidar smears every wall the robot passed while turning, and the smear reads
-    /// as an error at edges (mixed pixels) and takes part of the delay. Named, the scans are
-    /// placed under them (re-stamped, seen through the mount named) and the map built again;
+    /// as an error at edges (mixed pixels) and takes part of the delay. A warm-up moves the walls
+    /// the early scans alone see, and so takes part of its drift into the map. Named, the scans
+    /// are placed under them (re-stamped, seen through the mount named, the drift taken off
+    /// their ranges) and the map built again;
     /// the scenario keeps everything else it declared (the timing, the mount, the lidar's noise
     /// measured against the first map), so the delay and mount are judged again against a map
     /// they did not shape. The noise is kept: measured again against the second map it is
@@ -176,14 +178,17 @@ impl LogWorld for BuiltWorld {
     }
 }
 
-/// The lidar's named delay and mount offset in `diagnosis`: what moves where its scans land.
+/// The lidar's named delay, mount offset and warm-up in `diagnosis`: what moves where its
+/// scans land.
 fn named_placement(diagnosis: &Diagnosis) -> Effects {
     let mut effects = Effects::default();
     for named in &diagnosis.effects {
         let e = named.fit.effect;
         if matches!(
             e,
-            Effect::SensorLatency(Sensor::Lidar) | Effect::LidarMountOffset
+            Effect::SensorLatency(Sensor::Lidar)
+                | Effect::LidarMountOffset
+                | Effect::LidarWarmupDrift
         ) {
             e.apply(&named.fit.params, &mut effects);
         }
@@ -192,7 +197,7 @@ fn named_placement(diagnosis: &Diagnosis) -> Effects {
 }
 
 /// What `placement` moves, in words: "the lidar's delay of 32 ms and its mount turned
-/// +2.48°, moved x +0.066 m, y -0.049 m".
+/// +2.48°, moved x +0.066 m, y -0.049 m" (and "its warm-up's drift taken off its ranges").
 fn placement_text(placement: &Effects) -> String {
     let delay = placement
         .sensor_latency
@@ -204,7 +209,10 @@ fn placement_text(placement: &Effects) -> String {
             m.yaw_deg, m.x_m, m.y_m
         )
     });
-    let named: Vec<String> = delay.into_iter().chain(mount).collect();
+    let warmup = placement
+        .lidar_warmup_drift
+        .map(|_| "warm-up's drift taken off its ranges".to_string());
+    let named: Vec<String> = delay.into_iter().chain(mount).chain(warmup).collect();
     format!("the lidar's {}", named.join(" and its "))
 }
 
@@ -215,14 +223,25 @@ pub(crate) fn restamp_lidar(recording: &mut Recording, delay_s: f64) {
     }
 }
 
-/// `recording` with its scans re-stamped by the lidar's delay in `placement` and its mount
-/// moved by its mount offset; `None` when `placement` moves neither.
+/// `recording` with its scans re-stamped by the lidar's delay in `placement`, its mount moved
+/// by its mount offset and its warm-up's drift taken off each valid range (at the range read
+/// and the reading's stamp, as recorded); `None` when `placement` does none of these.
 fn placed_under(recording: &Recording, placement: &Effects) -> Option<Recording> {
     let delay_s = placement.sensor_latency.map_or(0.0, |l| l.lidar_s);
-    if delay_s == 0.0 && placement.lidar_mount_offset.is_none() {
+    if delay_s == 0.0
+        && placement.lidar_mount_offset.is_none()
+        && placement.lidar_warmup_drift.is_none()
+    {
         return None;
     }
     let mut placed = recording.clone();
+    if let Some(drift) = &placement.lidar_warmup_drift {
+        for s in placed.lidar.iter_mut().flatten() {
+            if !s.invalid && s.range_m > 0.0 {
+                s.range_m = (s.range_m - warmup_error_m(drift, s.range_m, s.t_s)).max(0.0);
+            }
+        }
+    }
     restamp_lidar(&mut placed, -delay_s);
     placed.meta.lidar = Some(real_mount(
         placed.meta.lidar.unwrap_or_default(),
@@ -310,6 +329,7 @@ pub fn diagnosed_in(
         (
             placed.sensor_latency.is_some(),
             placed.lidar_mount_offset.is_some(),
+            placed.lidar_warmup_drift.is_some(),
         )
     };
     if named_in_the_lidar(&again) != named_in_the_lidar(&first) {

@@ -5,6 +5,7 @@ use hilsim_sim::scenario::Effects;
 
 use super::params::ParamSpec;
 use super::sensor::Sensor;
+use crate::residuals::Covariate;
 
 /// An explanatory variable an effect's mechanism acts through: what its error grows, shrinks or
 /// appears with.
@@ -43,6 +44,28 @@ pub enum Variable {
 }
 
 impl Variable {
+    /// The variable the residuals are tested against that it is, where it is one.
+    #[must_use]
+    pub(crate) fn covariate(self) -> Option<Covariate> {
+        match self {
+            Variable::Range => Some(Covariate::Range),
+            Variable::IncidenceAngle => Some(Covariate::Incidence),
+            Variable::Bearing => Some(Covariate::Bearing),
+            Variable::TimeSincePowerOn => Some(Covariate::Time),
+            Variable::WheelSpeed => Some(Covariate::WheelSpeed),
+            Variable::NearnessToEdge => Some(Covariate::Edge),
+            Variable::EchoCone => Some(Covariate::OffAxisNearer),
+            Variable::Reflectivity
+            | Variable::TimeInRevolution
+            | Variable::AirTemperature
+            | Variable::WheelAcceleration
+            | Variable::Command
+            | Variable::Time
+            | Variable::WheelTravel
+            | Variable::Turn => None,
+        }
+    }
+
     /// Its name in reports.
     ///
     /// ```
@@ -116,6 +139,14 @@ pub trait Entry: Sync {
 
     /// The explanatory variables its mechanism acts through.
     fn variables(&self) -> &'static [Variable];
+
+    /// Whether a world's own error (a map's cell off by up to its size) can move the readings
+    /// as it does, so that its size counts only beyond that reach. A map is the same at every
+    /// instant: an effect that changes with the time since power-on changes the readings of
+    /// one place between visits, which no error of the map does.
+    fn mimicked_by_the_world(&self) -> bool {
+        !self.variables().contains(&Variable::TimeSincePowerOn)
+    }
 
     /// Whether its size (its first parameter, seconds) is a delay of its sensor against the
     /// path, or the mirror of one: a path whose own timing is off by as much passes for it.

@@ -101,6 +101,7 @@ impl LogSelfTest {
                     "effect": c.effect().label(),
                     "params": c.named_params().iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
                     "size": c.scored(),
+                    "undoes_the_logs_own": self.undoes_own(c),
                 })).collect::<Vec<_>>(),
                 "answer": answer_json(&o.answer),
                 "names_absent": o.names_absent(&b.whole).iter().map(|e| e.label()).collect::<Vec<_>>(),
@@ -109,7 +110,7 @@ impl LogSelfTest {
             })).collect::<Vec<_>>(),
             "per_effect": s.per_effect.iter().map(|(e, c, n)| json!({"effect": e.label(), "concealed": c, "named": n})).collect::<Vec<_>>(),
             "concealed": s.concealed, "named": s.named,
-            "false_alarms": s.false_alarms, "refused": s.refused,
+            "false_alarms": s.false_alarms, "refused": s.refused, "undone": s.undone,
             "param_within_20pct": s.param_within, "param_scored": s.param_scored,
             "pass": self.passed(),
             "wall_s": wall_s,
@@ -211,6 +212,14 @@ impl LogSelfTest {
                     || pct(s.param_within, s.param_scored) >= 100.0 * GOAL_PARAMS_ON_LOG
             )
         )?;
+        if s.undone > 0 {
+            writeln!(
+                out,
+                "undone: {} concealments undid the log's own reading of their mechanism (of opposite sign, summing to within {:.0} % of nothing): scored neither way",
+                s.undone,
+                100.0 * GOAL_PARAM_ERROR
+            )?;
+        }
         if s.refused > 0 {
             writeln!(out, "refused: {} trials", s.refused)?;
         }
@@ -218,7 +227,7 @@ impl LogSelfTest {
             let missed: Vec<String> = o
                 .concealed
                 .iter()
-                .filter(|c| o.answer.get(c.effect()).is_none())
+                .filter(|c| o.answer.get(c.effect()).is_none() && !self.undoes_own(c))
                 .map(|c| c.effect().label())
                 .collect();
             let absent = o.names_absent(&b.whole);

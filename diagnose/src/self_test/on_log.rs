@@ -507,16 +507,36 @@ pub struct LogScore {
     pub refused: usize,
     pub param_within: usize,
     pub param_scored: usize,
+    /// Concealments that undid the log's own reading of their mechanism
+    /// ([`LogSelfTest::undoes_own`]), scored neither way.
+    pub undone: usize,
 }
 
 impl LogSelfTest {
+    /// Whether `c` undoes the untouched log's own reading of its mechanism (named, or fitted
+    /// without being named): the two are of opposite signs and sum to within the parameters'
+    /// tolerance ([`super::GOAL_PARAM_ERROR`]) of `c`'s size, so the log it makes has next to
+    /// nothing of that mechanism to name (a wheel base 6.1 % wide concealed in a log whose own
+    /// encoders read it 5.0 % narrow). The encoders' delay and slip, which are scored by the
+    /// lead they move ([`Answer::encoders_lead_s`]), are never taken as undone.
+    #[must_use]
+    pub fn undoes_own(&self, c: &Concealment) -> bool {
+        let e = c.effect();
+        !crate::stamps::is_encoder_lead(e) && undoes(self.baseline.whole.own_size(e), c.scored())
+    }
+
     /// The score.
     #[must_use]
     pub fn score(&self) -> LogScore {
         let mut per_effect: Vec<(Effect, usize, usize)> =
             self.concealable.iter().map(|e| (*e, 0, 0)).collect();
+        let mut undone = 0;
         for o in &self.outcomes {
             for c in &o.concealed {
+                if self.undoes_own(c) {
+                    undone += 1;
+                    continue;
+                }
                 if let Some(row) = per_effect.iter_mut().find(|r| r.0 == c.effect()) {
                     row.1 += 1;
                     row.2 += usize::from(o.answer.get(c.effect()).is_some());
@@ -526,7 +546,16 @@ impl LogSelfTest {
         let errors: Vec<f64> = self
             .outcomes
             .iter()
-            .flat_map(|o| o.param_errors.iter().map(|(_, e)| *e))
+            .flat_map(|o| {
+                o.param_errors
+                    .iter()
+                    .filter(|(e, _)| {
+                        !o.concealed
+                            .iter()
+                            .any(|c| c.effect() == *e && self.undoes_own(c))
+                    })
+                    .map(|(_, err)| *err)
+            })
             .collect();
         LogScore {
             concealed: per_effect.iter().map(|r| r.1).sum(),
@@ -548,6 +577,7 @@ impl LogSelfTest {
                 .filter(|e| **e <= super::GOAL_PARAM_ERROR)
                 .count(),
             param_scored: errors.len(),
+            undone,
         }
     }
 
@@ -568,6 +598,12 @@ impl LogSelfTest {
             && (s.param_scored == 0 || share(s.param_within, s.param_scored) >= GOAL_PARAMS_ON_LOG)
             && self.baseline.stable()
     }
+}
+
+/// Whether a concealment of scored size `size` undoes a log's own `own` of the same mechanism
+/// ([`LogSelfTest::undoes_own`]).
+fn undoes(own: f64, size: f64) -> bool {
+    own * size < 0.0 && (own + size).abs() <= super::GOAL_PARAM_ERROR * size.abs()
 }
 
 /// The recording at `dir` for a self-test on it.
@@ -608,6 +644,18 @@ mod tests {
             whole: first.clone(),
             halves: Some([first, second]),
         }
+    }
+
+    /// The rover's own wheel base reads 5.0 % narrow: a base concealed 6.1 % or 5.3 % wide
+    /// leaves 1.1 % or 0.3 %, next to nothing; 8 % wide leaves 3 % (38 % of it), to be named,
+    /// and one concealed narrow adds to the log's own.
+    #[test]
+    fn a_concealment_undoes_the_logs_own_only_when_it_leaves_next_to_nothing() {
+        assert!(undoes(-0.050, 0.061));
+        assert!(undoes(-0.050, 0.053));
+        assert!(!undoes(-0.050, 0.080));
+        assert!(!undoes(-0.050, -0.061));
+        assert!(!undoes(0.0, 0.061));
     }
 
     /// An effect named in one half (30 ± 8.5 ms) and fitted just short of a name in the other

@@ -316,6 +316,10 @@ mod tests {
         assert!(!Effect::OdometerWheelRadius.departs(&[1.0001, 0.9999], 0.0));
         assert!(Effect::LidarMountOffset.departs(&[0.0, 0.0, 0.01], 0.0));
         assert!(!Effect::LidarMountOffset.departs(&[0.01, 0.001, 0.0], 0.0));
+        // Half a long-range unit's returns lost head-on at 28 m (half of all beyond 6 m of a
+        // building's corridors); at 45 m, within the search's far end.
+        assert!(Effect::LidarDropout.departs(&[28.3, 1.13], 0.0));
+        assert!(!Effect::LidarDropout.departs(&[45.0, 1.13], 0.0));
     }
 
     #[test]

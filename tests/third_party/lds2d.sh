@@ -17,9 +17,9 @@ scenario=scenarios/room-tour.toml
 "$hilsim" record "$scenario" --out "$tmp/rec" --seed 5
 "$hilsim" serve "$scenario" --realtime --seed 5 > "$tmp/serve.out" &
 serve_pid=$!
-# Up to a minute: on a loaded machine the server builds its world slowly; stop early if it
-# has exited.
-for _ in $(seq 600); do
+# Up to three minutes: on a loaded machine the server builds its world slowly (over a minute
+# was seen while another job kept both cores busy); stop early if it has exited.
+for _ in $(seq 1800); do
     grep -q '^serial: ' "$tmp/serve.out" 2>/dev/null && break
     kill -0 "$serve_pid" 2>/dev/null || break
     sleep 0.1

@@ -203,13 +203,30 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
 
 /// Whether the dropout fit `c` earns its place: it gains more than [`Options::min_gain`] on the
 /// held-out half and by BIC on the training half, loses half the returns nearer than the search's
-/// far end (`Effect::departs`), and loses at least [`Options::dropout_min_share`] more of the
-/// tenth of the readings it loses most than are lost at random.
+/// far end (`Effect::departs`) by more than [`HALF_LOSS_WITHIN_SD`] of its standard errors,
+/// and loses at least [`Options::dropout_min_share`] more of the tenth of the readings it loses
+/// most than are lost at random.
 pub(crate) fn earns_place(c: &CandidateFit, options: &Options) -> bool {
     c.heldout_gain > options.min_gain
         && c.bic_gain > 0.0
         && c.effect.departs(&c.params, 0.0)
+        && half_loss_beyond_its_error(c)
         && c.size_m >= options.dropout_min_share
+}
+
+/// Standard errors by which a dropout's half-loss range must be nearer than the search's far
+/// end: a long-range unit's fit at 38 ± 11 m (a map built beside a turned lidar loses a few far
+/// readings it should not) is the far end within its error, one at 28 ± 1.6 m is not.
+const HALF_LOSS_WITHIN_SD: f64 = 2.0;
+
+/// Whether `c`'s half-loss range is nearer than its absence by more than
+/// [`HALF_LOSS_WITHIN_SD`] standard errors (a standard error that cannot be had is not).
+fn half_loss_beyond_its_error(c: &CandidateFit) -> bool {
+    let absent = c.effect.absent(0.0)[0];
+    match (c.params.first(), c.param_sd.first()) {
+        (Some(&half_loss_m), Some(&sd)) => absent - half_loss_m > HALF_LOSS_WITHIN_SD * sd,
+        _ => false,
+    }
 }
 
 /// The dropout fitted on the lidar's reads and losses along `ctx`'s trajectory, when it is
@@ -300,6 +317,13 @@ mod tests {
             fit.param_sd
         );
         assert!(earns_place(&fit, &Options::default()), "{fit:?}");
+        // The same loss read at 38 ± 11 m: the search's far end within two standard errors.
+        let vague = CandidateFit {
+            params: vec![38.0, s],
+            param_sd: vec![11.0, fit.param_sd[1]],
+            ..fit.clone()
+        };
+        assert!(!earns_place(&vague, &Options::default()), "{vague:?}");
         assert!(fit.rmse_after < fit.rmse_before);
         let mut random = rows(20_000);
         for (i, l) in random.lost.iter_mut().enumerate() {

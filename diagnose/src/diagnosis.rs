@@ -506,11 +506,7 @@ fn explaining_their_sensor(
 ) -> Vec<CandidateFit> {
     let threshold = nominal.threshold;
     let unexplained_sensor = |sensor: Sensor| -> bool {
-        let Some(main) = nominal
-            .evidence
-            .iter()
-            .find(|e| e.sensor == sensor && e.counts(threshold, &options.floors))
-        else {
+        let Some(main) = main_structure(nominal, sensor, options) else {
             return false;
         };
         left.iter()
@@ -539,6 +535,18 @@ fn explaining_their_sensor(
         .collect()
 }
 
+/// `sensor`'s main structure: its strongest test under the nominal model that counts.
+fn main_structure<'a>(
+    nominal: &'a Nominal,
+    sensor: Sensor,
+    options: &Options,
+) -> Option<&'a Evidence> {
+    nominal
+        .evidence
+        .iter()
+        .find(|e| e.sensor == sensor && e.counts(nominal.threshold, &options.floors))
+}
+
 /// Share of the normal score of a structure against one of an effect's own variables at or
 /// below which the sensor's named effects are taken to explain it: half the score is an eighth
 /// of the χ² statistic (the score grows as its cube root).
@@ -558,10 +566,7 @@ fn explains_its_own_variable(
     options: &Options,
 ) -> bool {
     let threshold = nominal.threshold;
-    let main = nominal
-        .evidence
-        .iter()
-        .find(|e| e.sensor == c.sensor && e.counts(threshold, &options.floors));
+    let main = main_structure(nominal, c.sensor, options);
     let own: Vec<Covariate> = c
         .effect
         .entry()

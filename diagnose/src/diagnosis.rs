@@ -1408,8 +1408,10 @@ fn encoders_over_truth(
         return Vec::new();
     }
     let latency = Effect::SensorLatency(Sensor::Odometer);
-    let (Some(hi), Ok(path)) = (
+    // Encoders late by up to the latency's bound, or leading by up to a slip gain's.
+    let (Some(late), Some(lead), Ok(path)) = (
         latency.params().first().map(|p| p.hi),
+        Effect::OdometerWheelSlip.params().first().map(|p| p.hi),
         Trajectory::new(truth),
     ) else {
         return Vec::new();
@@ -1418,7 +1420,7 @@ fn encoders_over_truth(
         &path,
         ctx.physics.declared().wheel_base_m,
         odometry,
-        (-hi, hi),
+        (-late, lead),
         SpanLimits::SPARSE_TRUTH,
     ) else {
         return Vec::new();

@@ -63,6 +63,11 @@ impl SpanLimits {
 /// Consecutive spans of one block; blocks alternate between the training and the held-out
 /// halves (a turn lasts seconds, and its spans share its skid).
 const BLOCK_SPANS: usize = 4;
+/// How many parts of the log in time the delay is also read without, one at a time: a
+/// logger's stamps whose lag wanders over minutes (the Intel lab's encoders lead its scans by
+/// 0.11 s in its first quarter and 0.29 s in its last) give a delay no more certain than its
+/// parts agree, which blocks of a few spans do not see.
+const PARTS: usize = 8;
 /// The delay profile's grid step, seconds (a quarter of the catalogue's least delay drawn).
 const GRID_STEP_S: f64 = 0.005;
 /// Huber's k, in an equation's noise.
@@ -146,29 +151,82 @@ struct Span {
     held_out: bool,
 }
 
+/// How the encoders' travel is read at their stamps moved by a delay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Shift {
+    /// Between readings, linearly: exact where their stamps are.
+    Interpolated,
+    /// The travel at the unmoved stamp less the delay times the wheels' speed halfway through
+    /// it ([`crate::stamps::wheel_speeds`]), the midpoint rule, whose error is the delay's cube.
+    /// For a path stamped at the encoders' own readings (a CARMEN log's poses): it is read
+    /// exactly at no delay and, at any other, between readings whose stamps may scatter by
+    /// tenths of a second about when they counted, so the interpolated profile would have its
+    /// minimum at no delay whatever the lead.
+    ThroughSpeed,
+}
+
+impl Shift {
+    /// Through the speed when most of the path's stamps are the encoders' own readings' (a
+    /// logger's poses stamped with the readings they were taken at) and those are stamped in
+    /// bursts or scatter by more than the profile's grid step about when they counted
+    /// (`stamps.rs`), else interpolated.
+    fn for_stamps(path_times: &[f64], odometry: &[OdometrySample]) -> Self {
+        let scatters = crate::stamps::stamped_in_bursts(odometry)
+            || crate::stamps::encoder_scatter_s(odometry).is_some_and(|s| s > GRID_STEP_S);
+        let shared = path_times
+            .iter()
+            .filter(|&&t| {
+                let k = odometry.partition_point(|o| o.t_s < t);
+                odometry.get(k).is_some_and(|o| o.t_s == t)
+            })
+            .count();
+        if scatters && 2 * shared > path_times.len() {
+            Self::ThroughSpeed
+        } else {
+            Self::Interpolated
+        }
+    }
+}
+
 /// The encoders' travel apart (right less left) and mean travel over each span, its stamps
-/// moved `delay_s` earlier; linear between readings.
-fn encoder_travel(odometry: &[OdometrySample], spans: &[Span], delay_s: f64) -> Vec<[f64; 2]> {
+/// moved `delay_s` earlier as `shift` reads them.
+fn encoder_travel(
+    odometry: &[OdometrySample],
+    spans: &[Span],
+    delay_s: f64,
+    shift: Shift,
+) -> Vec<[f64; 2]> {
     let at = |t: f64| -> [f64; 2] {
+        let read_at = match shift {
+            Shift::Interpolated => t - delay_s,
+            Shift::ThroughSpeed => t,
+        };
         let k = odometry
-            .partition_point(|o| o.t_s <= t)
+            .partition_point(|o| o.t_s <= read_at)
             .clamp(1, odometry.len() - 1);
         let (a, b) = (&odometry[k - 1], &odometry[k]);
         let dt = b.t_s - a.t_s;
         let u = if dt > 0.0 {
-            ((t - a.t_s) / dt).clamp(0.0, 1.0)
+            ((read_at - a.t_s) / dt).clamp(0.0, 1.0)
         } else {
             1.0
         };
-        [
+        let travel = [
             a.left_m + u * (b.left_m - a.left_m),
             a.right_m + u * (b.right_m - a.right_m),
-        ]
+        ];
+        match shift {
+            Shift::Interpolated => travel,
+            Shift::ThroughSpeed => {
+                let v = crate::stamps::wheel_speeds(odometry, t - 0.5 * delay_s);
+                [travel[0] - delay_s * v[0], travel[1] - delay_s * v[1]]
+            }
+        }
     };
     spans
         .iter()
         .map(|s| {
-            let (a, b) = (at(s.from_s - delay_s), at(s.to_s - delay_s));
+            let (a, b) = (at(s.from_s), at(s.to_s));
             let (left, right) = (b[0] - a[0], b[1] - a[1]);
             [right - left, 0.5 * (right + left)]
         })
@@ -217,8 +275,16 @@ fn spans(
         start = k;
         (turn, forward) = (0.0, 0.0);
     }
-    for (i, s) in out.iter_mut().enumerate() {
-        s.held_out = (i / BLOCK_SPANS) % 2 == 1;
+    // Blocks of BLOCK_SPANS spans' median duration from the path's start, in time rather than
+    // by count, so that the spans the delays' reach leaves out at the log's ends do not move
+    // every later span from one half to the other.
+    let mut durations: Vec<f64> = out.iter().map(|s| s.to_s - s.from_s).collect();
+    if !durations.is_empty() {
+        let block_s = BLOCK_SPANS as f64 * median(&mut durations);
+        let start_s = times.first().copied().unwrap_or(0.0);
+        for s in &mut out {
+            s.held_out = ((s.from_s - start_s) / block_s).floor() as i64 % 2 == 1;
+        }
     }
     out
 }
@@ -415,6 +481,50 @@ fn jackknife_sd(without: &[f64]) -> f64 {
     ((n - 1.0) / n * spread).sqrt()
 }
 
+/// How far from the delay read on every span the delay without a part is looked for, seconds:
+/// a part left out moves the delay by the lag its own spans read over the number of parts, and
+/// a minimum farther off is another one of the profile's (the scatter's aliases, not a lag).
+const PART_REACH_S: f64 = 0.1;
+
+/// The delay's standard error by the delete-a-part jackknife over [`PARTS`] parts of the
+/// training spans in time: the profile's minimum on all but each part, within [`PART_REACH_S`]
+/// of `delay_s`, the minimum on all. Infinite with fewer spans than parts.
+fn parts_jackknife_sd(
+    y: &[f64],
+    turn_train: &[Vec<[f64; 2]>],
+    grid: &[f64],
+    noise: f64,
+    delay_s: f64,
+) -> f64 {
+    if y.len() < PARTS {
+        return f64::INFINITY;
+    }
+    let near: Vec<usize> = (0..grid.len())
+        .filter(|&j| (grid[j] - delay_s).abs() <= PART_REACH_S)
+        .collect();
+    let near_grid: Vec<f64> = near.iter().map(|&j| grid[j]).collect();
+    let part_len = y.len().div_ceil(PARTS);
+    let without: Vec<f64> = (0..PARTS)
+        .map(|k| {
+            let keep = |i: &usize| i / part_len != k;
+            let y: Vec<f64> = (0..y.len()).filter(keep).map(|i| y[i]).collect();
+            let profile: Vec<f64> = near
+                .iter()
+                .map(|&j| {
+                    let x = &turn_train[j];
+                    let x: Vec<[f64; 2]> = (0..x.len()).filter(keep).map(|i| x[i]).collect();
+                    loss(
+                        &robust_fit(&y, &x, noise, [None, None]).residuals(&y, &x),
+                        noise,
+                    )
+                })
+                .collect();
+            profile_minimum(&profile, &near_grid).0
+        })
+        .collect();
+    jackknife_sd(&without)
+}
+
 /// The delay's standard error by the block sandwich (Huber's, with the scores summed within
 /// blocks of [`BLOCK_SPANS`] spans as Künsch 1989 sums them): `√J / H`, `H` the profile's
 /// `curvature` at the minimum and `J` the sum over blocks of the square of their spans' score,
@@ -475,10 +585,17 @@ pub(crate) fn fit(
         return None;
     }
     let turns = |spans: &[Span]| spans.iter().map(|s| s.turn_m).collect::<Vec<f64>>();
+    let shift = Shift::for_stamps(path.times(), odometry);
     // The turn equation `s·Δ + c·f` and the travel equation `k·f`, at a delay.
     let turn_at = |delay_s: f64| Equation {
-        train: (turns(&train), encoder_travel(odometry, &train, delay_s)),
-        held: (turns(&held), encoder_travel(odometry, &held, delay_s)),
+        train: (
+            turns(&train),
+            encoder_travel(odometry, &train, delay_s, shift),
+        ),
+        held: (
+            turns(&held),
+            encoder_travel(odometry, &held, delay_s, shift),
+        ),
     };
     let free = [None, None];
     let steps = ((delays.1 - delays.0) / GRID_STEP_S).round().max(1.0) as usize;
@@ -487,7 +604,7 @@ pub(crate) fn fit(
         .collect();
     let turn_train: Vec<Vec<[f64; 2]>> = grid
         .iter()
-        .map(|&d| encoder_travel(odometry, &train, d))
+        .map(|&d| encoder_travel(odometry, &train, d, shift))
         .collect();
     let y = turns(&train);
     // The profile's minimum in a fixed noise: first the noise under no delay, then under the
@@ -521,14 +638,22 @@ pub(crate) fn fit(
     } else {
         f64::INFINITY
     };
-    let delay_sd_s = curvature_sd_s.max(block_sandwich_sd(
-        &y,
-        &turn_train,
-        nearest_j(delay_s),
-        grid.get(1).map_or(GRID_STEP_S, |g| g - grid[0]),
-        turn_noise,
-        curvature,
-    ));
+    let delay_sd_s = curvature_sd_s
+        .max(block_sandwich_sd(
+            &y,
+            &turn_train,
+            nearest_j(delay_s),
+            grid.get(1).map_or(GRID_STEP_S, |g| g - grid[0]),
+            turn_noise,
+            curvature,
+        ))
+        .max(parts_jackknife_sd(
+            &y,
+            &turn_train,
+            &grid,
+            turn_noise,
+            delay_s,
+        ));
     let (turn, on_time) = (turn_at(delay_s), turn_at(0.0));
     let full_turn = turn.fit(turn_noise, free);
     let [s, c] = full_turn.coef;
@@ -538,7 +663,7 @@ pub(crate) fn fit(
     // encoders' by a skid that does not cancel between neighbours (the rover's spans: 39 mm
     // each, their correlation −0.09), so its error is that noise over the root of the spans.
     let ratio = |spans: &[Span]| {
-        let encoders_m: f64 = encoder_travel(odometry, spans, delay_s)
+        let encoders_m: f64 = encoder_travel(odometry, spans, delay_s, shift)
             .iter()
             .map(|t| t[1])
             .sum();
@@ -551,7 +676,7 @@ pub(crate) fn fit(
     let travel_of = |spans: &[Span]| -> (Vec<f64>, Vec<[f64; 2]>) {
         (
             spans.iter().map(|s| s.forward_m).collect(),
-            encoder_travel(odometry, spans, delay_s)
+            encoder_travel(odometry, spans, delay_s, shift)
                 .iter()
                 .map(|t| [t[1], 0.0])
                 .collect(),
@@ -776,6 +901,87 @@ mod tests {
             SpanLimits::SCANS
         )
         .is_none());
+    }
+
+    /// A logger that stamps as it receives (the Intel lab's CARMEN log): the encoders count
+    /// every 0.1 s and arrive in bursts 0.1–0.6 s apart, each stamped on arrival, and every
+    /// twentieth reading's stamp is also a truth pose's, the robot's pose `lead_s` before that
+    /// reading counted. The encoders leading the truth by 80 ms are read so within 15 ms (the
+    /// stamps' half second of lag is shared by both, so only the lead is left) and named; on
+    /// time they are not told from on time. Interpolated between the bursts' stamps instead,
+    /// the lead of 80 ms is read at the search's end, 0.3 s: the encoders are exact at the
+    /// truth's own stamps only.
+    #[test]
+    fn a_lead_is_read_against_a_truth_stamped_at_the_encoders_bursts() {
+        let read = |lead_s: f64| {
+            let rate = |t: f64| 0.8 * (0.7 * t).sin() + 0.3 * (1.9 * t).sin();
+            let dt = 0.001;
+            let (mut x, mut y, mut heading, mut left, mut right) = (0.0_f64, 0.0, 0.0, 0.0, 0.0);
+            // The motion at every step, to read a pose `lead_s` before a count.
+            let mut poses: Vec<(f64, f64, f64)> = Vec::new();
+            let mut odometry = Vec::new();
+            let mut truth = Vec::new();
+            let lead_steps = (lead_s / dt).round() as usize;
+            // Deliveries 0.1–0.6 s apart (a linear congruential sequence); a reading is stamped
+            // at the first at or after its count, a millisecond after the one before it there.
+            let mut state = 7_u64;
+            let mut delivery_s = 0.0;
+            let mut in_burst = 0.0;
+            for i in 0..600_000_usize {
+                let t = i as f64 * dt;
+                poses.push((x, y, heading));
+                if i % 100 == 0 {
+                    let k = i / 100;
+                    if delivery_s < t {
+                        while delivery_s < t {
+                            state = state
+                                .wrapping_mul(6_364_136_223_846_793_005)
+                                .wrapping_add(1_442_695_040_888_963_407);
+                            delivery_s += 0.1 + 0.5 * (state >> 11) as f64 / (1u64 << 53) as f64;
+                        }
+                        in_burst = 0.0;
+                    }
+                    let stamp_s = delivery_s + 0.001 * in_burst;
+                    in_burst += 1.0;
+                    odometry.push(OdometrySample {
+                        t_s: stamp_s,
+                        left_m: left,
+                        right_m: right,
+                    });
+                    if k % 20 == 0 && i >= lead_steps {
+                        let (px, py, pyaw) = poses[i - lead_steps];
+                        truth.push(TruthSample {
+                            t_s: stamp_s,
+                            x_m: px,
+                            y_m: py,
+                            yaw_rad: pyaw,
+                        });
+                    }
+                }
+                let turn = rate(t) * dt;
+                heading += turn;
+                x += 0.5 * dt * heading.cos();
+                y += 0.5 * dt * heading.sin();
+                left += 0.5 * dt - 0.5 * turn * WHEEL_BASE_M;
+                right += 0.5 * dt + 0.5 * turn * WHEEL_BASE_M;
+            }
+            fit(
+                &Trajectory::new(&truth).unwrap(),
+                WHEEL_BASE_M,
+                &odometry,
+                (-0.3, 0.3),
+                SpanLimits::SPARSE_TRUTH,
+            )
+            .unwrap()
+        };
+        let leading = read(0.08);
+        let delay = &leading.delay_s;
+        assert!((delay.value[0] - 0.08).abs() < 0.015, "{leading:?}");
+        assert!(delay.departs && delay.heldout_gain > 10.0, "{leading:?}");
+        let on_time = read(0.0);
+        let delay = &on_time.delay_s;
+        assert!(delay.value[0].abs() < 0.015, "{on_time:?}");
+        assert!(!delay.departs || delay.heldout_gain < 10.0, "{on_time:?}");
     }
 
     /// Against a truth of a pose every 2 s (a CARMEN logger's), encoders read at 10 Hz whose

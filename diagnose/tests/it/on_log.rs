@@ -370,7 +370,7 @@ fn encoder_leads_within_their_stamps_scatter_are_not_concealed() {
     }
 }
 
-/// Three times round a 1.5 m by 1 m loop of the room at 0.3 m/s, with its truth and its
+/// Six times round a 1.5 m by 1 m loop of the room at 0.3 m/s, with its truth and its
 /// commands left out of the recording: a robot's own log, diagnosed along its scans' own
 /// matches against the scenario's world.
 fn loops() -> (Scenario, Recording) {
@@ -388,7 +388,7 @@ fn loops_with_truth() -> (Scenario, Recording) {
         "name = \"loops\"\nseed = 7\n\n{ROOM_4X3}\n[robot]\nstart = {{ x = 0.8, y = 0.8, yaw_deg = 0.0 }}\n\
          wheel_base_m = 0.23\nturn_rate_deg_s = 60.0\n\n{}\n[sensors.lidar]\n\
          noise = [0.003, 0.0, 0.002]\n[sensors.odometer]\nnoise_m = 0.002\n",
-        [side(1.5), side(1.0)].concat().repeat(6)
+        [side(1.5), side(1.0)].concat().repeat(12)
     );
     let loops = Scenario::from_toml(&text, Path::new("loops.toml")).expect("the test's scenario");
     let mut recording = Emulation::new(&loops, 7)
@@ -466,7 +466,7 @@ fn against_a_sparse_truth_a_late_encoder_is_read_through_its_stamps_scatter() {
 
 /// A run without truth and without commands is diagnosed along its scans' own matches: a
 /// lidar turned 3° on its mount moves that path sideways, and is named from it within the
-/// self-test's 20 %. The sideways motion is read over the path's travel (15 m here), in steps
+/// self-test's 20 %. The sideways motion is read over the path's travel (30 m here), in steps
 /// of 15 cm.
 #[test]
 fn without_truth_or_commands_a_turned_lidar_is_named_from_the_path_moving_sideways() {
@@ -494,8 +494,8 @@ fn without_truth_or_commands_a_turned_lidar_is_named_from_the_path_moving_sidewa
 /// Along the scans' own matches the encoders are judged span by span: a lidar stamped 60 ms
 /// late turns 60 ms after the encoders do, and wheels 6 % farther apart count 6 % more travel
 /// apart for each turn. Both are named, each within the self-test's 20 % of what the log
-/// without them reads (the simulator's encoders already read 17 ms ahead of its lidar, short of
-/// the 10 nats that name it, and the declared base 0.5 % narrow). The loops' 24 turns of 90°
+/// without them reads (the simulator's encoders already read a little ahead of its lidar, short
+/// of the 10 nats that name it, and the declared base is a little narrow). The loops' 48 turns of 90°
 /// start and stop at 60°/s, which is where a delay shows.
 #[test]
 fn without_truth_or_commands_a_late_lidar_and_the_wheel_base_are_read_from_the_paths_spans() {

@@ -119,13 +119,13 @@ impl Concealment {
                 time_constant_s,
             } => vec![coefficient_per_m, time_constant_s, offset_m],
             Self::MountYaw { yaw_deg } => vec![yaw_deg, 0.0, 0.0],
-            // Head-on the catalogue's logistic in log power with spread s is `1 / (1 + (R/d)^(2/s))`
-            // (power falls as d⁻²).
+            // The catalogue's logistic in log power with spread s is `1 / (1 + (R/d)^(2/s))`
+            // (power falls as d⁻²), at any incidence with its incidence power 0.
             Self::LidarLoss {
                 half_loss_range_m,
                 steepness,
                 ..
-            } => vec![half_loss_range_m, 2.0 / steepness],
+            } => vec![half_loss_range_m, 2.0 / steepness, 0.0],
         }
     }
 
@@ -684,27 +684,34 @@ mod tests {
             braking_gain_s: 0.0,
         };
         assert_eq!(c.catalogue_params(), vec![0.05, 0.0]);
-        // A loss by range is the catalogue's head-on on its reference surface.
+        // A loss by range is the catalogue's on its reference surface at any incidence.
         let c = Concealment::LidarLoss {
             half_loss_range_m: 5.0,
             steepness: 4.0,
             seed: 0,
         };
         let params = c.catalogue_params();
-        assert_eq!(params, vec![5.0, 0.5]);
+        assert_eq!(params, vec![5.0, 0.5, 0.0]);
         let catalogue = hilsim_sim::scenario::LidarDropout {
             half_loss_range_m: params[0],
             log_power_spread: params[1],
+            incidence_power: params[2],
             reference: 0.8,
         };
         for range_m in [2.0, 5.0, 9.0] {
             let by_range = 1.0 / (1.0 + (5.0_f64 / range_m).powf(4.0));
-            let head_on =
-                hilsim_lidar_emulator::effects::dropout_probability(&catalogue, range_m, 1.0, 0.8);
-            assert!(
-                (by_range - head_on).abs() < 1e-12,
-                "{range_m}: {by_range} {head_on}"
-            );
+            for cos_incidence in [1.0, 0.3] {
+                let catalogue = hilsim_lidar_emulator::effects::dropout_probability(
+                    &catalogue,
+                    range_m,
+                    cos_incidence,
+                    0.8,
+                );
+                assert!(
+                    (by_range - catalogue).abs() < 1e-12,
+                    "{range_m} at {cos_incidence}: {by_range} {catalogue}"
+                );
+            }
         }
     }
 }

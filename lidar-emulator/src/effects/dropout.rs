@@ -10,24 +10,34 @@
 //! scatter (speckle, exposure control) logistic in its logarithm with scale s, the chance that a
 //! reading is lost is the logistic of the threshold's excess over the expected log power:
 //! `1 / (1 + e^{−z/s})`, `z = 2 ln(d / d½) − ln cos θ − ln(ρ / ρ_ref)`, d½ the range at which
-//! half are lost head-on on a surface of reflectivity `ρ_ref`.
+//! half are lost head-on on a surface of reflectivity `ρ_ref`. A surface that is not diffuse
+//! returns `cos^m θ` instead (m the dropout's `incidence_power`: above 1 a glossy one's lobe;
+//! 0 a unit whose gain is set so that the range alone decides).
 
 use hilsim_sim::scenario::LidarDropout;
 
 /// The chance that a reading of a surface of reflectivity `reflectivity` at `range_m`, met at
-/// `|cos θ|` = `cos_incidence`, is lost under `dropout`. A return with no power (`cos θ` or ρ
-/// of 0) is always lost; a range of 0 never.
+/// `|cos θ|` = `cos_incidence`, is lost under `dropout`. A return with no power (ρ of 0, or
+/// `cos θ` of 0 when the power falls with the incidence) is always lost; a range of 0 never.
 ///
 /// ```
 /// use hilsim_lidar_emulator::effects::dropout_probability;
 /// use hilsim_sim::scenario::LidarDropout;
-/// let d = LidarDropout { half_loss_range_m: 4.0, log_power_spread: 0.3, reference: 0.8 };
+/// let d = LidarDropout {
+///     half_loss_range_m: 4.0,
+///     log_power_spread: 0.3,
+///     reference: 0.8,
+///     incidence_power: 1.0,
+/// };
 /// assert!((dropout_probability(&d, 4.0, 1.0, 0.8) - 0.5).abs() < 1e-12);
 /// // Twice as far is a quarter of the power, as is a quarter of the reflectivity.
 /// let far = dropout_probability(&d, 8.0, 1.0, 0.8);
 /// assert!((far - dropout_probability(&d, 4.0, 1.0, 0.2)).abs() < 1e-12);
 /// assert!(far > 0.98);
 /// assert!(dropout_probability(&d, 4.0, 0.5, 0.8) > 0.9);
+/// // Lost by the range alone: half at 4 m, whatever the incidence.
+/// let by_range = LidarDropout { incidence_power: 0.0, ..d };
+/// assert!((dropout_probability(&by_range, 4.0, 0.5, 0.8) - 0.5).abs() < 1e-12);
 /// ```
 #[must_use]
 pub fn dropout_probability(
@@ -36,7 +46,8 @@ pub fn dropout_probability(
     cos_incidence: f64,
     reflectivity: f64,
 ) -> f64 {
-    let power = reflectivity / dropout.reference * cos_incidence.abs()
+    let power = reflectivity / dropout.reference
+        * cos_incidence.abs().powf(dropout.incidence_power)
         / (range_m / dropout.half_loss_range_m).powi(2);
     if power.is_nan() || power <= 0.0 {
         return 1.0;
@@ -58,6 +69,7 @@ mod tests {
             half_loss_range_m: 5.0,
             log_power_spread: 0.25,
             reference: 0.8,
+            incidence_power: 1.0,
         };
         let logistic = |x: f64| 1.0 / (1.0 + (-x).exp());
         let near = dropout_probability(&d, 5.0 * (-0.25f64).exp(), 1.0, 0.8);

@@ -444,6 +444,7 @@ fn dropout_loses_readings_by_returned_power_and_keeps_the_rest_as_they_were() {
         half_loss_range_m: 3.5,
         log_power_spread: 0.3,
         reference: 0.8,
+        incidence_power: 1.0,
     };
     dropping.effects.lidar_dropout = Some(dropout);
     let (a, b) = (lidar(&nominal), lidar(&dropping));

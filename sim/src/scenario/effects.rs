@@ -337,7 +337,8 @@ impl RangeBias {
 /// reading-to-reading scatter logistic in its logarithm, the chance a reading is lost is
 /// `1 / (1 + e^{−z/s})`, `z = 2 ln(d / d½) − ln cos θ − ln(ρ / ρ_ref)`: half are lost at
 /// `half_loss_range_m` on a surface of the reference reflectivity met head-on, nearer at
-/// grazing incidence and on darker surfaces.
+/// grazing incidence and on darker surfaces. A surface that is not diffuse returns `cos^m θ`
+/// (`incidence_power` m): `z = 2 ln(d / d½) − m ln cos θ − ln(ρ / ρ_ref)`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LidarDropout {
@@ -351,8 +352,18 @@ pub struct LidarDropout {
     /// strength reference).
     #[serde(default = "default_dropout_reference")]
     pub reference: f64,
+    /// How the returned power falls with the incidence θ, as `cos^m θ`: 1 (the default) a
+    /// diffuse surface's (Lambert's law), 0 a unit whose losses the range alone sets (its gain
+    /// set for its surfaces), above 1 a glossy surface's, whose return falls faster off the
+    /// normal.
+    #[serde(default = "default_dropout_incidence_power")]
+    pub incidence_power: f64,
 }
 
 fn default_dropout_reference() -> f64 {
     0.8
+}
+
+fn default_dropout_incidence_power() -> f64 {
+    1.0
 }

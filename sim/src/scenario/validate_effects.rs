@@ -194,6 +194,13 @@ pub(super) fn validate(s: &Scenario) -> Check {
         positive_up_to(p("half_loss_range_m"), x.half_loss_range_m, 100.0, "metres")?;
         positive_up_to(p("log_power_spread"), x.log_power_spread, 5.0, "a spread")?;
         positive_up_to(p("reference"), x.reference, 1.0, "a reflectivity")?;
+        within(
+            p("incidence_power"),
+            x.incidence_power,
+            0.0,
+            4.0,
+            "an exponent",
+        )?;
     }
     Ok(())
 }

@@ -5,7 +5,7 @@
 use hilsim_sim::scenario::{self, Effects};
 
 use super::super::entry::{Entry, Variable};
-use super::super::params::{log, ParamSpec, SelfTestRange as R};
+use super::super::params::{lin, log, ParamSpec, SelfTestRange as R};
 use super::super::sensor::Sensor;
 use super::lidar_reflectivity::REFERENCE_REFLECTIVITY;
 
@@ -41,14 +41,20 @@ impl Entry for LidarDropout {
     }
 
     /// The self-test draws a half-loss range of [3, 5] m and a spread of [0.15, 0.4], both
-    /// unscaled.
+    /// unscaled, on a diffuse surface (incidence power 1).
     fn params(&self) -> &'static [ParamSpec] {
         // The range at which half the returns are lost head-on on the reference surface over
         // 0.5–50 m on a log grid (a unit that loses half at 50 m loses nothing a room shows),
         // the spread of the returned log power over 0.05–2 (the loss rising from 12 % to 88 %
         // over a factor 1.1 to 55 of range). The loss chance is smooth in both, so the
         // Bernoulli likelihood is unimodal between grid points.
-        const DROPOUT: [ParamSpec; 2] = [
+        //
+        // How the power falls with the incidence, `cos^m θ`, over m in [0, 2] on a 0.5 grid:
+        // 1 Lambert's diffuse surface (a triangulation unit's spot on paint or plaster), 0 a
+        // unit whose losses the range alone sets (a gain set for its surfaces, a time-of-flight
+        // unit's range gate), 2 a glossy surface whose lobe falls off the normal faster
+        // (Phong, "Illumination for computer generated pictures", CACM 18(6), 1975).
+        const DROPOUT: [ParamSpec; 3] = [
             log(
                 "half_loss_range_m",
                 "m",
@@ -65,13 +71,21 @@ impl Entry for LidarDropout {
                 R::uniform(0.15, 0.4).unscaled(),
             )
             .form(),
+            lin(
+                "incidence_power",
+                "",
+                (0.0, 2.0),
+                5,
+                R::zero().around(1.0, 0.0, 2.0),
+            )
+            .form(),
         ];
         &DROPOUT
     }
 
     fn absent(&self, _: f64) -> Vec<f64> {
-        // Half the returns lost only at the search's far end.
-        vec![50.0, 0.3]
+        // Half the returns lost only at the search's far end, on a diffuse surface.
+        vec![50.0, 0.3, 1.0]
     }
 
     /// Half the returns lost nearer than 40 m head-on (at the search's far end of 50 m a
@@ -89,17 +103,39 @@ impl Entry for LidarDropout {
             half_loss_range_m: p(0),
             log_power_spread: p(1),
             reference: REFERENCE_REFLECTIVITY,
+            incidence_power: params.get(2).copied().unwrap_or(1.0),
         });
     }
 
     fn explanation(&self, params: &[f64], _: f64) -> String {
         let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
+        let incidence_power = params.get(2).copied().unwrap_or(1.0);
+        // Within half the fit's 0.5 grid step of a form.
+        let (head_on, incidence) = if incidence_power < 0.25 {
+            (
+                "",
+                "whatever the incidence (the range alone sets the loss: the shape differs from \
+                 the catalogue's diffuse surface),"
+                    .to_string(),
+            )
+        } else if (incidence_power - 1.0).abs() < 0.25 {
+            (" head-on", "nearer at grazing incidence".to_string())
+        } else {
+            (
+                " head-on",
+                format!(
+                    "nearer at grazing incidence (the power falling as cos^{incidence_power:.1} \
+                     of it: the shape differs from the catalogue's diffuse surface),"
+                ),
+            )
+        };
         format!(
             "The simulated lidar reads every surface within its range; the real one loses \
-             returns too weak to range: half of them at {:.1} m head-on on a surface of \
-             reflectivity {REFERENCE_REFLECTIVITY}, nearer at grazing incidence and on darker \
-             surfaces (head-on, from 12 % lost at {:.1} m to 88 % at {:.1} m).",
+             returns too weak to range: half of them at {:.1} m{head_on} on a surface of \
+             reflectivity {REFERENCE_REFLECTIVITY}, {incidence} and nearer on darker surfaces \
+             ({}from 12 % lost at {:.1} m to 88 % at {:.1} m).",
             p(0),
+            if head_on.is_empty() { "" } else { "head-on, " },
             p(0) * (-p(1)).exp(),
             p(0) * p(1).exp()
         )

@@ -49,10 +49,13 @@ fn an_interrupted_dataset_resumes_to_the_uninterrupted_one() {
     for r in [2, 5, 6, 9] {
         fs::remove_dir_all(dir.join(format!("run-{r:06}"))).unwrap();
     }
-    let half = dir.join(".run-000005.tmp.4242");
+    // Left by a writer that is gone: its pid above Linux's largest (2^22), which no live
+    // process has (a small pid may be a live process's on a busy machine, and its temporaries
+    // are then left alone as another writer's).
+    let half = dir.join(".run-000005.tmp.4194305");
     fs::create_dir(&half).unwrap();
     fs::write(half.join("lidar.csv"), "t_s,rev\n0.1,").unwrap();
-    fs::write(dir.join(".manifest.csv.tmp.4242"), "run,se").unwrap();
+    fs::write(dir.join(".manifest.csv.tmp.4194305"), "run,se").unwrap();
     let manifest = fs::read_to_string(dir.join("manifest.csv")).unwrap();
     let stale: String = manifest.lines().take(3).map(|l| format!("{l}\n")).collect();
     fs::write(dir.join("manifest.csv"), stale).unwrap();

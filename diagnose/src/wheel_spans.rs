@@ -65,8 +65,8 @@ impl SpanLimits {
 const BLOCK_SPANS: usize = 4;
 /// How many parts of the log in time the delay is also read without, one at a time: a
 /// logger's stamps whose lag wanders over minutes (the Intel lab's encoders lead its scans by
-/// 0.11 s in its first quarter and 0.29 s in its last) give a delay no more certain than its
-/// parts agree, which blocks of a few spans do not see.
+/// 0.16 s over its first half and 0.26 s over its second) give a delay no more certain than
+/// its parts agree, which blocks of a few spans do not see.
 const PARTS: usize = 8;
 /// The delay profile's grid step, seconds (a quarter of the catalogue's least delay drawn).
 const GRID_STEP_S: f64 = 0.005;
@@ -217,6 +217,7 @@ fn encoder_travel(
         ];
         match shift {
             Shift::Interpolated => travel,
+            Shift::ThroughSpeed if delay_s == 0.0 => travel,
             Shift::ThroughSpeed => {
                 let v = crate::stamps::wheel_speeds(odometry, t - 0.5 * delay_s);
                 [travel[0] - delay_s * v[0], travel[1] - delay_s * v[1]]
@@ -909,8 +910,8 @@ mod tests {
     /// reading counted. The encoders leading the truth by 80 ms are read so within 15 ms (the
     /// stamps' half second of lag is shared by both, so only the lead is left) and named; on
     /// time they are not told from on time. Interpolated between the bursts' stamps instead,
-    /// the lead of 80 ms is read at the search's end, 0.3 s: the encoders are exact at the
-    /// truth's own stamps only.
+    /// the lead of 80 ms is read as none (1 ms): the encoders are exact at the truth's own
+    /// stamps only, so the profile's minimum sits there.
     #[test]
     fn a_lead_is_read_against_a_truth_stamped_at_the_encoders_bursts() {
         let read = |lead_s: f64| {

@@ -111,33 +111,53 @@ impl Entry for LidarDropout {
         let p = |i: usize| params.get(i).copied().unwrap_or(f64::NAN);
         let incidence_power = params.get(2).copied().unwrap_or(1.0);
         // Within half the fit's 0.5 grid step of a form.
-        let (head_on, incidence) = if incidence_power < 0.25 {
-            (
-                "",
-                "whatever the incidence (the range alone sets the loss: the shape differs from \
-                 the catalogue's diffuse surface),"
-                    .to_string(),
-            )
+        let by_range_alone = incidence_power < 0.25;
+        let nearer = if by_range_alone {
+            "whatever the incidence (the range alone sets the loss: the shape differs from the \
+             catalogue's diffuse surface), and nearer on darker surfaces"
+                .to_string()
         } else if (incidence_power - 1.0).abs() < 0.25 {
-            (" head-on", "nearer at grazing incidence".to_string())
+            "nearer at grazing incidence and on darker surfaces".to_string()
         } else {
-            (
-                " head-on",
-                format!(
-                    "nearer at grazing incidence (the power falling as cos^{incidence_power:.1} \
-                     of it: the shape differs from the catalogue's diffuse surface),"
-                ),
+            format!(
+                "nearer at grazing incidence (the power falling as cos^{incidence_power:.1} of \
+                 it: the shape differs from the catalogue's diffuse surface) and on darker \
+                 surfaces"
             )
         };
+        let head_on = if by_range_alone { "" } else { " head-on" };
         format!(
             "The simulated lidar reads every surface within its range; the real one loses \
              returns too weak to range: half of them at {:.1} m{head_on} on a surface of \
-             reflectivity {REFERENCE_REFLECTIVITY}, {incidence} and nearer on darker surfaces \
-             ({}from 12 % lost at {:.1} m to 88 % at {:.1} m).",
+             reflectivity {REFERENCE_REFLECTIVITY}, {nearer} ({}from 12 % lost at {:.1} m to \
+             88 % at {:.1} m).",
             p(0),
-            if head_on.is_empty() { "" } else { "head-on, " },
+            if by_range_alone { "" } else { "head-on, " },
             p(0) * (-p(1)).exp(),
             p(0) * p(1).exp()
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sentence says the loss's form: by the range alone (no "head-on"), the catalogue's
+    /// diffuse surface (no departure said), a glossy one's power.
+    #[test]
+    fn the_sentence_says_how_the_loss_depends_on_the_incidence() {
+        let said = |m: f64| LidarDropout.explanation(&[4.0, 0.3, m], 0.0);
+        let by_range = said(0.1);
+        assert!(by_range.contains("whatever the incidence"), "{by_range}");
+        assert!(!by_range.contains("head-on"), "{by_range}");
+        let diffuse = said(1.0);
+        assert!(diffuse.contains("4.0 m head-on"), "{diffuse}");
+        assert!(!diffuse.contains("shape differs"), "{diffuse}");
+        let glossy = said(2.0);
+        assert!(
+            glossy.contains("cos^2.0") && glossy.contains("shape differs"),
+            "{glossy}"
+        );
     }
 }

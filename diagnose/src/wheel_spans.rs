@@ -152,40 +152,93 @@ struct Span {
 }
 
 /// How the encoders' travel is read at their stamps moved by a delay.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Shift {
     /// Between readings, linearly: exact where their stamps are.
     Interpolated,
-    /// The travel at the unmoved stamp less the delay times the wheels' speed halfway through
-    /// it ([`crate::stamps::wheel_speeds`]), the midpoint rule, whose error is the delay's cube.
-    /// For a path stamped at the encoders' own readings (a CARMEN log's poses): it is read
-    /// exactly at no delay and, at any other, between readings whose stamps may scatter by
-    /// tenths of a second about when they counted, so the interpolated profile would have its
-    /// minimum at no delay whatever the lead.
-    ThroughSpeed,
+    /// The travel at the path's stamp moved by `anchor_s` (where a reading is), less the rest
+    /// of the delay times the wheels' speed halfway through it
+    /// ([`crate::stamps::wheel_speeds`]), the midpoint rule, whose error is that rest's cube.
+    /// For a path stamped at the encoders' own readings, or at them a fixed time apart (a
+    /// CARMEN log's poses; the same after its encoders were re-stamped): it is read exactly
+    /// there and, at any other delay, between readings whose stamps may scatter by tenths of a
+    /// second about when they counted, so the interpolated profile would have its minimum where
+    /// the stamps meet whatever the lead.
+    ThroughSpeed { anchor_s: f64 },
 }
 
+/// How near two stamps are to be the same reading's, seconds: a microsecond, well above the
+/// rounding of a stamp moved by a delay in double precision (a nanosecond at a day's seconds)
+/// and well below any logger's time between readings.
+const SAME_STAMP_S: f64 = 1e-6;
+
+/// How many of the path's stamps are looked at to find the time its stamps are apart from the
+/// encoders' readings: enough that a half of them sharing one is no chance.
+const ANCHOR_PROBES: usize = 64;
+
 impl Shift {
-    /// Through the speed when most of the path's stamps are the encoders' own readings' (a
-    /// logger's poses stamped with the readings they were taken at) and those are stamped in
-    /// bursts or scatter by more than the profile's grid step about when they counted
-    /// (`stamps.rs`), else interpolated.
-    fn for_stamps(path_times: &[f64], odometry: &[OdometrySample]) -> Self {
+    /// Through the speed when most of the path's stamps are the encoders' own readings', or
+    /// theirs a fixed time apart ([`shared_offset_s`]), and those are stamped in bursts or
+    /// scatter by more than the profile's grid step about when they counted (`stamps.rs`),
+    /// else interpolated.
+    fn for_stamps(path_times: &[f64], odometry: &[OdometrySample], reach_s: f64) -> Self {
         let scatters = crate::stamps::stamped_in_bursts(odometry)
             || crate::stamps::encoder_scatter_s(odometry).is_some_and(|s| s > GRID_STEP_S);
-        let shared = path_times
-            .iter()
-            .filter(|&&t| {
-                let k = odometry.partition_point(|o| o.t_s < t);
-                odometry.get(k).is_some_and(|o| o.t_s == t)
-            })
-            .count();
-        if scatters && 2 * shared > path_times.len() {
-            Self::ThroughSpeed
-        } else {
-            Self::Interpolated
+        match shared_offset_s(path_times, odometry, reach_s) {
+            Some(anchor_s) if scatters => Self::ThroughSpeed { anchor_s },
+            _ => Self::Interpolated,
         }
     }
+}
+
+/// The time, within `reach_s` either way, by which more than half of `path_times` are each an
+/// encoder reading's stamp less it ([`SAME_STAMP_S`]): 0 for poses stamped with the readings
+/// they were taken at; a fixed time for the same after one of the two was re-stamped. Its
+/// candidates are the readings' stamps near [`ANCHOR_PROBES`] of the path's, spread over it.
+fn shared_offset_s(path_times: &[f64], odometry: &[OdometrySample], reach_s: f64) -> Option<f64> {
+    if path_times.is_empty() || odometry.is_empty() {
+        return None;
+    }
+    let step = (path_times.len() / ANCHOR_PROBES).max(1);
+    let mut candidates: Vec<f64> = path_times
+        .iter()
+        .step_by(step)
+        .flat_map(|&t| {
+            let from = odometry.partition_point(|o| o.t_s < t - reach_s);
+            odometry[from..]
+                .iter()
+                .take_while(move |o| o.t_s <= t + reach_s)
+                .map(move |o| o.t_s - t)
+        })
+        .collect();
+    candidates.sort_by(f64::total_cmp);
+    // The candidate with the most others within the tolerance, found in one pass; of equals
+    // the nearest to none (a logger's even grid repeats every multiple of its step).
+    let (mut best, mut best_n, mut from) = (f64::NAN, 0, 0);
+    for (to, &c) in candidates.iter().enumerate() {
+        while c - candidates[from] > SAME_STAMP_S {
+            from += 1;
+        }
+        let n = to + 1 - from;
+        if n > best_n || (n == best_n && candidates[from].abs() < best.abs()) {
+            (best, best_n) = (candidates[from], n);
+        }
+    }
+    let offset_s = best;
+    if best_n == 0 {
+        return None;
+    }
+    let shared = path_times
+        .iter()
+        .filter(|&&t| {
+            let at = t + offset_s;
+            let k = odometry.partition_point(|o| o.t_s < at - SAME_STAMP_S);
+            odometry
+                .get(k)
+                .is_some_and(|o| o.t_s <= at + 2.0 * SAME_STAMP_S)
+        })
+        .count();
+    (2 * shared > path_times.len()).then_some(offset_s)
 }
 
 /// The encoders' travel apart (right less left) and mean travel over each span, its stamps
@@ -197,12 +250,14 @@ fn encoder_travel(
     shift: Shift,
 ) -> Vec<[f64; 2]> {
     let at = |t: f64| -> [f64; 2] {
-        let read_at = match shift {
-            Shift::Interpolated => t - delay_s,
-            Shift::ThroughSpeed => t,
+        // Through the speed, from the last of the readings stamped at `t + anchor` (as at no
+        // anchor), however that sum rounds.
+        let (read_at, same_s) = match shift {
+            Shift::Interpolated => (t - delay_s, 0.0),
+            Shift::ThroughSpeed { anchor_s } => (t + anchor_s, SAME_STAMP_S),
         };
         let k = odometry
-            .partition_point(|o| o.t_s <= read_at)
+            .partition_point(|o| o.t_s <= read_at + same_s)
             .clamp(1, odometry.len() - 1);
         let (a, b) = (&odometry[k - 1], &odometry[k]);
         let dt = b.t_s - a.t_s;
@@ -217,10 +272,14 @@ fn encoder_travel(
         ];
         match shift {
             Shift::Interpolated => travel,
-            Shift::ThroughSpeed if delay_s == 0.0 => travel,
-            Shift::ThroughSpeed => {
-                let v = crate::stamps::wheel_speeds(odometry, t - 0.5 * delay_s);
-                [travel[0] - delay_s * v[0], travel[1] - delay_s * v[1]]
+            // From the reading at `t + anchor` back to `t − delay`.
+            Shift::ThroughSpeed { anchor_s } => {
+                let back_s = delay_s + anchor_s;
+                if back_s == 0.0 {
+                    return travel;
+                }
+                let v = crate::stamps::wheel_speeds(odometry, t + 0.5 * (anchor_s - delay_s));
+                [travel[0] - back_s * v[0], travel[1] - back_s * v[1]]
             }
         }
     };
@@ -586,7 +645,7 @@ pub(crate) fn fit(
         return None;
     }
     let turns = |spans: &[Span]| spans.iter().map(|s| s.turn_m).collect::<Vec<f64>>();
-    let shift = Shift::for_stamps(path.times(), odometry);
+    let shift = Shift::for_stamps(path.times(), odometry, delays.0.abs().max(delays.1));
     // The turn equation `s·Δ + c·f` and the travel equation `k·f`, at a delay.
     let turn_at = |delay_s: f64| Equation {
         train: (
@@ -608,27 +667,27 @@ pub(crate) fn fit(
         .map(|&d| encoder_travel(odometry, &train, d, shift))
         .collect();
     let y = turns(&train);
-    // The profile's minimum in a fixed noise: first the noise under no delay, then under the
-    // delay that one finds, so the loss is compared across delays in one scale.
+    // The profile's minimum in a fixed noise: first the noise with the readings as stamped,
+    // then under the delay that one finds, so the loss is compared across delays in one scale
+    // (and a stream re-stamped by a fixed time moves the minimum by that time, nothing else).
     let profile = |noise: f64| -> Vec<f64> {
         turn_train
             .iter()
             .map(|x| loss(&robust_fit(&y, x, noise, free).residuals(&y, x), noise))
             .collect()
     };
-    // The grid point at no delay (the search starts at or below it).
-    let on_time_j = grid
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-        .map_or(0, |(j, _)| j);
-    let first = profile_minimum(&profile(own_noise(&y, &turn_train[on_time_j], free)), &grid);
     let nearest_j = |d: f64| {
         grid.iter()
             .enumerate()
             .min_by(|a, b| (a.1 - d).abs().total_cmp(&(b.1 - d).abs()))
             .map_or(0, |(j, _)| j)
     };
+    let as_stamped_s = match shift {
+        Shift::Interpolated => 0.0,
+        Shift::ThroughSpeed { anchor_s } => -anchor_s,
+    };
+    let as_stamped = encoder_travel(odometry, &train, as_stamped_s, shift);
+    let first = profile_minimum(&profile(own_noise(&y, &as_stamped, free)), &grid);
     let turn_noise = own_noise(&y, &turn_train[nearest_j(first.0)], free);
     let (delay_s, curvature) = profile_minimum(&profile(turn_noise), &grid);
     // Its standard error: the larger of the profile's curvature's (the loss is a negative
@@ -904,6 +963,41 @@ mod tests {
         .is_none());
     }
 
+    /// The path's stamps are found to be the readings' own, or theirs a fixed time apart, when
+    /// more than half are; a path stamped between readings has no such time.
+    #[test]
+    fn a_path_stamped_at_the_readings_a_fixed_time_apart_is_found_so() {
+        let odometry: Vec<OdometrySample> = (0..200)
+            .map(|k| OdometrySample {
+                t_s: 1000.0 + 0.1 * k as f64 + 0.06 * ((k * k * 7919 % 1000) as f64 / 1000.0),
+                left_m: 0.0,
+                right_m: 0.0,
+            })
+            .collect();
+        let stamps = |offset_s: f64, every: usize| -> Vec<f64> {
+            odometry
+                .iter()
+                .step_by(every)
+                .map(|o| o.t_s - offset_s)
+                .collect()
+        };
+        assert_eq!(shared_offset_s(&stamps(0.0, 3), &odometry, 0.5), Some(0.0));
+        let found = shared_offset_s(&stamps(0.06, 3), &odometry, 0.5).expect("a fixed time");
+        assert!((found - 0.06).abs() < SAME_STAMP_S, "{found}");
+        assert_eq!(shared_offset_s(&stamps(0.7, 3), &odometry, 0.5), None);
+        let between: Vec<f64> = (0..60).map(|k| 1000.05 + 0.31 * k as f64).collect();
+        assert_eq!(shared_offset_s(&between, &odometry, 0.5), None);
+        // On an even grid every multiple of its step is shared alike: none is taken.
+        let grid: Vec<OdometrySample> = (0..200)
+            .map(|k| OdometrySample {
+                t_s: 0.125 * k as f64,
+                ..odometry[0]
+            })
+            .collect();
+        let every_other: Vec<f64> = grid.iter().step_by(2).map(|o| o.t_s).collect();
+        assert_eq!(shared_offset_s(&every_other, &grid, 0.5), Some(0.0));
+    }
+
     /// A logger that stamps as it receives (the Intel lab's CARMEN log): the encoders count
     /// every 0.1 s and arrive in bursts 0.1–0.6 s apart, each stamped on arrival, and every
     /// twentieth reading's stamp is also a truth pose's, the robot's pose `lead_s` before that
@@ -911,10 +1005,12 @@ mod tests {
     /// stamps' half second of lag is shared by both, so only the lead is left) and named; on
     /// time they are not told from on time. Interpolated between the bursts' stamps instead,
     /// the lead of 80 ms is read as none (1 ms): the encoders are exact at the truth's own
-    /// stamps only, so the profile's minimum sits there.
+    /// stamps only, so the profile's minimum sits there. Every encoder stamp moved 60 ms later
+    /// (a delay concealed in such a log: the truth's stamps are now the readings' less 60 ms),
+    /// the lead left, 20 ms, is read so within 15 ms.
     #[test]
     fn a_lead_is_read_against_a_truth_stamped_at_the_encoders_bursts() {
-        let read = |lead_s: f64| {
+        let read = |lead_s: f64, restamp_s: f64| {
             let rate = |t: f64| 0.8 * (0.7 * t).sin() + 0.3 * (1.9 * t).sin();
             let dt = 0.001;
             let (mut x, mut y, mut heading, mut left, mut right) = (0.0_f64, 0.0, 0.0, 0.0, 0.0);
@@ -945,7 +1041,7 @@ mod tests {
                     let stamp_s = delivery_s + 0.001 * in_burst;
                     in_burst += 1.0;
                     odometry.push(OdometrySample {
-                        t_s: stamp_s,
+                        t_s: stamp_s + restamp_s,
                         left_m: left,
                         right_m: right,
                     });
@@ -975,11 +1071,14 @@ mod tests {
             )
             .unwrap()
         };
-        let leading = read(0.08);
+        let leading = read(0.08, 0.0);
         let delay = &leading.delay_s;
         assert!((delay.value[0] - 0.08).abs() < 0.015, "{leading:?}");
         assert!(delay.departs && delay.heldout_gain > 10.0, "{leading:?}");
-        let on_time = read(0.0);
+        let restamped = read(0.08, 0.06);
+        let delay = &restamped.delay_s;
+        assert!((delay.value[0] - 0.02).abs() < 0.015, "{restamped:?}");
+        let on_time = read(0.0, 0.0);
         let delay = &on_time.delay_s;
         assert!(delay.value[0].abs() < 0.015, "{on_time:?}");
         assert!(!delay.departs || delay.heldout_gain < 10.0, "{on_time:?}");

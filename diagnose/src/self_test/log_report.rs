@@ -227,7 +227,7 @@ impl LogSelfTest {
             let missed: Vec<String> = o
                 .concealed
                 .iter()
-                .filter(|c| o.answer.get(c.effect()).is_none() && !self.undoes_own(c))
+                .filter(|c| !o.names(c.effect()) && !self.undoes_own(c))
                 .map(|c| c.effect().label())
                 .collect();
             let absent = o.names_absent(&b.whole);

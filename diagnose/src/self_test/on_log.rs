@@ -174,6 +174,14 @@ impl Baseline {
     }
 }
 
+/// Whether `a` and `b` are one mechanism as a log's diagnosis reads it: the same effect, or the
+/// encoders' delay and slip, one lead of their count on the truth whose sign names it (a slip's
+/// gain `g` is the encoders' travel `g` seconds ahead; a log whose own encoders lead, a delay
+/// concealed in it moves that lead back and may leave it a lead).
+fn one_mechanism(a: Effect, b: Effect) -> bool {
+    a == b || (crate::stamps::is_encoder_lead(a) && crate::stamps::is_encoder_lead(b))
+}
+
 /// One trial on a log.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogOutcome {
@@ -184,12 +192,20 @@ pub struct LogOutcome {
     pub answer: Answer,
     /// For each concealed mechanism named, |fitted − true| / |true| of its scored size, the
     /// fitted size taken less the untouched log's own ([`Answer::own_size`]; for the encoders'
-    /// delay and slip, the change of their lead, [`Answer::encoders_lead_s`]).
+    /// delay and slip, the change of their lead, [`Answer::encoders_lead_s`], which names either
+    /// when it moved the concealed way, [`one_mechanism`]).
     pub param_errors: Vec<(Effect, f64)>,
     pub seconds: f64,
 }
 
 impl LogOutcome {
+    /// Whether the concealed `effect` was named: it has a scored size
+    /// ([`LogOutcome::param_errors`]).
+    #[must_use]
+    pub fn names(&self, effect: Effect) -> bool {
+        self.param_errors.iter().any(|(e, _)| *e == effect)
+    }
+
     /// Effects named that were neither concealed nor named on the untouched log.
     #[must_use]
     pub fn names_absent(&self, baseline: &Answer) -> Vec<Effect> {
@@ -197,7 +213,10 @@ impl LogOutcome {
             .effects()
             .into_iter()
             .filter(|e| {
-                self.concealed.iter().all(|c| c.effect() != *e) && baseline.get(*e).is_none()
+                self.concealed
+                    .iter()
+                    .all(|c| !one_mechanism(c.effect(), *e))
+                    && baseline.named.iter().all(|n| !one_mechanism(n.effect, *e))
             })
             .collect()
     }
@@ -403,6 +422,25 @@ pub fn conceal_and_diagnose(
     })
 }
 
+/// The size of the concealed `c` that `answer` names, as the self-test scores it: its entry's
+/// fitted size less the untouched log's own ([`Answer::own_size`]); for the encoders' delay and
+/// slip, how far their lead moved from the untouched log's ([`Answer::encoders_lead_s`]), named
+/// as either ([`one_mechanism`]) when it moved the concealed way. `None` when not named.
+fn scored_size(answer: &Answer, baseline: &Answer, c: &Concealment) -> Option<f64> {
+    let e = c.effect();
+    if !crate::stamps::is_encoder_lead(e) {
+        return Some(answer.get(e)?.size - baseline.own_size(e));
+    }
+    answer.named.iter().find(|n| one_mechanism(n.effect, e))?;
+    let lead_s = answer.encoders_lead_s() - baseline.encoders_lead_s();
+    let moved = if e == Effect::OdometerWheelSlip {
+        lead_s
+    } else {
+        -lead_s
+    };
+    (moved * c.scored() > 0.0).then_some(moved)
+}
+
 fn trial(
     recording: &Recording,
     world: &dyn LogWorld,
@@ -420,20 +458,8 @@ fn trial(
     let param_errors = concealed
         .iter()
         .filter_map(|c| {
-            let e = c.effect();
-            let got = if crate::stamps::is_encoder_lead(e) {
-                // Named as itself, sized by how far it moved the encoders' lead.
-                answer.get(e)?;
-                let lead_s = answer.encoders_lead_s() - baseline.encoders_lead_s();
-                if e == Effect::OdometerWheelSlip {
-                    lead_s
-                } else {
-                    -lead_s
-                }
-            } else {
-                answer.get(e)?.size - baseline.own_size(e)
-            };
-            Some((e, (got - c.scored()).abs() / c.scored().abs()))
+            let got = scored_size(&answer, baseline, c)?;
+            Some((c.effect(), (got - c.scored()).abs() / c.scored().abs()))
         })
         .collect();
     LogOutcome {
@@ -539,7 +565,7 @@ impl LogSelfTest {
                 }
                 if let Some(row) = per_effect.iter_mut().find(|r| r.0 == c.effect()) {
                     row.1 += 1;
-                    row.2 += usize::from(o.answer.get(c.effect()).is_some());
+                    row.2 += usize::from(o.names(c.effect()));
                 }
             }
         }
@@ -644,6 +670,44 @@ mod tests {
             whole: first.clone(),
             halves: Some([first, second]),
         }
+    }
+
+    fn slip(gain_s: f64) -> NamedSize {
+        let e = Effect::OdometerWheelSlip;
+        let mut params = e.absent(0.0);
+        params[0] = gain_s;
+        NamedSize {
+            effect: e,
+            size: e.scored(&params),
+            params,
+            size_sd: 0.02,
+        }
+    }
+
+    /// A log whose own encoders lead the truth by 0.2 s (a slip's sign): a delay of 50 ms
+    /// concealed in it leaves a lead of 0.15 s, still a slip's sign. That is the delay named,
+    /// sized 50 ms, and no false alarm; the lead moved the other way is not it.
+    #[test]
+    fn a_delay_concealed_in_a_log_whose_encoders_lead_is_the_lead_it_took_away() {
+        let baseline = answer(Some(slip(0.2)), None);
+        let delay = Concealment::Restamp {
+            sensor: Sensor::Odometer,
+            delay_s: 0.05,
+        };
+        let left_leading = answer(Some(slip(0.15)), None);
+        let got = scored_size(&left_leading, &baseline, &delay).expect("named");
+        assert!((got - 0.05).abs() < 1e-12, "{got}");
+        let outcome = LogOutcome {
+            index: 0,
+            concealed: vec![delay],
+            answer: left_leading,
+            param_errors: Vec::new(),
+            seconds: 0.0,
+        };
+        assert!(outcome.names_absent(&answer(None, None)).is_empty());
+        let more_leading = answer(Some(slip(0.25)), None);
+        assert_eq!(scored_size(&more_leading, &baseline, &delay), None);
+        assert_eq!(scored_size(&answer(None, None), &baseline, &delay), None);
     }
 
     /// The rover's own wheel base reads 5.0 % narrow: a base concealed 6.1 % or 5.3 % wide

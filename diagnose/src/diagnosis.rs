@@ -1425,23 +1425,49 @@ fn encoders_over_truth(
     ) else {
         return Vec::new();
     };
-    let lead_s = spans.delay_s.value[0];
-    let (effect, value) = if lead_s < 0.0 {
-        (latency, vec![-lead_s])
+    let slip = Effect::OdometerWheelSlip;
+    // A slip that braking gives back less of than it gained (`h` < 0), when it earns its place
+    // on the held-out spans: the lead and the wheels are then read under it.
+    let braking = spans.braking.as_ref().filter(|b| {
+        let h = &b.lead_per_fall_s;
+        h.value[0] < 0.0 && h.departs && h.heldout_gain > options.min_gain
+    });
+    let lead = braking.map_or(&spans.delay_s, |b| &b.delay_s);
+    let lead_s = lead.value[0];
+    let (effect, value, sd) = if lead_s < 0.0 {
+        (latency, vec![-lead_s], vec![lead.sd[0]])
     } else {
-        let slip = Effect::OdometerWheelSlip;
         let mut value = slip.absent(0.0);
+        let mut sd = vec![0.0; value.len()];
         value[0] = lead_s;
-        (slip, value)
+        sd[0] = lead.sd[0];
+        // The braking share `1 + h / g`; held at its absence without one.
+        if let (Some(b), Some(share)) = (braking, value.get_mut(1)) {
+            let h = &b.lead_per_fall_s;
+            *share = 1.0 + h.value[0] / lead_s;
+            sd[1] = h.sd[0] / lead_s;
+        }
+        (slip, value, sd)
     };
-    // The form (a slip's braking share) held at its absence.
-    let sd = (0..value.len())
-        .map(|i| if i == 0 { spans.delay_s.sd[0] } else { 0.0 })
-        .collect();
-    let timing = wheel_spans::Reading {
-        value,
-        sd,
-        ..spans.delay_s.clone()
+    // Scored on the turn (the lead) and, with a braking share, the travel too.
+    let timing = match braking {
+        Some(b) if effect == slip => {
+            let h = &b.lead_per_fall_s;
+            wheel_spans::Reading {
+                value,
+                sd,
+                train_gain: spans.delay_s.train_gain + h.train_gain,
+                heldout_gain: spans.delay_s.heldout_gain + h.heldout_gain,
+                departs: lead.departs || h.departs,
+                ..spans.delay_s.clone()
+            }
+        }
+        _ => wheel_spans::Reading {
+            value,
+            sd,
+            departs: lead.departs,
+            ..spans.delay_s.clone()
+        },
     };
     let mut judged = |effect: Effect, reading: &wheel_spans::Reading| {
         judged_on_spans(
@@ -1454,11 +1480,35 @@ fn encoders_over_truth(
             options,
         )
     };
-    vec![
+    let (base, radii) = braking.map_or((&spans.base_scale, &spans.radius_scales), |b| {
+        (&b.base_scale, &b.radius_scales)
+    });
+    let mut read = vec![
         judged(effect, &timing),
-        judged(Effect::DriveWheelBase, &spans.base_scale),
-        judged(Effect::OdometerWheelRadius, &spans.radius_scales),
-    ]
+        judged(Effect::DriveWheelBase, base),
+        judged(Effect::OdometerWheelRadius, radii),
+    ];
+    // Encoders late on the truth that also gain on every start and give less back on every
+    // stop: the slip apart, as one that braking gives none of back (`g = −h`).
+    if let Some(b) = braking.filter(|_| effect == latency) {
+        let h = &b.lead_per_fall_s;
+        let mut value = slip.absent(0.0);
+        let mut sd = vec![0.0; value.len()];
+        value[0] = -h.value[0];
+        sd[0] = h.sd[0];
+        if let Some(share) = value.get_mut(1) {
+            *share = 0.0;
+        }
+        read.push(judged(
+            slip,
+            &wheel_spans::Reading {
+                value,
+                sd,
+                ..h.clone()
+            },
+        ));
+    }
+    read
 }
 
 /// The yaw of a lidar turned on its mount, against a path that is the lidar's own matches

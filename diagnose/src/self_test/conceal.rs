@@ -228,22 +228,30 @@ fn rewrite_travel(recording: &mut Recording, f: impl Fn(f64, [f64; 2]) -> [f64; 
     }
 }
 
+/// How often a wheel's speed is taken for a slip's lead, seconds: a quarter of the span it is
+/// measured over ([`crate::stamps::WHEEL_SPEED_SPAN_S`]), so that consecutive speeds share most
+/// of their readings. Taken at every reading instead, a logger's bursts and scatter of stamps
+/// would add changes of speed the wheels never made, each a lead that braking does not give
+/// back as it was gained: a drift with the readings, not a slip.
+const SLIP_SPEED_STEP_S: f64 = 0.25;
+
 /// Each odometry sample's slip lead `[left, right]`: the wheel's changes of speed (from its own
-/// encoder, [`crate::stamps::wheel_speeds`]) summed, each weighted by the driving gain while the speed's
-/// magnitude grows and by the braking gain while it falls (a reversal brakes to rest, then
-/// drives).
+/// encoder, [`crate::stamps::wheel_speeds`], every [`SLIP_SPEED_STEP_S`]) summed, each weighted
+/// by the driving gain while the speed's magnitude grows and by the braking gain while it falls
+/// (a reversal brakes to rest, then drives), and read at the sample's stamp between those
+/// times.
 fn slip_leads(odometry: &[OdometrySample], driving_s: f64, braking_s: f64) -> Vec<[f64; 2]> {
-    let speeds: Vec<[f64; 2]> = odometry
-        .iter()
-        .map(|s| crate::stamps::wheel_speeds(odometry, s.t_s))
-        .collect();
+    let (Some(first), Some(last)) = (odometry.first(), odometry.last()) else {
+        return Vec::new();
+    };
+    let steps = ((last.t_s - first.t_s) / SLIP_SPEED_STEP_S).ceil() as usize;
     let mut lead = [0.0_f64; 2];
-    let mut last = [0.0_f64; 2];
-    speeds
-        .iter()
-        .map(|v| {
+    let mut before = [0.0_f64; 2];
+    let leads: Vec<[f64; 2]> = (0..=steps)
+        .map(|k| {
+            let v = crate::stamps::wheel_speeds(odometry, first.t_s + k as f64 * SLIP_SPEED_STEP_S);
             for w in 0..2 {
-                let (from, to) = (last[w], v[w]);
+                let (from, to) = (before[w], v[w]);
                 let (braked, driven) = if from * to < 0.0 {
                     (-from, to)
                 } else if to.abs() < from.abs() {
@@ -252,9 +260,19 @@ fn slip_leads(odometry: &[OdometrySample], driving_s: f64, braking_s: f64) -> Ve
                     (0.0, to - from)
                 };
                 lead[w] += braking_s * braked + driving_s * driven;
-                last[w] = to;
+                before[w] = to;
             }
             lead
+        })
+        .collect();
+    odometry
+        .iter()
+        .map(|s| {
+            let x = (s.t_s - first.t_s) / SLIP_SPEED_STEP_S;
+            let k = (x.floor().max(0.0) as usize).min(steps);
+            let (a, b) = (leads[k], leads[(k + 1).min(steps)]);
+            let u = (x - k as f64).clamp(0.0, 1.0);
+            [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])]
         })
         .collect()
 }

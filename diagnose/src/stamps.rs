@@ -24,6 +24,60 @@ pub(crate) fn is_encoder_lead(effect: Effect) -> bool {
 /// indoor robot changes its speed (0.3 m/s at 0.5 m/s² takes 0.6 s).
 pub(crate) const WHEEL_SPEED_SPAN_S: f64 = 1.0;
 
+/// How long a logger may fall silent for the wheels' speed to be followed through the gap (from
+/// the samples either side), seconds: a sparse truth's longest span (`wheel_spans`). A longer
+/// silence is a pause.
+const SILENCE_S: f64 = 10.0;
+
+/// The times every `step_s` from `odometry`'s first stamp at which the wheels' speed is taken
+/// ([`wheel_speeds`]) to follow its changes: those within half [`WHEEL_SPEED_SPAN_S`] of a
+/// sample or within a gap between samples of up to [`SILENCE_S`]. Across a longer gap the
+/// logger paused, and a speed there is no measure; so their number stays within a few dozen per
+/// sample whatever time the stamps span.
+pub(crate) fn speed_times(odometry: &[OdometrySample], step_s: f64) -> Vec<f64> {
+    let Some(first) = odometry.first() else {
+        return Vec::new();
+    };
+    if !(step_s > 0.0 && step_s.is_finite()) {
+        return Vec::new();
+    }
+    let half = 0.5 * WHEEL_SPEED_SPAN_S;
+    let index = |t: f64| (t - first.t_s) / step_s;
+    let mut times = Vec::new();
+    // The next grid index not yet taken.
+    let mut next = 0.0_f64;
+    for (i, s) in odometry.iter().enumerate() {
+        let lo = index(s.t_s - half).ceil().max(next);
+        let reach = match odometry.get(i + 1) {
+            Some(after) if after.t_s - s.t_s <= SILENCE_S => after.t_s.max(s.t_s + half),
+            _ => s.t_s + half,
+        };
+        let hi = index(reach).floor();
+        let mut k = lo;
+        while k <= hi {
+            times.push(first.t_s + k * step_s);
+            k += 1.0;
+        }
+        next = next.max(hi + 1.0);
+    }
+    times
+}
+
+/// `values` (one per of `times`, in order) at `t_s`, linearly between their times: the first's
+/// before them is none, the last's after them its own.
+pub(crate) fn pair_at(times: &[f64], values: &[[f64; 2]], t_s: f64) -> [f64; 2] {
+    let k = times.partition_point(|&t| t <= t_s);
+    match (k.checked_sub(1), times.get(k), values.get(k)) {
+        (None, ..) => [0.0; 2],
+        (Some(i), Some(&next), Some(b)) => {
+            let u = (t_s - times[i]) / (next - times[i]);
+            let a = values[i];
+            [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])]
+        }
+        (Some(i), ..) => values.get(i).copied().unwrap_or([0.0; 2]),
+    }
+}
+
 /// The share of a wheel's travel over a span that its stamps must explain (the squared
 /// correlation) for the travel's own slope to be corrected for their scatter in full; below it
 /// the correction is held at what it is here (twice the slope), so that a wheel that turns
@@ -220,6 +274,28 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_distr::StandardNormal;
     use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// The speed's times follow the samples: every step within half a speed's span of one or
+    /// through a short gap, none across a logger's pause, however long (a day here: five, not
+    /// 350,000).
+    #[test]
+    fn the_speeds_times_skip_a_silence_however_long() {
+        let at = |t_s: f64| OdometrySample {
+            t_s,
+            left_m: 0.0,
+            right_m: 0.0,
+        };
+        let times = speed_times(&[at(10.0), at(10.2), at(86_410.0)], 0.25);
+        assert_eq!(
+            times,
+            vec![10.0, 10.25, 10.5, 86_409.5, 86_409.75, 86_410.0, 86_410.25, 86_410.5]
+        );
+        assert!(speed_times(&[at(0.0)], 0.0).is_empty());
+        let values = [[0.0, 2.0], [1.0, 4.0]];
+        assert_eq!(pair_at(&[1.0, 2.0], &values, 1.5), [0.5, 3.0]);
+        assert_eq!(pair_at(&[1.0, 2.0], &values, 0.5), [0.0, 0.0]);
+        assert_eq!(pair_at(&[1.0, 2.0], &values, 9.0), [1.0, 4.0]);
+    }
 
     /// A robot whose speed swings between 0.2 and 0.6 m/s every 4 s, read every `step_s`, each
     /// reading stamped `jitter_s` × a standard normal draw off when it was counted.

@@ -142,8 +142,8 @@ struct Wheels {
 /// A slip that braking does not give back as it was gained: beyond the lead a delay reads
 /// (the speed's every change alike), the encoders' travel gains `h` × each fall of their speed
 /// (a slip's braking gain less its driving gain: a wheel that slips as it speeds up and not as
-/// it slows has `h` the driving gain's negative), read from the spans' travel with those
-/// falls as a second regressor.
+/// it slows has `h` the driving gain's negative), profiled with the delay
+/// ([`braking_read`]).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Braking {
     /// `h`, seconds, against its absence.
@@ -156,8 +156,8 @@ pub(crate) struct Braking {
 }
 
 /// Each wheel's speed's falls, summed from the log's start: the change of its speed while its
-/// magnitude falls (to nothing where it turns back), on a grid of half the speed's span
-/// ([`crate::stamps::WHEEL_SPEED_SPAN_S`]), which no logger's bursts of stamps alias.
+/// magnitude falls (to nothing where it turns back), every half the speed's span
+/// ([`crate::stamps::speed_times`]), which no logger's bursts of stamps alias.
 struct SpeedFalls {
     times: Vec<f64>,
     sums: Vec<[f64; 2]>,
@@ -165,15 +165,7 @@ struct SpeedFalls {
 
 impl SpeedFalls {
     fn of(odometry: &[OdometrySample]) -> Self {
-        let (Some(first), Some(last)) = (odometry.first(), odometry.last()) else {
-            return Self {
-                times: Vec::new(),
-                sums: Vec::new(),
-            };
-        };
-        let step_s = 0.5 * crate::stamps::WHEEL_SPEED_SPAN_S;
-        let n = ((last.t_s - first.t_s) / step_s).floor() as usize + 1;
-        let times: Vec<f64> = (0..n).map(|k| first.t_s + k as f64 * step_s).collect();
+        let times = crate::stamps::speed_times(odometry, 0.5 * crate::stamps::WHEEL_SPEED_SPAN_S);
         let mut sum = [0.0_f64; 2];
         let mut before = [0.0_f64; 2];
         let sums = times
@@ -199,16 +191,7 @@ impl SpeedFalls {
 
     /// The sums at `t_s`, linearly between the grid's points.
     fn at(&self, t_s: f64) -> [f64; 2] {
-        let k = self.times.partition_point(|&g| g <= t_s);
-        match (k.checked_sub(1), self.times.get(k)) {
-            (None, _) => [0.0; 2],
-            (Some(i), None) => self.sums[i],
-            (Some(i), Some(&next)) => {
-                let u = (t_s - self.times[i]) / (next - self.times[i]);
-                let (a, b) = (self.sums[i], self.sums[k]);
-                [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])]
-            }
-        }
+        crate::stamps::pair_at(&self.times, &self.sums, t_s)
     }
 
     /// Each span's falls, apart (right less left) and mean, at the encoders' time of its ends

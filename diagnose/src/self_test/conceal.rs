@@ -241,15 +241,13 @@ const SLIP_SPEED_STEP_S: f64 = 0.25;
 /// (a reversal brakes to rest, then drives), and read at the sample's stamp between those
 /// times.
 fn slip_leads(odometry: &[OdometrySample], driving_s: f64, braking_s: f64) -> Vec<[f64; 2]> {
-    let (Some(first), Some(last)) = (odometry.first(), odometry.last()) else {
-        return Vec::new();
-    };
-    let steps = ((last.t_s - first.t_s) / SLIP_SPEED_STEP_S).ceil() as usize;
+    let times = crate::stamps::speed_times(odometry, SLIP_SPEED_STEP_S);
     let mut lead = [0.0_f64; 2];
     let mut before = [0.0_f64; 2];
-    let leads: Vec<[f64; 2]> = (0..=steps)
-        .map(|k| {
-            let v = crate::stamps::wheel_speeds(odometry, first.t_s + k as f64 * SLIP_SPEED_STEP_S);
+    let leads: Vec<[f64; 2]> = times
+        .iter()
+        .map(|&t| {
+            let v = crate::stamps::wheel_speeds(odometry, t);
             for w in 0..2 {
                 let (from, to) = (before[w], v[w]);
                 let (braked, driven) = if from * to < 0.0 {
@@ -267,13 +265,7 @@ fn slip_leads(odometry: &[OdometrySample], driving_s: f64, braking_s: f64) -> Ve
         .collect();
     odometry
         .iter()
-        .map(|s| {
-            let x = (s.t_s - first.t_s) / SLIP_SPEED_STEP_S;
-            let k = (x.floor().max(0.0) as usize).min(steps);
-            let (a, b) = (leads[k], leads[(k + 1).min(steps)]);
-            let u = (x - k as f64).clamp(0.0, 1.0);
-            [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])]
-        })
+        .map(|s| crate::stamps::pair_at(&times, &leads, s.t_s))
         .collect()
 }
 

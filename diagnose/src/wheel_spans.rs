@@ -861,16 +861,14 @@ struct BrakingInputs<'a> {
     travel_noise: f64,
 }
 
-/// The most a slip's braking gain falls short of its driving gain, seconds: a slip gain's
-/// bound (the catalogue's, 0.5 s) with braking giving none of it back.
-const BRAKING_LEAD_MOST_S: f64 = 0.5;
-/// Its grid's step, seconds: a tenth of the least slip gain the catalogue's grid tells.
+/// The step of the grid a slip's braking lead `h` is profiled on ([`braking_read`]), seconds: a
+/// tenth of the least slip gain the catalogue's grid tells.
 const BRAKING_LEAD_STEP_S: f64 = 0.01;
 
 /// A slip that braking does not give back as it was gained ([`Braking`]): the encoders'
-/// travel less `h` × their speed's falls, `h` from [`BRAKING_LEAD_MOST_S`] short to none,
-/// profiled jointly with the delay (a lead that braking keeps biases the lead the turn reads
-/// alone) on the turn `s·Δ + c·f` and the travel `m·f`, their losses summed (each in its own
+/// travel less `h` × their speed's falls, `h` from the delays' lead end (a slip gain's bound,
+/// with braking giving none of it back) short to none, profiled jointly with the delay (a lead
+/// that braking keeps biases the lead the turn reads alone) on the turn `s·Δ + c·f` and the travel `m·f`, their losses summed (each in its own
 /// noise); its error the profile's curvature's. Scored against `h` = 0 on the held-out spans,
 /// each at its own delay, and the wheels read again under it. `None` with no speed's falls.
 fn braking_read(inputs: &BrakingInputs<'_>, delay_sd_s: f64) -> Option<Braking> {
@@ -925,9 +923,10 @@ fn braking_read(inputs: &BrakingInputs<'_>, delay_sd_s: f64) -> Option<Braking> 
         let least = profile.iter().copied().fold(f64::INFINITY, f64::min);
         (delay_s, least)
     };
-    let steps = (BRAKING_LEAD_MOST_S / BRAKING_LEAD_STEP_S).round() as usize;
+    let most_s = grid.last().copied().unwrap_or(0.0).max(BRAKING_LEAD_STEP_S);
+    let steps = (most_s / BRAKING_LEAD_STEP_S).round() as usize;
     let h_grid: Vec<f64> = (0..=steps)
-        .map(|k| -BRAKING_LEAD_MOST_S + k as f64 * BRAKING_LEAD_STEP_S)
+        .map(|k| -most_s + k as f64 * BRAKING_LEAD_STEP_S)
         .collect();
     let profile: Vec<f64> = h_grid.iter().map(|&h| at_h(h).1).collect();
     let (h, curvature) = profile_minimum(&profile, &h_grid);

@@ -1441,10 +1441,13 @@ fn encoders_over_truth(
         let mut sd = vec![0.0; value.len()];
         value[0] = lead_s;
         sd[0] = lead.sd[0];
-        // The braking share `1 + h / g`; held at its absence without one.
-        if let (Some(b), Some(share)) = (braking, value.get_mut(1)) {
+        // The braking share `1 + h / g`, within the catalogue's family; held at its absence
+        // without one.
+        if let (Some(b), Some(share), Some(spec)) =
+            (braking, value.get_mut(1), slip.params().get(1))
+        {
             let h = &b.lead_per_fall_s;
-            *share = 1.0 + h.value[0] / lead_s;
+            *share = (1.0 + h.value[0] / lead_s).clamp(spec.lo, spec.hi);
             sd[1] = h.sd[0] / lead_s;
         }
         (slip, value, sd)

@@ -19,6 +19,7 @@
 use hilsim_calibrator::random_walk_smoother::{self, Step};
 use hilsim_recording::{LidarSample, Recording, TruthSample};
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 
 use crate::error::MismatchError;
 use crate::physics::{Hypothesis, LidarQuery, Physics};
@@ -172,7 +173,7 @@ fn residuals(
     hypothesis: &Hypothesis,
 ) -> Vec<Option<f64>> {
     physics
-        .lidar(trajectory, queries, hypothesis)
+        .lidar_distributions(trajectory, queries, hypothesis)
         .iter()
         .zip(readings)
         .map(|(p, &y)| {
@@ -607,16 +608,25 @@ impl Matcher<'_> {
         let residuals_at = |c: [f64; 3]| self.scan_residuals(scan, c);
         let n = scan.y.len();
         let steps = [0.001, 0.001, 0.001];
-        // Central differences of the residuals along each coordinate.
+        // Central differences of the residuals along each coordinate: the six predictions
+        // side by side (a revolution's few dozen readings are too few to share among the
+        // threads one prediction at a time without most of the time going to handing over).
+        let moved: Vec<Vec<Option<f64>>> = (0..6)
+            .into_par_iter()
+            .map(|j| {
+                let mut c = correction;
+                c[j / 2] += if j % 2 == 0 {
+                    steps[j / 2]
+                } else {
+                    -steps[j / 2]
+                };
+                residuals_at(c)
+            })
+            .collect();
         let mut jac: Vec<[f64; 3]> = vec![[0.0; 3]; n];
         let mut usable = vec![true; n];
         for k in 0..3 {
-            let mut up = correction;
-            let mut down = correction;
-            up[k] += steps[k];
-            down[k] -= steps[k];
-            let ru = residuals_at(up);
-            let rd = residuals_at(down);
+            let (ru, rd) = (&moved[2 * k], &moved[2 * k + 1]);
             for i in 0..n {
                 match (ru[i], rd[i]) {
                     (Some(a), Some(b)) => jac[i][k] = (a - b) / (2.0 * steps[k]),

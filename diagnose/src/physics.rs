@@ -261,6 +261,19 @@ pub trait Physics: Sync {
         hypothesis: &Hypothesis,
     ) -> Vec<LidarPrediction>;
 
+    /// [`Physics::lidar`] for matching scans to the world, which reads each reading's
+    /// distribution (`components`) and nothing else: the physics may leave out what only
+    /// judging the readings needs ([`LidarPrediction::world_reach_m`], 0 then, which takes two
+    /// more rays a reading in a map). The default asks [`Physics::lidar`].
+    fn lidar_distributions(
+        &self,
+        trajectory: &Trajectory,
+        queries: &[LidarQuery],
+        hypothesis: &Hypothesis,
+    ) -> Vec<LidarPrediction> {
+        self.lidar(trajectory, queries, hypothesis)
+    }
+
     /// The sonar pings at `times` from the robot on `trajectory`, under `hypothesis`.
     fn sonar(
         &self,

@@ -41,6 +41,13 @@ const GEOMETRIES_COUNTED: usize = 4096;
 /// are hashed by a fast hash (randomly seeded: a recording cannot be made to collide). Only
 /// looked up, never iterated: the seed changes no result.
 type BeamCache<V> = HashMap<BeamKey, V, foldhash::fast::RandomState>;
+/// Whether a lidar prediction casts the world's reach of each reading
+/// ([`LidarPrediction::world_reach_m`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Reach {
+    Cast,
+    LeftOut,
+}
 /// Beams the caches hold at most (~1 KB each): a 60 s recording has 108,000 readings; beyond
 /// this (e.g. the many trial poses of a scan matcher) beams are cast again instead.
 const CACHE_CAPACITY: usize = 250_000;
@@ -268,73 +275,13 @@ impl SimPhysics {
         c
     }
 
-    fn object_id(&self, o: Obstacle) -> u32 {
-        let w = &self.scenario.world;
-        (match o {
-            Obstacle::Wall(i) => i,
-            Obstacle::Cylinder(i) => w.walls.len() + i,
-            Obstacle::Board(i) => w.walls.len() + w.cylinders.len() + i,
-            Obstacle::Map => w.walls.len() + w.cylinders.len() + w.boards.len(),
-        }) as u32
-    }
-
-    /// The lidar as the hypothesis has it mounted (`[effects.lidar_mount_offset]`: the
-    /// simulator's own [`real_mount`]).
-    fn lidar_config(&self, effects: &Effects) -> Option<scenario::Lidar> {
-        let mut config = self.scenario.sensors.lidar.clone()?;
-        let m = real_mount(config.mount.into(), effects.lidar_mount_offset);
-        config.mount = scenario::Mount {
-            x_m: m.x_m,
-            y_m: m.y_m,
-            yaw_deg: m.yaw_deg,
-        };
-        Some(config)
-    }
-
-    /// The scenario's effects with the hypothesis's switched on over them.
-    fn effects(&self, h: &Hypothesis) -> Effects {
-        let mut e = self.scenario.effects.clone();
-        for (effect, params) in &h.effects {
-            effect.apply(params, &mut e);
-        }
-        e
-    }
-}
-
-impl Physics for SimPhysics {
-    fn declared(&self) -> &Declared {
-        &self.declared
-    }
-
-    fn object_name(&self, object: u32) -> String {
-        self.names
-            .get(object as usize)
-            .cloned()
-            .unwrap_or_else(|| format!("object {object}"))
-    }
-
-    fn drive(
-        &self,
-        commands: &[CommandSample],
-        end_s: f64,
-        hypothesis: &Hypothesis,
-    ) -> Vec<TruthSample> {
-        replay::replay_commands(&self.drive_scenario(hypothesis), commands, end_s)
-    }
-
-    fn drive_contacts(&self, commands: &[CommandSample], end_s: f64) -> Vec<(f64, f64)> {
-        replay::replay_contacts(
-            &self.drive_scenario(&Hypothesis::nominal()),
-            commands,
-            end_s,
-        )
-    }
-
-    fn lidar(
+    /// [`Physics::lidar`], with the world's reach of each reading cast or left out.
+    fn lidar_predicted(
         &self,
         trajectory: &Trajectory,
         queries: &[LidarQuery],
         hypothesis: &Hypothesis,
+        reach: Reach,
     ) -> Vec<LidarPrediction> {
         let all_effects = self.effects(hypothesis);
         let Some(config) = self.lidar_config(&all_effects) else {
@@ -403,6 +350,12 @@ impl Physics for SimPhysics {
                 [p.x, p.y, p.yaw, q.angle_deg, mount[0], mount[1], mount[2]].map(f64::to_bits);
             (pose(p), key)
         };
+        let uncached = |robot: &Pose, q: &LidarQuery| match reach {
+            Reach::Cast => predictor.predict(&self.world, robot, q.angle_deg, q.t_s),
+            Reach::LeftOut => {
+                predictor.predict_distribution(&self.world, robot, q.angle_deg, q.t_s)
+            }
+        };
         // Without a footprint of its own, a kept call's beams are read in order.
         if cacheable && keep && !mixed {
             let places: Vec<(Pose, BeamKey)> = queries
@@ -444,18 +397,98 @@ impl Physics for SimPhysics {
                     let (robot, key) = place(q);
                     let e = if cacheable {
                         if mixed && !self.cached_clear(&geometry, key, keep, &robot, q.angle_deg) {
-                            predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
+                            uncached(&robot, q)
                         } else {
                             let beam = self.cached_beam(&geometry, key, keep, &robot, q.angle_deg);
                             predictor.predict_nodes(&beam, q.t_s)
                         }
                     } else {
-                        predictor.predict(&self.world, &robot, q.angle_deg, q.t_s)
+                        uncached(&robot, q)
                     };
                     prediction(e)
                 })
             })
             .collect()
+    }
+
+    fn object_id(&self, o: Obstacle) -> u32 {
+        let w = &self.scenario.world;
+        (match o {
+            Obstacle::Wall(i) => i,
+            Obstacle::Cylinder(i) => w.walls.len() + i,
+            Obstacle::Board(i) => w.walls.len() + w.cylinders.len() + i,
+            Obstacle::Map => w.walls.len() + w.cylinders.len() + w.boards.len(),
+        }) as u32
+    }
+
+    /// The lidar as the hypothesis has it mounted (`[effects.lidar_mount_offset]`: the
+    /// simulator's own [`real_mount`]).
+    fn lidar_config(&self, effects: &Effects) -> Option<scenario::Lidar> {
+        let mut config = self.scenario.sensors.lidar.clone()?;
+        let m = real_mount(config.mount.into(), effects.lidar_mount_offset);
+        config.mount = scenario::Mount {
+            x_m: m.x_m,
+            y_m: m.y_m,
+            yaw_deg: m.yaw_deg,
+        };
+        Some(config)
+    }
+
+    /// The scenario's effects with the hypothesis's switched on over them.
+    fn effects(&self, h: &Hypothesis) -> Effects {
+        let mut e = self.scenario.effects.clone();
+        for (effect, params) in &h.effects {
+            effect.apply(params, &mut e);
+        }
+        e
+    }
+}
+
+impl Physics for SimPhysics {
+    fn declared(&self) -> &Declared {
+        &self.declared
+    }
+
+    fn object_name(&self, object: u32) -> String {
+        self.names
+            .get(object as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("object {object}"))
+    }
+
+    fn drive(
+        &self,
+        commands: &[CommandSample],
+        end_s: f64,
+        hypothesis: &Hypothesis,
+    ) -> Vec<TruthSample> {
+        replay::replay_commands(&self.drive_scenario(hypothesis), commands, end_s)
+    }
+
+    fn drive_contacts(&self, commands: &[CommandSample], end_s: f64) -> Vec<(f64, f64)> {
+        replay::replay_contacts(
+            &self.drive_scenario(&Hypothesis::nominal()),
+            commands,
+            end_s,
+        )
+    }
+
+    fn lidar(
+        &self,
+        trajectory: &Trajectory,
+        queries: &[LidarQuery],
+        hypothesis: &Hypothesis,
+    ) -> Vec<LidarPrediction> {
+        self.lidar_predicted(trajectory, queries, hypothesis, Reach::Cast)
+    }
+
+    fn lidar_distributions(
+        &self,
+        trajectory: &Trajectory,
+        queries: &[LidarQuery],
+        hypothesis: &Hypothesis,
+    ) -> Vec<LidarPrediction> {
+        self.lidar_predicted(trajectory, queries, hypothesis, Reach::LeftOut)
     }
 
     fn sonar(

@@ -434,6 +434,21 @@ impl LidarPredictor {
         e.world_reach_m = cast.world_reach_m;
         e
     }
+
+    /// [`LidarPredictor::predict`] without the world's reach (`world_reach_m` 0), which casts
+    /// two more rays in a world with uncertain surfaces: for a caller that reads the reading's
+    /// distribution only (a scan matcher).
+    #[must_use]
+    pub fn predict_distribution(
+        &self,
+        world: &World,
+        robot: &Pose,
+        angle_deg: f64,
+        t_s: f64,
+    ) -> ExpectedLidar {
+        let cast = self.cast_directions(world, robot, angle_deg);
+        self.predict_from(cast.nodes(), cast.centre, cast.dense, t_s)
+    }
 }
 
 /// The expected reading of a sonar ping, and the echo's true range.

@@ -284,8 +284,6 @@ mod tests {
         r
     }
 
-    /// Losses drawn one by one spread as a binomial's (dispersion near 1); losses of whole
-    /// revolutions (a wall lost at once) spread as many times more as a revolution has readings.
     /// The profiled share lost at random is the likelihood's greatest over `p₀`: against a
     /// search every 10⁻⁴ of it, the likelihood at the profile is not lower.
     #[test]
@@ -303,6 +301,8 @@ mod tests {
         assert_eq!(profiled_p0(&[false; 4], &[0.5; 4]), 0.0);
     }
 
+    /// Losses drawn one by one spread as a binomial's (dispersion near 1); losses of whole
+    /// revolutions (a wall lost at once) spread as many times more as a revolution has readings.
     #[test]
     fn losses_clustered_by_revolution_widen_the_errors_and_independent_ones_do_not() {
         let (revs, per) = (400_usize, 50_usize);

@@ -1381,6 +1381,41 @@ fn judged_on_spans(
     (fit, earns)
 }
 
+/// How the encoders' lead on a sparse truth is named ([`split_lead`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum LeadSplit {
+    /// Encoders stamped late by this many seconds.
+    Late(f64),
+    /// A slip of this gain and braking share (1: braking gives back all it led).
+    Slip { gain_s: f64, share: f64 },
+    /// Encoders late by `late_s` beside a slip of gain `gain_s` that braking gives none of back.
+    LateBesideSlip { late_s: f64, gain_s: f64 },
+}
+
+/// The encoders' lead `L v + h F` on a sparse truth (`lead_s` = `L`; `F` the speed's falls
+/// summed, `h` ≤ 0 when read) as the catalogue names it. It is a gain `L` on every rise of the
+/// speed and `L + h` on every fall: a slip of gain `L` and braking share `1 + h / L` when `L` is
+/// a lead and the share is at least `least_share` (the slip entry's family); otherwise,
+/// with `h`, encoders late by `−(L + h)` beside a slip of gain `−h` that braking gives none of
+/// back, which is the same lead; without `h`, a delay or an even slip by the sign of `L`.
+fn split_lead(lead_s: f64, h_s: Option<f64>, least_share: f64) -> LeadSplit {
+    match h_s {
+        Some(h) if lead_s > 0.0 && 1.0 + h / lead_s >= least_share => LeadSplit::Slip {
+            gain_s: lead_s,
+            share: (1.0 + h / lead_s).min(1.0),
+        },
+        Some(h) => LeadSplit::LateBesideSlip {
+            late_s: -(lead_s + h),
+            gain_s: -h,
+        },
+        None if lead_s < 0.0 => LeadSplit::Late(-lead_s),
+        None => LeadSplit::Slip {
+            gain_s: lead_s,
+            share: 1.0,
+        },
+    }
+}
+
 /// The encoders against a truth sparser than they are (a logger's scan-matched pose every few
 /// seconds), read span by span between its poses ([`wheel_spans`]): their timing, the wheels'
 /// effective base and their sizes, each a candidate and whether it is named
@@ -1433,24 +1468,33 @@ fn encoders_over_truth(
         h.value[0] < 0.0 && h.departs && h.heldout_gain > options.min_gain
     });
     let lead = braking.map_or(&spans.delay_s, |b| &b.delay_s);
-    let lead_s = lead.value[0];
-    let (effect, value, sd) = if lead_s < 0.0 {
-        (latency, vec![-lead_s], vec![lead.sd[0]])
-    } else {
-        let mut value = slip.absent(0.0);
-        let mut sd = vec![0.0; value.len()];
-        value[0] = lead_s;
-        sd[0] = lead.sd[0];
-        // The braking share `1 + h / g`, within the catalogue's family; held at its absence
-        // without one.
-        if let (Some(b), Some(share), Some(spec)) =
-            (braking, value.get_mut(1), slip.params().get(1))
-        {
-            let h = &b.lead_per_fall_s;
-            *share = (1.0 + h.value[0] / lead_s).clamp(spec.lo, spec.hi);
-            sd[1] = h.sd[0] / lead_s;
+    let h = braking.map(|b| &b.lead_per_fall_s);
+    let least_share = slip.params().get(1).map_or(-1.0, |spec| spec.lo);
+    let split = split_lead(lead.value[0], h.map(|h| h.value[0]), least_share);
+    let h_sd = h.map_or(0.0, |h| h.sd[0]);
+    let (effect, value, sd) = match split {
+        LeadSplit::Late(late_s) => (latency, vec![late_s], vec![lead.sd[0]]),
+        LeadSplit::LateBesideSlip { late_s, .. } => {
+            (latency, vec![late_s], vec![lead.sd[0].hypot(h_sd)])
         }
-        (slip, value, sd)
+        LeadSplit::Slip { gain_s, share } => {
+            let mut value = slip.absent(0.0);
+            let mut sd = vec![0.0; value.len()];
+            value[0] = gain_s;
+            sd[0] = lead.sd[0];
+            // The braking share; held at its absence without one.
+            if let (Some(read), true) = (value.get_mut(1), braking.is_some()) {
+                *read = share;
+                sd[1] = h_sd / gain_s;
+            }
+            (slip, value, sd)
+        }
+    };
+    let late_beside_slip = braking.filter(|_| matches!(split, LeadSplit::LateBesideSlip { .. }));
+    // Late by more than its error, when read beside a slip braking gives none of back.
+    let departs = match late_beside_slip {
+        Some(_) => value[0].abs() > wheel_spans::MIN_SD * sd[0],
+        None => lead.departs,
     };
     // Scored on the turn (the lead) and, with a braking share, the travel too.
     let timing = match braking {
@@ -1468,7 +1512,7 @@ fn encoders_over_truth(
         _ => wheel_spans::Reading {
             value,
             sd,
-            departs: lead.departs,
+            departs,
             ..spans.delay_s.clone()
         },
     };
@@ -1493,11 +1537,11 @@ fn encoders_over_truth(
     ];
     // Encoders late on the truth that also gain on every start and give less back on every
     // stop: the slip apart, as one that braking gives none of back (`g = −h`).
-    if let Some(b) = braking.filter(|_| effect == latency) {
+    if let (Some(b), LeadSplit::LateBesideSlip { gain_s, .. }) = (late_beside_slip, split) {
         let h = &b.lead_per_fall_s;
         let mut value = slip.absent(0.0);
         let mut sd = vec![0.0; value.len()];
-        value[0] = -h.value[0];
+        value[0] = gain_s;
         sd[0] = h.sd[0];
         if let Some(share) = value.get_mut(1) {
             *share = 0.0;
@@ -1833,8 +1877,8 @@ fn settle(
 #[cfg(test)]
 mod tests {
     use super::{
-        explaining_their_sensor, fixed_point_step, within_the_paths_scale, within_the_search,
-        REALIGN_ROUNDS, REALIGN_SETTLED,
+        explaining_their_sensor, fixed_point_step, split_lead, within_the_paths_scale,
+        within_the_search, LeadSplit, REALIGN_ROUNDS, REALIGN_SETTLED,
     };
     use crate::catalogue::{Effect, Sensor};
     use crate::conclude::{Left, Nominal};
@@ -2070,5 +2114,49 @@ mod tests {
         let next = fixed_point_step(&rounds).expect("a step");
         assert!(next > 0.1 && next < 0.25, "{next}");
         assert_eq!(fixed_point_step(&[(0.1, 0.12)]), None);
+    }
+
+    /// A lead and what braking keeps of it, named as the catalogue's entries have them: each
+    /// reading's gain on a rise (`L`) and on a fall (`L + h`) is kept.
+    #[test]
+    fn a_lead_is_split_into_the_entries_that_give_it() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // Encoders 60 ms late whose wheels slip 80 ms on a rise and give none back on a fall:
+        // 20 ms ahead on a rise, 60 ms behind on a fall. A slip alone would need a share of −3.
+        match split_lead(0.02, Some(-0.08), -1.0) {
+            LeadSplit::LateBesideSlip { late_s, gain_s } => {
+                assert!(
+                    close(late_s, 0.06) && close(gain_s, 0.08),
+                    "{late_s} {gain_s}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // Late encoders and braking that keeps a lead: late by the fall's lag.
+        match split_lead(-0.03, Some(-0.05), -1.0) {
+            LeadSplit::LateBesideSlip { late_s, gain_s } => {
+                assert!(
+                    close(late_s, 0.08) && close(gain_s, 0.05),
+                    "{late_s} {gain_s}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // A lead of 50 ms whose braking gives back 60 % of it: a slip of that share.
+        match split_lead(0.05, Some(-0.02), -1.0) {
+            LeadSplit::Slip { gain_s, share } => {
+                assert!(close(gain_s, 0.05) && close(share, 0.6), "{gain_s} {share}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Without braking read: the lead's sign.
+        assert_eq!(split_lead(-0.04, None, -1.0), LeadSplit::Late(0.04));
+        assert_eq!(
+            split_lead(0.04, None, -1.0),
+            LeadSplit::Slip {
+                gain_s: 0.04,
+                share: 1.0
+            }
+        );
     }
 }

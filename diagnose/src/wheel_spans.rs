@@ -84,7 +84,7 @@ const MIN_SPANS: usize = 20;
 const ITERATIONS: usize = 6;
 /// How many standard errors from its absence a quantity must lie to be told from it: 3, as
 /// the halves of a log are compared.
-const MIN_SD: f64 = 3.0;
+pub(crate) const MIN_SD: f64 = 3.0;
 /// The median absolute deviation of a Gaussian over its standard deviation.
 const MAD_PER_SD: f64 = 0.674_489_750_196_081_7;
 

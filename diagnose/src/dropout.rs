@@ -7,7 +7,7 @@
 //! training half's share lost. It moves no reading and no path: the ranges' residuals, which
 //! keep the valid readings only, are the same with it or without it.
 
-use hilsim_lidar_emulator::effects::dropout_probability;
+use hilsim_lidar_emulator::effects::{dropout_probability_of, ReturnLogs};
 use hilsim_sim::scenario::LidarDropout;
 
 use crate::catalogue::{Effect, Sensor, REFERENCE_REFLECTIVITY};
@@ -24,24 +24,26 @@ const PROFILE_STEPS: usize = 40;
 /// The share of the held-out rows the dropout's size is measured over: the tenth it loses most.
 const SIZE_SHARE: f64 = 0.1;
 
-/// The catalogue's loss by power at each of `rows`' `idx` under `params` (d½, s, m; m 1, a
-/// diffuse surface's, when not given).
-fn power_loss(rows: &DropoutRows, idx: &[usize], params: &[f64]) -> Vec<f64> {
+/// The logarithms of each of `rows`' `idx` returns, taken once for a fit that weighs them under
+/// many dropouts.
+fn return_logs(rows: &DropoutRows, idx: &[usize]) -> Vec<ReturnLogs> {
+    idx.iter()
+        .map(|&i| ReturnLogs::new(rows.range_m[i], rows.cos_incidence[i], rows.reflectivity[i]))
+        .collect()
+}
+
+/// The catalogue's loss by power at each of `returns` under `params` (d½, s, m; m 1, a diffuse
+/// surface's, when not given).
+fn power_loss(returns: &[ReturnLogs], params: &[f64]) -> Vec<f64> {
     let dropout = LidarDropout {
         half_loss_range_m: params.first().copied().unwrap_or(f64::NAN),
         log_power_spread: params.get(1).copied().unwrap_or(f64::NAN),
         reference: REFERENCE_REFLECTIVITY,
         incidence_power: params.get(2).copied().unwrap_or(1.0),
     };
-    idx.iter()
-        .map(|&i| {
-            dropout_probability(
-                &dropout,
-                rows.range_m[i],
-                rows.cos_incidence[i],
-                rows.reflectivity[i],
-            )
-        })
+    returns
+        .iter()
+        .map(|r| dropout_probability_of(&dropout, r))
         .collect()
 }
 
@@ -153,12 +155,13 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
     let base_train = log_likelihood(&train_lost, &zeros(train.len()), base_p);
     let base_held = log_likelihood(&held_lost, &zeros(held.len()), base_p);
     let specs = Effect::LidarDropout.params();
+    let (train_returns, held_returns) = (return_logs(rows, &train), return_logs(rows, &held));
     let mut train_ll = |x: &[f64]| {
-        let q = power_loss(rows, &train, x);
+        let q = power_loss(&train_returns, x);
         log_likelihood(&train_lost, &q, profiled_p0(&train_lost, &q))
     };
     let (params, best) = maximize(specs, &mut train_ll);
-    let q_train = power_loss(rows, &train, &params);
+    let q_train = power_loss(&train_returns, &params);
     let p0 = profiled_p0(&train_lost, &q_train);
     let p_train: Vec<f64> = q_train.iter().map(|q| p0 + (1.0 - p0) * q).collect();
     let spread = dispersion(
@@ -173,7 +176,7 @@ pub(crate) fn fit(rows: &DropoutRows) -> Option<CandidateFit> {
         .into_iter()
         .map(|sd| sd * spread.sqrt())
         .collect();
-    let q_held = power_loss(rows, &held, &params);
+    let q_held = power_loss(&held_returns, &params);
     let p_held: Vec<f64> = q_held.iter().map(|q| p0 + (1.0 - p0) * q).collect();
     let held_ll = log_likelihood(&held_lost, &q_held, p0);
     let train_gain = best - base_train;
@@ -247,6 +250,7 @@ pub(crate) fn fitted(ctx: &Context<'_>, options: &Options) -> Option<CandidateFi
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hilsim_lidar_emulator::effects::dropout_probability;
 
     /// Uniform numbers in [0, 1) from xorshift64* seeded with `state`: a fixed stream for a
     /// fixed test.

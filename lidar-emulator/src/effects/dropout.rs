@@ -46,14 +46,51 @@ pub fn dropout_probability(
     cos_incidence: f64,
     reflectivity: f64,
 ) -> f64 {
-    let power = reflectivity / dropout.reference
-        * cos_incidence.abs().powf(dropout.incidence_power)
-        / (range_m / dropout.half_loss_range_m).powi(2);
-    if power.is_nan() || power <= 0.0 {
+    dropout_probability_of(
+        dropout,
+        &ReturnLogs::new(range_m, cos_incidence, reflectivity),
+    )
+}
+
+/// The logarithms of a return's range, `|cos θ|` and reflectivity: its log power apart from
+/// the dropout's parameters, taken once for a reading weighed under many dropouts (a fit's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReturnLogs {
+    ln_range: f64,
+    ln_cos_incidence: f64,
+    ln_reflectivity: f64,
+}
+
+impl ReturnLogs {
+    /// A reading of a surface of reflectivity `reflectivity` at `range_m`, met at `|cos θ|` =
+    /// `cos_incidence`.
+    #[must_use]
+    pub fn new(range_m: f64, cos_incidence: f64, reflectivity: f64) -> Self {
+        Self {
+            ln_range: range_m.ln(),
+            ln_cos_incidence: cos_incidence.abs().ln(),
+            ln_reflectivity: reflectivity.ln(),
+        }
+    }
+}
+
+/// [`dropout_probability`] of a return given by its logarithms.
+#[must_use]
+pub fn dropout_probability_of(dropout: &LidarDropout, r: &ReturnLogs) -> f64 {
+    // cos⁰ θ is 1 whatever θ, a grazing return's too.
+    let incidence = if dropout.incidence_power == 0.0 {
+        0.0
+    } else {
+        dropout.incidence_power * r.ln_cos_incidence
+    };
+    let ln_power = r.ln_reflectivity - dropout.reference.ln() + incidence
+        - 2.0 * (r.ln_range - dropout.half_loss_range_m.ln());
+    // No power, or none defined (a negative reflectivity, a range of 0 on a black surface).
+    if ln_power.is_nan() || ln_power == f64::NEG_INFINITY {
         return 1.0;
     }
     // z = −ln(power relative to the threshold's), in units of the scatter.
-    let z = -power.ln() / dropout.log_power_spread;
+    let z = -ln_power / dropout.log_power_spread;
     1.0 / (1.0 + (-z).exp())
 }
 
@@ -81,5 +118,35 @@ mod tests {
         assert_eq!(dropout_probability(&d, 3.0, 0.0, 0.8), 1.0);
         assert_eq!(dropout_probability(&d, 0.0, 1.0, 0.8), 0.0);
         assert_eq!(dropout_probability(&d, f64::NAN, 1.0, 0.8), 1.0);
+        assert_eq!(dropout_probability(&d, 3.0, 1.0, 0.0), 1.0);
+        assert_eq!(dropout_probability(&d, 3.0, 1.0, -0.2), 1.0);
+        assert_eq!(dropout_probability(&d, 0.0, 1.0, 0.0), 1.0);
+        // By the range alone, a grazing return is lost as a head-on one is.
+        let by_range = LidarDropout {
+            incidence_power: 0.0,
+            ..d
+        };
+        assert_eq!(
+            dropout_probability(&by_range, 3.0, 0.0, 0.8),
+            dropout_probability(&by_range, 3.0, 1.0, 0.8)
+        );
+    }
+
+    /// Weighed from its logarithms, a return is lost as the power's own formula says,
+    /// `ρ cos^m θ / d²` against the threshold's (to rounding).
+    #[test]
+    fn a_return_weighed_by_its_logarithms_is_the_power_formula() {
+        let d = LidarDropout {
+            half_loss_range_m: 4.5,
+            log_power_spread: 0.3,
+            reference: 0.8,
+            incidence_power: 1.7,
+        };
+        for (range_m, cos, rho) in [(0.3, 1.0, 0.8), (4.5, 0.4, 0.5), (9.0_f64, 0.9_f64, 0.1)] {
+            let power = rho / d.reference * cos.powf(d.incidence_power) / (range_m / 4.5).powi(2);
+            let formula = 1.0 / (1.0 + power.powf(1.0 / d.log_power_spread));
+            let p = dropout_probability(&d, range_m, cos, rho);
+            assert!((p - formula).abs() < 1e-12, "{p} against {formula}");
+        }
     }
 }

@@ -19,7 +19,7 @@ mod speed_of_sound;
 mod warmup;
 mod wheel_slip;
 
-pub use dropout::dropout_probability;
+pub use dropout::{dropout_probability, dropout_probability_of, ReturnLogs};
 pub use incidence::{incidence_error_m, tan_incidence, MAX_INCIDENCE_DEG};
 pub use lidar::{BeamReturn, LidarEffects};
 pub use mixed_pixels::footprint_range_m;

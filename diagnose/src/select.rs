@@ -79,8 +79,9 @@ fn beyond_floor(c: &CandidateFit, options: &Options) -> bool {
     c.size_m > options.floors.floor_m(c.sensor, c.size_noise_m) || c.floor_multiple > 1.0
 }
 
-/// The least share of a recording a warm-up's drift must settle within: its time constant at
-/// most the span (63 % of the drift, `1 − e^{−1}`, seen to go; a shorter run names a drift
+/// The least share of a recording a warm-up's drift must settle within: its mean settling time
+/// (its time constant for one thermal mass) at most the span (for one mass, 63 % of the drift,
+/// `1 − e^{−1}`, seen to go; a shorter run names a drift
 /// whose τ it barely outlasts, as `a_warmup_of_the_constant_term_is_named_not_a_mount_offset`
 /// conceals τ = 15 s in 17 s). A drift that outlasts the
 /// run is a constant range error over it, which the warm-up's `(c + k d²) e^{−t/τ}` mimics at

@@ -111,9 +111,20 @@ impl Entry for LidarWarmupDrift {
         true
     }
 
-    /// Where its time constant τ is at most `span_s`.
+    /// Where its mean settling time is at most `span_s`: `τ Γ(1/β) / β` for the stretched
+    /// settling `e^{−(t/τ)^β}` (the Kohlrausch–Williams–Watts relaxation's mean time; Lindsey
+    /// and Patterson, J. Chem. Phys. 73, 1980), τ itself for one mass. A settling spread as
+    /// far as the family goes (β = 0.35) takes 4.8 τ on average: at τ of a thousand seconds
+    /// it is a drift over the whole of an hour's log, not a warm-up.
     fn settles_within(&self, params: &[f64], span_s: f64) -> bool {
-        params.get(1).is_some_and(|tau_s| *tau_s <= span_s)
+        let stretch = params
+            .get(3)
+            .copied()
+            .unwrap_or(1.0)
+            .clamp(STRETCH_LEAST, STRETCH_MOST);
+        params
+            .get(1)
+            .is_some_and(|tau_s| tau_s * libm::tgamma(1.0 / stretch) / stretch <= span_s)
     }
 
     /// Absent at k = 0 for any τ.
@@ -175,5 +186,27 @@ impl Entry for LidarWarmupDrift {
             (p(2) + p(0) * 0.25) * 1000.0,
             (p(2) + p(0) * 16.0) * 1000.0,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LidarWarmupDrift, STRETCH_LEAST};
+    use crate::catalogue::Entry;
+
+    /// One mass settles on average in τ; a settling spread as far as the family goes takes
+    /// Γ(1/β)/β ≈ 4.8 τ, so at τ = 1000 s it outlasts a 22-minute log and not a 75-minute one
+    /// at τ = 300 s.
+    #[test]
+    fn a_warmup_settles_within_a_span_by_its_mean_settling_time() {
+        let w = LidarWarmupDrift;
+        let at = |tau_s: f64, stretch: f64| vec![0.005, tau_s, 0.0, stretch];
+        assert!(w.settles_within(&at(250.0, 1.0), 1339.0));
+        assert!(w.settles_within(&at(1000.0, 1.0), 1339.0));
+        assert!(!w.settles_within(&at(1000.0, STRETCH_LEAST), 1339.0));
+        assert!(!w.settles_within(&at(300.0, STRETCH_LEAST), 1339.0));
+        assert!(w.settles_within(&at(300.0, STRETCH_LEAST), 2684.0));
+        // Held at one mass when the stretch is not fitted.
+        assert!(w.settles_within(&[0.005, 60.0], 60.0));
     }
 }

@@ -1483,18 +1483,17 @@ fn encoders_over_truth(
             value[0] = gain_s;
             sd[0] = lead.sd[0];
             // The braking share; held at its absence without one.
-            if let (Some(read), true) = (value.get_mut(1), braking.is_some()) {
+            if let (Some(read), Some(_)) = (value.get_mut(1), h) {
                 *read = share;
                 sd[1] = h_sd / gain_s;
             }
             (slip, value, sd)
         }
     };
-    let late_beside_slip = braking.filter(|_| matches!(split, LeadSplit::LateBesideSlip { .. }));
     // Late by more than its error, when read beside a slip braking gives none of back.
-    let departs = match late_beside_slip {
-        Some(_) => value[0].abs() > wheel_spans::MIN_SD * sd[0],
-        None => lead.departs,
+    let departs = match split {
+        LeadSplit::LateBesideSlip { .. } => value[0].abs() > wheel_spans::MIN_SD * sd[0],
+        _ => lead.departs,
     };
     // Scored on the turn (the lead) and, with a braking share, the travel too.
     let timing = match braking {
@@ -1537,8 +1536,7 @@ fn encoders_over_truth(
     ];
     // Encoders late on the truth that also gain on every start and give less back on every
     // stop: the slip apart, as one that braking gives none of back (`g = −h`).
-    if let (Some(b), LeadSplit::LateBesideSlip { gain_s, .. }) = (late_beside_slip, split) {
-        let h = &b.lead_per_fall_s;
+    if let (Some(h), LeadSplit::LateBesideSlip { gain_s, .. }) = (h, split) {
         let mut value = slip.absent(0.0);
         let mut sd = vec![0.0; value.len()];
         value[0] = gain_s;

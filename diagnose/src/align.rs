@@ -60,6 +60,9 @@ pub(crate) struct Aligned {
     pub reckoned: Option<DeadReckoning>,
     /// With [`DeadReckoning::Scans`], the matches smoothed along the encoders between them.
     pub smoothed: Option<Trajectory>,
+    /// What an estimate's revolutions were matched along ([`Estimate::matched_along`]; `None`
+    /// for `truth.csv`): estimated again, it is matched along the same.
+    pub matched_along: Option<DeadReckoning>,
     /// What the path the drive is judged against followed between the lidar's corrections,
     /// when the drive is judged against an estimate (`None` otherwise).
     pub drive_reckoned: Option<DeadReckoning>,
@@ -116,6 +119,7 @@ pub(crate) fn align(
         ));
     }
     let mut first_smoothed = None;
+    let mut matched_along = None;
     let (trajectory, alignment, position_sd_m, yaw_sd_rad, reckoned) = match &recording.truth {
         Some(truth) if !truth.is_empty() => (
             truth_trajectory(truth, recording, declared.wheel_base_m, &mut notes)?,
@@ -137,14 +141,17 @@ pub(crate) fn align(
                 uncertainty: sd,
                 reckoned,
                 smoothed,
+                matched_along: along,
             } = estimate_trajectory(
                 physics,
                 recording,
                 end_s,
                 &Hypothesis::nominal(),
                 DeadReckoning::Commands,
+                None,
             )?;
             first_smoothed = smoothed;
+            matched_along = Some(along);
             notes.push(format!(
                 "no truth.csv: the trajectory is estimated by matching the lidar to the \
                  scenario's world (position s.d. {:.1} mm, heading {:.2} mrad); every sensor is \
@@ -189,6 +196,7 @@ pub(crate) fn align(
         yaw_sd_rad,
         reckoned,
         smoothed: first_smoothed,
+        matched_along,
         drive_reckoned: None,
         replayed: Hypothesis::nominal(),
         notes,
@@ -230,8 +238,13 @@ fn truth_trajectory(
 #[derive(Default)]
 pub(crate) struct Estimates(Mutex<Vec<(EstimateKey, Estimate)>>);
 
-/// The effects (sorted, parameters bit for bit) and the dead reckoning followed.
-type EstimateKey = (Vec<(Effect, Vec<u64>)>, DeadReckoning);
+/// The effects (sorted, parameters bit for bit), the dead reckoning followed and what the
+/// revolutions were matched along.
+type EstimateKey = (
+    Vec<(Effect, Vec<u64>)>,
+    DeadReckoning,
+    Option<DeadReckoning>,
+);
 
 /// Estimates kept at most (each a trajectory of the recording's length).
 const MAX_ESTIMATES: usize = 16;
@@ -245,6 +258,7 @@ impl Estimates {
         end_s: f64,
         hypothesis: &Hypothesis,
         preferred: DeadReckoning,
+        matched_along: Option<DeadReckoning>,
     ) -> Result<Estimate, MismatchError> {
         let mut effects: Vec<(Effect, Vec<u64>)> = hypothesis
             .effects
@@ -252,7 +266,7 @@ impl Estimates {
             .map(|(e, p)| (*e, p.iter().map(|v| v.to_bits()).collect()))
             .collect();
         effects.sort();
-        let key = (effects, preferred);
+        let key = (effects, preferred, matched_along);
         let found = self
             .0
             .lock()
@@ -261,7 +275,14 @@ impl Estimates {
         if let Some(estimate) = found {
             return Ok(estimate);
         }
-        let estimate = estimate_trajectory(physics, recording, end_s, hypothesis, preferred)?;
+        let estimate = estimate_trajectory(
+            physics,
+            recording,
+            end_s,
+            hypothesis,
+            preferred,
+            matched_along,
+        )?;
         if let Ok(mut done) = self.0.lock() {
             if done.len() >= MAX_ESTIMATES {
                 done.remove(0);
@@ -300,8 +321,14 @@ pub(crate) fn realign(
         .filter(|(e, _)| e.sensor() == Sensor::Drive)
         .fold(Hypothesis::nominal(), |h, (e, p)| h.and(*e, p.clone()));
     let preferred = aligned.reckoned.unwrap_or(DeadReckoning::Commands);
-    let estimate =
-        estimates.get_or_estimate(physics, recording, aligned.end_s, &full, preferred)?;
+    let estimate = estimates.get_or_estimate(
+        physics,
+        recording,
+        aligned.end_s,
+        &full,
+        preferred,
+        aligned.matched_along,
+    )?;
     Ok(aligned.estimated_again(estimate, replayed))
 }
 
@@ -316,6 +343,7 @@ impl Aligned {
             yaw_sd_rad: estimate.uncertainty.yaw_rad,
             reckoned: Some(estimate.reckoned),
             smoothed: estimate.smoothed,
+            matched_along: Some(estimate.matched_along),
             drive_reckoned: self.drive_reckoned,
             replayed,
             notes: self.notes.clone(),
@@ -343,6 +371,7 @@ pub(crate) fn along_encoders(
         aligned.end_s,
         &Hypothesis::nominal(),
         DeadReckoning::Encoders,
+        None,
     )?;
     Ok(estimate
         .reckoned

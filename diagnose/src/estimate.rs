@@ -202,7 +202,9 @@ pub(crate) struct Uncertainty {
 /// The trajectory estimated from `recording` following `preferred` between the lidar's
 /// corrections, its uncertainty and what it followed, with the lidar predicted and the
 /// commands replayed under `hypothesis` (the nominal model first; fitted effects when
-/// re-aligning).
+/// re-aligning). `matched_along` is the path an earlier estimate of the same recording chose to
+/// match its revolutions along ([`Estimate::matched_along`]), followed again without choosing
+/// anew; `None` to choose.
 ///
 /// # Errors
 /// [`MismatchError::Refused`] without lidar readings to match.
@@ -212,6 +214,7 @@ pub(crate) fn estimate_trajectory(
     end_s: f64,
     hypothesis: &Hypothesis,
     preferred: DeadReckoning,
+    matched_along: Option<DeadReckoning>,
 ) -> Result<Estimate, MismatchError> {
     let Some(lidar) = recording.lidar.as_ref().filter(|l| !l.is_empty()) else {
         return Err(MismatchError::Refused(
@@ -219,8 +222,6 @@ pub(crate) fn estimate_trajectory(
                 .into(),
         ));
     };
-    let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
-    let estimate = matched(physics, lidar, &base, hypothesis)?;
     // Without commands, a path that follows the encoders would leave them nothing to be judged
     // against: the matches alone are the path then (unless the encoders' own path is asked
     // for).
@@ -235,6 +236,7 @@ pub(crate) fn estimate_trajectory(
                     uncertainty,
                     reckoned: DeadReckoning::Scans,
                     smoothed: Some(m.trajectory),
+                    matched_along: reckoned,
                 }
             }
             _ => Estimate {
@@ -242,19 +244,31 @@ pub(crate) fn estimate_trajectory(
                 uncertainty: m.uncertainty,
                 reckoned,
                 smoothed: None,
+                matched_along: reckoned,
             },
         }
     };
+    let path = declared_path(physics);
+    if let (Some(DeadReckoning::DeclaredPath), Some(path)) = (matched_along, &path) {
+        let along_path = matched(physics, lidar, path, hypothesis)?;
+        return Ok(finish(along_path, DeadReckoning::DeclaredPath));
+    }
+    let (base, reckoned) = dead_reckoning(physics, recording, end_s, preferred, hypothesis)?;
+    let estimate = matched(physics, lidar, &base, hypothesis)?;
     // A twin's path is the encoders already matched to these scans by `hilsim world`: the same
     // motion without the drift that the encoders' bare integration gathers over a long run, or
     // that commands replayed on wheels of another size turn away by, faster than a revolution's
     // match follows (measured on a 75 s rover log: from the bare integration the matches lost
     // the path by metres). It is taken when it matches at least as many of the readings as the
     // encoders, and clearly more than the commands (along which the encoders stay
-    // diagnosable). A twin of another run matches few of this one's.
-    if reckoned != DeadReckoning::DeclaredPath {
-        if let Some(path) = declared_path(physics) {
-            let along_path = matched(physics, lidar, &path, hypothesis)?;
+    // diagnosable). A twin of another run matches few of this one's. The choice is made once,
+    // under the nominal model: an estimate again under fitted effects follows what it chose
+    // (each choice matches every revolution, and on a log without commands the encoders'
+    // integration, which loses the path, would be matched in every estimate only to be
+    // dropped).
+    if reckoned != DeadReckoning::DeclaredPath && matched_along.is_none() {
+        if let Some(path) = &path {
+            let along_path = matched(physics, lidar, path, hypothesis)?;
             let margin = match reckoned {
                 DeadReckoning::Commands => LOST_TRACK_SHARE,
                 _ => 0.0,
@@ -277,6 +291,9 @@ pub(crate) struct Estimate {
     /// them (a random walk of corrections): less of each match's own noise, for what reads the
     /// path's shape over short steps (`crab.rs`).
     pub smoothed: Option<Trajectory>,
+    /// What the revolutions were matched along: the commands' replay, the encoders' travel or
+    /// the scenario's path.
+    pub matched_along: DeadReckoning,
 }
 
 /// How many more of the readings (within Huber's k of their prediction at the match) a twin's

@@ -6,7 +6,8 @@ use serde_json::{json, Value};
 
 use super::conceal::Concealment;
 use super::on_log::{
-    Answer, LogSelfTest, GOAL_FALSE_ON_LOG, GOAL_NAMED_ON_LOG, GOAL_PARAMS_ON_LOG, HALVES_WITHIN_SD,
+    Answer, LogSelfTest, GOAL_FALSE_ON_LOG, GOAL_NAMED_ON_LOG, GOAL_PARAMS_ON_LOG,
+    HALVES_WITHIN_SD, READ_UNNAMED_SD,
 };
 use super::trial::verdict_label;
 use super::GOAL_PARAM_ERROR;
@@ -110,7 +111,9 @@ impl LogSelfTest {
             })).collect::<Vec<_>>(),
             "per_effect": s.per_effect.iter().map(|(e, c, n)| json!({"effect": e.label(), "concealed": c, "named": n})).collect::<Vec<_>>(),
             "concealed": s.concealed, "named": s.named,
-            "false_alarms": s.false_alarms, "refused": s.refused, "undone": s.undone,
+            "false_alarms": s.false_alarms,
+            "false_alarms_read_untouched": s.false_alarms_read_untouched,
+            "refused": s.refused, "undone": s.undone,
             "param_within_20pct": s.param_within, "param_scored": s.param_scored,
             "pass": self.passed(),
             "wall_s": wall_s,
@@ -199,6 +202,13 @@ impl LogSelfTest {
             100.0 * GOAL_FALSE_ON_LOG,
             mark(pct(s.false_alarms, s.trials) <= 100.0 * GOAL_FALSE_ON_LOG)
         )?;
+        if s.false_alarms_read_untouched > 0 {
+            writeln!(
+                out,
+                "  of which {} named only what the untouched log fits, the same way, {READ_UNNAMED_SD} or more standard errors from nothing, without naming it: the log's own, at the naming's threshold",
+                s.false_alarms_read_untouched,
+            )?;
+        }
         writeln!(
             out,
             "parameters: {}/{} within {:.0} % ({:.0} %; goal ≥ {:.0} %) {}",

@@ -81,13 +81,13 @@ fn beyond_floor(c: &CandidateFit, options: &Options) -> bool {
 
 /// The least share of a recording a warm-up's drift must settle within: its mean settling time
 /// (its time constant for one thermal mass) at most the span (for one mass, 63 % of the drift,
-/// `1 − e^{−1}`, seen to go; a shorter run names a drift
-/// whose τ it barely outlasts, as `a_warmup_of_the_constant_term_is_named_not_a_mount_offset`
-/// conceals τ = 15 s in 17 s). A drift that outlasts the
-/// run is a constant range error over it, which the warm-up's `(c + k d²) e^{−t/τ}` mimics at
-/// τ far beyond the run and a unit's warm-up is not: without truth, a range error of another
-/// form than the catalogue's (a reflectivity walk written otherwise) is fitted as a "warm-up" of
-/// τ in the hundreds of seconds. The self-test conceals τ of 5–20 s in 60 s runs.
+/// `1 − e^{−1}`, seen to go; a shorter run names a drift whose τ it barely outlasts, as
+/// `a_warmup_of_the_constant_term_is_named_not_a_mount_offset` conceals τ = 15 s in 17 s). A
+/// drift that outlasts the run is a constant range error over it, which the warm-up's
+/// `(c + k d²) e^{−t/τ}` mimics at τ far beyond the run and a unit's warm-up is not: without
+/// truth, a range error of another form than the catalogue's (a reflectivity walk written
+/// otherwise) is fitted as a "warm-up" of τ in the hundreds of seconds. The self-test conceals
+/// τ of 5–20 s in 60 s runs.
 const WARMUP_SETTLED_SHARE: f64 = 1.0;
 
 /// Whether `c`, a lidar warm-up, is seen to settle within the readings it was scored on

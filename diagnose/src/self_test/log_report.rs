@@ -106,6 +106,7 @@ impl LogSelfTest {
                 })).collect::<Vec<_>>(),
                 "answer": answer_json(&o.answer),
                 "names_absent": o.names_absent(&b.whole).iter().map(|e| e.label()).collect::<Vec<_>>(),
+                "names_absent_read_untouched": o.alarms_read_untouched(&b.whole),
                 "param_errors": o.param_errors.iter().map(|(e, v)| (e.label(), json!(finite(*v)))).collect::<serde_json::Map<_, _>>(),
                 "seconds": o.seconds,
             })).collect::<Vec<_>>(),
